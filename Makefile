@@ -1,0 +1,44 @@
+# nlobs — two commands: `make demo` (the main job) and `make test`.
+# Both install missing Debian packages (scripts/ensure-deps.sh), configure (Release), build, run.
+BUILD      ?= build
+BUILD_TYPE ?= Release
+WERROR     ?= OFF
+JOBS       ?= 2
+CMAKE_ARGS ?=
+
+.PHONY: all deps configure build test demo bench sanitize format format-check clean
+
+all: build
+
+deps:
+	@./scripts/ensure-deps.sh
+
+configure: deps
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DNLOBS_WERROR=$(WERROR) $(CMAKE_ARGS)
+
+build: configure
+	cmake --build $(BUILD) -j $(JOBS)
+
+test: build
+	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
+
+demo: build
+	$(BUILD)/cli/nlobs solve chua-window --tol 1e-5
+
+bench: build
+	$(BUILD)/bench/nlobs_bench --benchmark_min_time=0.2
+
+# AddressSanitizer + UndefinedBehaviorSanitizer, warnings as errors, separate build directory.
+sanitize: deps
+	cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DNLOBS_SANITIZE=ON -DNLOBS_WERROR=ON $(CMAKE_ARGS)
+	cmake --build build-asan -j $(JOBS)
+	ctest --test-dir build-asan --output-on-failure -j $(JOBS)
+
+format:
+	find solvers observers models bench cli tests examples -name '*.hpp' -o -name '*.cpp' | xargs clang-format -i
+
+format-check:
+	find solvers observers models bench cli tests examples -name '*.hpp' -o -name '*.cpp' | xargs clang-format --dry-run --Werror
+
+clean:
+	rm -rf $(BUILD) build-asan

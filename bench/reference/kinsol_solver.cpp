@@ -1,0 +1,125 @@
+#include "reference/kinsol_solver.hpp"
+
+#include <kinsol/kinsol.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+
+#include <cstdlib>
+#include <stdexcept>
+
+namespace nlobs::reference {
+
+struct KinsolSolver::Impl {
+  int n = 0;
+  KinsolOptions options;
+  Function function;
+  Jacobian jacobian;
+  SUNContext context = nullptr;
+  void* kinsol = nullptr;
+  N_Vector u = nullptr, scale = nullptr;
+  SUNMatrix matrix = nullptr;
+  SUNLinearSolver linear_solver = nullptr;
+  Eigen::VectorXd x_in, f_out;
+  Eigen::MatrixXd jac_out;
+
+  static int residual(N_Vector u_vec, N_Vector f_vec, void* data) {
+    auto* self = static_cast<Impl*>(data);
+    self->x_in = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(u_vec), self->n);
+    self->function(self->x_in, self->f_out);
+    Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(f_vec), self->n) = self->f_out;
+    return self->f_out.allFinite() ? 0 : 1;  // > 0: recoverable error
+  }
+  static int dense_jacobian(N_Vector u_vec, N_Vector, SUNMatrix jac, void* data, N_Vector,
+                            N_Vector) {
+    auto* self = static_cast<Impl*>(data);
+    self->x_in = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(u_vec), self->n);
+    self->jacobian(self->x_in, self->jac_out);
+    // SUNDIALS dense matrices are column-major, like Eigen's default.
+    Eigen::Map<Eigen::MatrixXd>(SUNDenseMatrix_Data(jac), self->n, self->n) = self->jac_out;
+    return 0;
+  }
+  static void silent(int, const char*, const char*, char*, void*) {}
+
+  void check(int flag, const char* call) {
+    if (flag < 0) throw std::runtime_error(std::string("KINSOL: ") + call + " failed");
+  }
+};
+
+KinsolSolver::KinsolSolver(int n, KinsolOptions options, Function function, Jacobian jacobian)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& s = *impl_;
+  s.n = n;
+  s.options = options;
+  s.function = std::move(function);
+  s.jacobian = std::move(jacobian);
+  s.x_in.resize(n);
+  s.f_out.resize(n);
+  s.jac_out.resize(n, n);
+  s.check(SUNContext_Create(nullptr, &s.context), "SUNContext_Create");
+  s.u = N_VNew_Serial(n, s.context);
+  s.scale = N_VNew_Serial(n, s.context);
+  N_VConst(1.0, s.scale);
+  s.kinsol = KINCreate(s.context);
+  if (s.kinsol == nullptr) throw std::runtime_error("KINSOL: KINCreate failed");
+  s.check(KINSetErrHandlerFn(s.kinsol, &Impl::silent, nullptr), "KINSetErrHandlerFn");
+  if (options.strategy == KinsolStrategy::kFixedPointAnderson) {
+    s.check(KINSetMAA(s.kinsol, options.anderson_depth), "KINSetMAA");  // before KINInit
+  }
+  N_VConst(0.0, s.u);
+  s.check(KINInit(s.kinsol, &Impl::residual, s.u), "KINInit");
+  s.check(KINSetUserData(s.kinsol, &s), "KINSetUserData");
+  s.check(KINSetFuncNormTol(s.kinsol, options.tolerance), "KINSetFuncNormTol");
+  s.check(KINSetScaledStepTol(s.kinsol, options.tolerance), "KINSetScaledStepTol");
+  s.check(KINSetNumMaxIters(s.kinsol, options.max_iterations), "KINSetNumMaxIters");
+  if (options.strategy == KinsolStrategy::kNewtonLineSearch) {
+    s.matrix = SUNDenseMatrix(n, n, s.context);
+    s.linear_solver = SUNLinSol_Dense(s.u, s.matrix, s.context);
+    s.check(KINSetLinearSolver(s.kinsol, s.linear_solver, s.matrix), "KINSetLinearSolver");
+    if (s.jacobian) s.check(KINSetJacFn(s.kinsol, &Impl::dense_jacobian), "KINSetJacFn");
+    s.check(KINSetMaxSetupCalls(s.kinsol, 1), "KINSetMaxSetupCalls");  // exact Newton
+  }
+}
+
+KinsolSolver::~KinsolSolver() {
+  Impl& s = *impl_;
+  KINFree(&s.kinsol);
+  if (s.linear_solver) SUNLinSolFree(s.linear_solver);
+  if (s.matrix) SUNMatDestroy(s.matrix);
+  N_VDestroy(s.u);
+  N_VDestroy(s.scale);
+  SUNContext_Free(&s.context);
+}
+
+KinsolResult KinsolSolver::solve(Eigen::VectorXd& x) {
+  Impl& s = *impl_;
+  if (x.size() != s.n) throw std::invalid_argument("KinsolSolver::solve: wrong size");
+  Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(s.u), s.n) = x;
+  const int strategy =
+      s.options.strategy == KinsolStrategy::kNewtonLineSearch ? KIN_LINESEARCH : KIN_FP;
+  KinsolResult r;
+  r.flag = KINSol(s.kinsol, s.u, strategy, s.scale, s.scale);
+  r.success = r.flag >= 0;
+  char* name = KINGetReturnFlagName(r.flag);
+  r.flag_name = name ? name : "?";
+  free(name);
+  KINGetNumNonlinSolvIters(s.kinsol, &r.iterations);
+  KINGetNumFuncEvals(s.kinsol, &r.evaluations);
+  x = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(s.u), s.n);
+  return r;
+}
+
+std::string KinsolSolver::name(KinsolStrategy strategy) {
+  switch (strategy) {
+    case KinsolStrategy::kFixedPoint:
+      return "kinsol:fp";
+    case KinsolStrategy::kFixedPointAnderson:
+      return "kinsol:fp-aa2";
+    case KinsolStrategy::kNewtonLineSearch:
+      return "kinsol:newton";
+  }
+  return "kinsol:?";
+}
+
+}  // namespace nlobs::reference

@@ -1,0 +1,210 @@
+#include "solve_chua_window.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <memory>
+#include <ostream>
+#include <stdexcept>
+
+#include "nlobs/solvers/solvers.hpp"
+#include "reference/chua_window.hpp"
+#include "reference/kinsol_solver.hpp"
+
+namespace nlobs::cli {
+namespace {
+
+using reference::KinsolStrategy;
+
+std::unique_ptr<Engine<3>> make_engine(const std::string& name, const SolverOptions& options) {
+  if (name == "picard") return std::make_unique<PicardEngine<3>>(options);
+  if (name == "aitken") return std::make_unique<AitkenEngine<3>>(options);
+  if (name == "steffensen") return std::make_unique<SteffensenEngine<3>>(options);
+  if (name == "anderson") return std::make_unique<AndersonEngine<3>>(AndersonOptions{}, options);
+  if (name == "newton") return std::make_unique<NewtonEngine<3>>(NewtonOptions{}, options);
+  return nullptr;
+}
+
+KinsolStrategy strategy_of(const std::string& name) {
+  if (name == "kinsol:fp") return KinsolStrategy::kFixedPoint;
+  if (name == "kinsol:fp-aa2") return KinsolStrategy::kFixedPointAnderson;
+  return KinsolStrategy::kNewtonLineSearch;
+}
+
+// Mean wall time of `solve_once` over batches totalling at least 20 ms (at least 3 calls).
+double time_per_solve(const std::function<void()>& solve_once) {
+  using Clock = std::chrono::steady_clock;
+  long calls = 0;
+  long batch = 1;
+  const auto start = Clock::now();
+  double elapsed_ns = 0.0;
+  while (elapsed_ns < 2e7 || calls < 3) {
+    for (long i = 0; i < batch; ++i) solve_once();
+    calls += batch;
+    batch *= 2;
+    elapsed_ns = std::chrono::duration<double, std::nano>(Clock::now() - start).count();
+  }
+  return elapsed_ns / static_cast<double>(calls);
+}
+
+std::string kinsol_status(const reference::KinsolResult& r) {
+  if (r.success) return "converged";
+  if (r.flag_name == "KIN_MAXITER_REACHED") return "max_iterations";
+  std::string s = r.flag_name;
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+SolveRow run_engine(const std::string& name, const reference::ChuaWindowCase& c, double tol) {
+  SolverOptions options;
+  options.stop.step_tolerance = tol;      // KINSOL's scsteptol
+  options.stop.residual_tolerance = tol;  // KINSOL's fnormtol
+  std::unique_ptr<Engine<3>> engine = make_engine(name, options);
+  Vector<3> x = c.initial_guess;
+  const Summary s = engine->solve(c.problem, x);
+  SolveRow row{name,
+               std::string(to_string(s.status)),
+               s.iterations,
+               s.function_evaluations,
+               x,
+               (x - c.true_state).lpNorm<Eigen::Infinity>(),
+               0.0};
+  row.ns_per_solve = time_per_solve([&] {
+    Vector<3> xr = c.initial_guess;
+    engine->solve(c.problem, xr);
+  });
+  return row;
+}
+
+SolveRow run_kinsol(const std::string& name, const reference::ChuaWindowCase& c, double tol) {
+  reference::KinsolOptions options;
+  options.strategy = strategy_of(name);
+  options.tolerance = tol;
+  const FixedPointProblem<3>& p = c.problem;
+  reference::KinsolSolver::Function function;
+  reference::KinsolSolver::Jacobian jacobian;
+  if (options.strategy == KinsolStrategy::kNewtonLineSearch) {
+    function = [&p](const Eigen::VectorXd& x, Eigen::VectorXd& f) {  // F = G(x) − x
+      Vector<3> g;
+      p.evaluate(x, g);
+      f = g - x;
+    };
+    jacobian = [&p](const Eigen::VectorXd& x, Eigen::MatrixXd& j) {  // ∂F = ∂G − I
+      Matrix<3, 3> dg;
+      p.jacobian(x, dg);
+      j = dg - Matrix<3, 3>::Identity();
+    };
+  } else {
+    function = [&p](const Eigen::VectorXd& x, Eigen::VectorXd& g) {
+      Vector<3> gx;
+      p.evaluate(x, gx);
+      g = gx;
+    };
+  }
+  reference::KinsolSolver solver(3, options, function, jacobian);
+  Eigen::VectorXd x = c.initial_guess;
+  const reference::KinsolResult r = solver.solve(x);
+  SolveRow row{name,
+               kinsol_status(r),
+               r.iterations,
+               r.evaluations,
+               x,
+               (x - c.true_state).lpNorm<Eigen::Infinity>(),
+               0.0};
+  Eigen::VectorXd xr(3);
+  row.ns_per_solve = time_per_solve([&] {
+    xr = c.initial_guess;
+    solver.solve(xr);
+  });
+  return row;
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& e : v) s += (s.empty() ? "" : ", ") + e;
+  return s;
+}
+
+}  // namespace
+
+const std::vector<std::string>& engine_names() {
+  static const std::vector<std::string> names = {"picard", "aitken", "steffensen", "anderson",
+                                                 "newton"};
+  return names;
+}
+
+const std::vector<std::string>& reference_names() {
+  static const std::vector<std::string> names = {"kinsol:fp", "kinsol:fp-aa2", "kinsol:newton"};
+  return names;
+}
+
+std::vector<SolveRow> solve_chua_window(const std::vector<std::string>& engines, double tolerance,
+                                        bool with_reference) {
+  if (!(std::isfinite(tolerance) && tolerance > 0.0)) {
+    throw std::invalid_argument("--tol " + std::to_string(tolerance) +
+                                " is invalid: must be finite and > 0");
+  }
+  const auto& ours = engine_names();
+  const auto& refs = reference_names();
+  std::vector<std::string> order;
+  for (const std::string& e : engines) {
+    const bool known = std::find(ours.begin(), ours.end(), e) != ours.end() ||
+                       std::find(refs.begin(), refs.end(), e) != refs.end();
+    if (!known) {
+      throw std::invalid_argument("unknown engine '" + e + "'; valid engines: " + join(ours) +
+                                  ", " + join(refs));
+    }
+    if (std::find(order.begin(), order.end(), e) == order.end()) order.push_back(e);
+  }
+  if (with_reference) {
+    for (const std::string& r : refs) {
+      if (std::find(order.begin(), order.end(), r) == order.end()) order.push_back(r);
+    }
+  }
+  const reference::ChuaWindowCase c;
+  std::vector<SolveRow> rows;
+  for (const std::string& e : order) {
+    rows.push_back(e.rfind("kinsol:", 0) == 0 ? run_kinsol(e, c, tolerance)
+                                              : run_engine(e, c, tolerance));
+  }
+  return rows;
+}
+
+void print_table(const std::vector<SolveRow>& rows, double tolerance, std::ostream& out) {
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "modified-Chua window (METHODS §1): x_true = [1, 2.1428, -0.1648], "
+                "x0 = [5, 10, -5], tol = %g\n",
+                tolerance);
+  out << line;
+  std::snprintf(line, sizeof line, "%-14s %-17s %6s %6s  %-34s %10s %12s\n", "engine", "status",
+                "iter", "evals", "solution", "|x-x*|inf", "ns/solve");
+  out << line;
+  for (const SolveRow& r : rows) {
+    char sol[64];
+    std::snprintf(sol, sizeof sol, "[%.6f, %.6f, %.6f]", r.solution[0], r.solution[1],
+                  r.solution[2]);
+    std::snprintf(line, sizeof line, "%-14s %-17s %6ld %6ld  %-34s %10.2e %12.0f\n",
+                  r.engine.c_str(), r.status.c_str(), r.iterations, r.evaluations, sol, r.error,
+                  r.ns_per_solve);
+    out << line;
+  }
+}
+
+nlohmann::json to_json(const std::vector<SolveRow>& rows) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const SolveRow& r : rows) {
+    a.push_back({{"engine", r.engine},
+                 {"status", r.status},
+                 {"iterations", r.iterations},
+                 {"evaluations", r.evaluations},
+                 {"solution", {r.solution[0], r.solution[1], r.solution[2]}},
+                 {"error", r.error},
+                 {"ns_per_solve", r.ns_per_solve}});
+  }
+  return a;
+}
+
+}  // namespace nlobs::cli

@@ -1,0 +1,158 @@
+#pragma once
+// Anderson acceleration (type II, Walker & Ni 2011; the accelerator of KINSOL's fixed-point
+// solver). With f_k = G(x_k) − x_k and the last m_k = min(m, k) differences
+//   ΔX = [x_{i+1} − x_i], ΔF = [f_{i+1} − f_i]   (oldest column first),
+//   γ = argmin ‖f_k − ΔF γ‖₂,   x_{k+1} = x_k + β f_k − (ΔX + β ΔF) γ,
+// β the damping (β = 1: x_{k+1} = G(x_k) − ΔG γ). Depth 0 is damped Picard.
+//
+// The least-squares problem is solved through a thin QR factorisation ΔF = Q R that is updated,
+// not recomputed: a new column is orthogonalised against Q (modified Gram–Schmidt, O(nm)); when
+// the history is full the oldest column is removed with Givens rotations (O(m² + nm)). Then
+// γ = R⁻¹ Qᵀ f and ΔF γ = Q Qᵀ f. A new column that is numerically dependent on the history
+// (‖q‖ ≤ 1e-13 ‖Δf‖) is not added. Fixed N: all storage is on the stack (depth ≤
+// kMaxFixedDepth), so a solve never allocates; dynamic N allocates in start() when n changes.
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <type_traits>
+
+#include "nlobs/solvers/status.hpp"
+#include "nlobs/solvers/types.hpp"
+
+namespace nlobs {
+
+struct AndersonOptions {
+  int depth = 3;         // m ≥ 0
+  double damping = 1.0;  // β ∈ (0, 1]
+};
+
+template <int N = Dynamic>
+class AndersonMixing {
+ public:
+  static constexpr int kMaxFixedDepth = 16;
+
+  explicit AndersonMixing(AndersonOptions options = {}) : options_(options) {
+    if (options_.depth < 0 || (N != Dynamic && options_.depth > kMaxFixedDepth)) {
+      std::ostringstream os;
+      os << "AndersonOptions::depth = " << options_.depth << " is invalid: must be >= 0"
+         << (N != Dynamic ? " and <= " + std::to_string(kMaxFixedDepth) + " for fixed sizes"
+                          : std::string());
+      throw InvalidInput(os.str());
+    }
+    if (!(options_.damping > 0.0 && options_.damping <= 1.0)) {
+      std::ostringstream os;
+      os << "AndersonOptions::damping = " << options_.damping << " is invalid: must lie in (0, 1]";
+      throw InvalidInput(os.str());
+    }
+  }
+
+  std::string_view name() const { return "anderson"; }
+  const AndersonOptions& options() const { return options_; }
+
+  void start(const Vector<N>& x0) {
+    const Index n = x0.size(), m = options_.depth;
+    dx_.resize(n, m), q_.resize(n, m), r_.resize(m, m), dg_.resize(m);
+    f_.resize(n), x_prev_.resize(n), f_prev_.resize(n), v_.resize(n);
+    count_ = 0;
+    have_prev_ = false;
+  }
+
+  bool propose(const Vector<N>& x, const Vector<N>& gx, Vector<N>& next, Vector<N>& estimate) {
+    const double beta = options_.damping;
+    f_ = gx - x;
+    if (options_.depth > 0 && have_prev_) add_column(x);
+    x_prev_ = x;
+    f_prev_ = f_;
+    have_prev_ = true;
+
+    next = x + beta * f_;
+    if (count_ > 0) {
+      const int k = count_;
+      // c = Qᵀ f;  γ = R⁻¹ c (back substitution);  ΔF γ = Q c.
+      for (int i = 0; i < k; ++i) dg_[i] = q_.col(i).dot(f_);
+      next -= beta * (q_.leftCols(k) * dg_.head(k));
+      for (int i = k - 1; i >= 0; --i) {
+        double s = dg_[i];
+        for (int j = i + 1; j < k; ++j) s -= r_(i, j) * dg_[j];
+        dg_[i] = s / r_(i, i);
+      }
+      next -= dx_.leftCols(k) * dg_.head(k);
+    }
+    estimate = next;
+    return true;
+  }
+
+ private:
+  // Appends Δx = x − x_prev, Δf = f − f_prev to the history and to its QR factorisation.
+  void add_column(const Vector<N>& x) {
+    const int m = options_.depth;
+    v_ = f_ - f_prev_;
+    const double dfnorm = v_.norm();
+    if (!(dfnorm > 0.0) || !std::isfinite(dfnorm)) return;
+    if (count_ == m) remove_oldest();
+    const int k = count_;
+    for (int i = 0; i < k; ++i) {  // modified Gram–Schmidt
+      r_(i, k) = q_.col(i).dot(v_);
+      v_ -= r_(i, k) * q_.col(i);
+    }
+    const double rkk = v_.norm();
+    if (!(rkk > 1e-13 * dfnorm)) return;  // dependent on the history: skip it
+    r_(k, k) = rkk;
+    q_.col(k) = v_ / rkk;
+    dx_.col(k) = x - x_prev_;
+    ++count_;
+  }
+
+  // Drops column 0 of ΔF = QR (and of ΔX): R without its first column is upper Hessenberg;
+  // Givens rotations on rows (i, i+1) restore the triangle, applied to Q's columns alike.
+  void remove_oldest() {
+    const int k = count_;
+    for (int i = 0; i + 1 < k; ++i) {
+      const double a = r_(i, i + 1), b = r_(i + 1, i + 1);
+      const double h = std::hypot(a, b);
+      const double c = a / h, s = b / h;
+      r_(i, i + 1) = h;
+      r_(i + 1, i + 1) = 0.0;
+      for (int j = i + 2; j < k; ++j) {
+        const double t1 = r_(i, j), t2 = r_(i + 1, j);
+        r_(i, j) = c * t1 + s * t2;
+        r_(i + 1, j) = -s * t1 + c * t2;
+      }
+      for (Index row = 0; row < q_.rows(); ++row) {
+        const double t1 = q_(row, i), t2 = q_(row, i + 1);
+        q_(row, i) = c * t1 + s * t2;
+        q_(row, i + 1) = -s * t1 + c * t2;
+      }
+    }
+    // Shift R's columns (and ΔX's) left by one; Q keeps its first k − 1 columns.
+    for (int j = 0; j + 1 < k; ++j) {
+      for (int i = 0; i <= j; ++i) r_(i, j) = r_(i, j + 1);
+      dx_.col(j) = dx_.col(j + 1);
+    }
+    --count_;
+  }
+
+  // Eigen requires a one-row matrix to be row-major.
+  static constexpr int kHistoryLayout = N == 1 ? Eigen::RowMajor : Eigen::ColMajor;
+  using History = std::conditional_t<
+      N == Dynamic, Eigen::MatrixXd,
+      Eigen::Matrix<double, N, Eigen::Dynamic, kHistoryLayout, N, kMaxFixedDepth>>;
+  using Square = std::conditional_t<
+      N == Dynamic, Eigen::MatrixXd,
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxFixedDepth, kMaxFixedDepth>>;
+  using Coefficients =
+      std::conditional_t<N == Dynamic, Eigen::VectorXd,
+                         Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxFixedDepth, 1>>;
+
+  AndersonOptions options_;
+  History dx_, q_;
+  Square r_;
+  Coefficients dg_;
+  Vector<N> f_ = zero_vector<N>(), x_prev_ = zero_vector<N>(), f_prev_ = zero_vector<N>(),
+            v_ = zero_vector<N>();
+  int count_ = 0;
+  bool have_prev_ = false;
+};
+
+}  // namespace nlobs

@@ -1,0 +1,93 @@
+#pragma once
+// The one call shape every engine shares:  Summary s = engine.solve(problem, x);
+// x holds the initial guess on entry and the engine's answer on return.
+#include <cmath>
+#include <sstream>
+#include <string_view>
+
+#include "nlobs/solvers/problem.hpp"
+#include "nlobs/solvers/stop_criteria.hpp"
+#include "nlobs/solvers/summary.hpp"
+
+namespace nlobs {
+
+struct SolverOptions {
+  StopCriteria stop;
+  bool record_trace = false;  // fill Summary::trace (allocates; off in hot loops)
+};
+
+template <int N = Dynamic>
+class Engine {
+ public:
+  virtual ~Engine() = default;
+  virtual std::string_view name() const = 0;
+  // Throws InvalidInput for a dimension mismatch or a non-finite initial guess. Every other
+  // outcome, including a non-finite G value, is a Status in the returned Summary.
+  virtual Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) = 0;
+  const SolverOptions& options() const { return options_; }
+
+ protected:
+  explicit Engine(SolverOptions options) : options_(std::move(options)) { validate(options_.stop); }
+  SolverOptions options_;
+};
+
+// For batch drivers (CLI, benchmarks): invalid input becomes status invalid_input with the
+// message in Summary::message instead of an exception.
+template <int N>
+Summary solve_or_report(Engine<N>& engine, const FixedPointProblem<N>& problem, Vector<N>& x) {
+  try {
+    return engine.solve(problem, x);
+  } catch (const InvalidInput& e) {
+    Summary s;
+    s.engine = engine.name();
+    s.status = Status::kInvalidInput;
+    s.message = e.what();
+    return s;
+  }
+}
+
+namespace detail {
+
+// The error-bound criterion needs L; only Picard steps can estimate it (StopMonitor).
+inline void require_lipschitz_for_error_bound(std::string_view engine, const StopCriteria& c) {
+  if (c.error_tolerance && !c.lipschitz_constant) {
+    std::ostringstream os;
+    os << engine << ": StopCriteria::error_tolerance = " << *c.error_tolerance
+       << " needs StopCriteria::lipschitz_constant (only the picard engine estimates L from its "
+          "steps)";
+    throw InvalidInput(os.str());
+  }
+}
+
+template <int N>
+void check_initial_guess(std::string_view engine, const FixedPointProblem<N>& problem,
+                         const Vector<N>& x) {
+  if (x.size() != problem.size()) {
+    std::ostringstream os;
+    os << engine << ": initial guess has size " << x.size() << " but the problem has dimension "
+       << problem.size();
+    throw InvalidInput(os.str());
+  }
+  for (Index i = 0; i < x.size(); ++i) {
+    if (!std::isfinite(x[i])) {
+      std::ostringstream os;
+      os << engine << ": initial guess x0[" << i << "] = " << x[i] << " is not finite";
+      throw InvalidInput(os.str());
+    }
+  }
+}
+
+// Dynamic-size user functions may resize their output; catch a wrong size at once.
+template <int N>
+void check_output_size(const FixedPointProblem<N>& problem, const Vector<N>& g) {
+  if constexpr (N == Dynamic) {
+    if (g.size() != problem.size()) {
+      std::ostringstream os;
+      os << "G returned a vector of size " << g.size() << ", expected " << problem.size();
+      throw InvalidInput(os.str());
+    }
+  }
+}
+
+}  // namespace detail
+}  // namespace nlobs

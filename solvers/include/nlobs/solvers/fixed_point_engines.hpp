@@ -1,0 +1,43 @@
+#pragma once
+// The fixed-point engines by name: one loop (AcceleratedEngine), four accelerators.
+#include "nlobs/solvers/accelerated_engine.hpp"
+#include "nlobs/solvers/accelerators/aitken.hpp"
+#include "nlobs/solvers/accelerators/anderson.hpp"
+#include "nlobs/solvers/accelerators/picard_step.hpp"
+#include "nlobs/solvers/accelerators/steffensen.hpp"
+
+namespace nlobs {
+
+// x ← G(x).
+template <int N = Dynamic>
+class PicardEngine : public AcceleratedEngine<N, PicardStep<N>> {
+ public:
+  explicit PicardEngine(SolverOptions options = {})
+      : AcceleratedEngine<N, PicardStep<N>>(std::move(options)) {}
+};
+
+// Component-wise Δ² transform of the Picard sequence.
+template <int N = Dynamic>
+class AitkenEngine : public AcceleratedEngine<N, AitkenTransform<N>> {
+ public:
+  explicit AitkenEngine(SolverOptions options = {})
+      : AcceleratedEngine<N, AitkenTransform<N>>(std::move(options)) {}
+};
+
+// Aitken restarted every three iterates.
+template <int N = Dynamic>
+class SteffensenEngine : public AcceleratedEngine<N, SteffensenRestart<N>> {
+ public:
+  explicit SteffensenEngine(SolverOptions options = {})
+      : AcceleratedEngine<N, SteffensenRestart<N>>(std::move(options)) {}
+};
+
+// Anderson mixing of depth m with damping β.
+template <int N = Dynamic>
+class AndersonEngine : public AcceleratedEngine<N, AndersonMixing<N>> {
+ public:
+  explicit AndersonEngine(AndersonOptions anderson = {}, SolverOptions options = {})
+      : AcceleratedEngine<N, AndersonMixing<N>>(std::move(options), AndersonMixing<N>(anderson)) {}
+};
+
+}  // namespace nlobs

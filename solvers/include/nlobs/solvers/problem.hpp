@@ -1,0 +1,180 @@
+#pragma once
+// The two problem forms of METHODS §1:
+//   fixed point  G: Rⁿ → Rⁿ,  find p = G(p)        (FixedPointProblem)
+//   root         F: Rⁿ → Rᵐ,  find F(x) = 0         (RootProblem)
+// Engines solve a FixedPointProblem; a square RootProblem becomes one through
+// to_fixed_point() (G(x) = x + Ψ F(x)), and Newton solves G(x) − x = 0, which is F when Ψ = I.
+//
+// A problem type-erases the user's callable once, at construction: build it once and solve it
+// many times (a window estimator does); evaluating it never allocates for fixed sizes.
+#include <functional>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <utility>
+
+#include "nlobs/solvers/autodiff.hpp"
+#include "nlobs/solvers/callable.hpp"
+#include "nlobs/solvers/status.hpp"
+#include "nlobs/solvers/types.hpp"
+
+namespace nlobs {
+
+// Where an engine that needs ∂G (Newton, the contraction check) gets it.
+enum class JacobianSource {
+  kFiniteDifference,  // none given: engines difference G themselves
+  kUserSupplied,      // the user's ∂G / ∂F
+  kAutoDiff,          // forward-mode AD of the user's scalar-generic function
+};
+
+inline std::string_view to_string(JacobianSource source) {
+  switch (source) {
+    case JacobianSource::kFiniteDifference:
+      return "finite_difference";
+    case JacobianSource::kUserSupplied:
+      return "user_supplied";
+    case JacobianSource::kAutoDiff:
+      return "autodiff";
+  }
+  return "unknown";
+}
+
+namespace detail {
+inline void check_size(const char* what, Index expected, Index got) {
+  if (expected != got) {
+    std::ostringstream os;
+    os << what << ": size " << got << " does not match the problem dimension " << expected;
+    throw InvalidInput(os.str());
+  }
+}
+}  // namespace detail
+
+template <int N = Dynamic>
+class FixedPointProblem {
+ public:
+  using VectorType = Vector<N>;
+  using JacobianType = Matrix<N, N>;
+  using Map = std::function<void(const VectorType&, VectorType&)>;
+  using JacobianMap = std::function<void(const VectorType&, JacobianType&)>;
+
+  // G alone; Jacobians (if an engine needs them) by finite differences.
+  template <typename G>
+  static FixedPointProblem from_map(G g, Index n = N) {
+    return FixedPointProblem(n, wrap(std::move(g)), {}, JacobianSource::kFiniteDifference);
+  }
+  // G generic in its scalar type: ∂G by forward-mode AD.
+  template <typename G>
+  static FixedPointProblem with_autodiff(G g, Index n = N) {
+    JacobianMap dg = [g, n](const VectorType& x, JacobianType& jac) mutable {
+      if constexpr (N == Dynamic) jac.resize(n, n);
+      autodiff_jacobian<N, N>(g, x, jac);
+    };
+    return FixedPointProblem(n, wrap(std::move(g)), std::move(dg), JacobianSource::kAutoDiff);
+  }
+  // G and the user's ∂G (called as dg(x, J) with J n×n, or J = dg(x)).
+  // `source` lets adapters that forward an AD Jacobian report it as such.
+  template <typename G, typename DG>
+  static FixedPointProblem with_jacobian(G g, DG dg, Index n = N,
+                                         JacobianSource source = JacobianSource::kUserSupplied) {
+    JacobianMap jm = [dg = std::move(dg), n](const VectorType& x, JacobianType& jac) mutable {
+      if constexpr (N == Dynamic) jac.resize(n, n);
+      detail::invoke_map(dg, x, jac);
+    };
+    return FixedPointProblem(n, wrap(std::move(g)), std::move(jm), source);
+  }
+
+  Index size() const { return n_; }
+  JacobianSource jacobian_source() const { return source_; }
+  bool has_jacobian() const { return static_cast<bool>(dg_); }
+
+  // g = G(x). For dynamic sizes g must already have size n (engines keep it so).
+  void evaluate(const VectorType& x, VectorType& g) const { g_(x, g); }
+  // jac = ∂G(x); only when has_jacobian().
+  void jacobian(const VectorType& x, JacobianType& jac) const { dg_(x, jac); }
+
+ private:
+  FixedPointProblem(Index n, Map g, JacobianMap dg, JacobianSource source)
+      : n_(n), g_(std::move(g)), dg_(std::move(dg)), source_(source) {
+    if (n_ < 1 || (N != Dynamic && n_ != N)) {
+      std::ostringstream os;
+      os << "FixedPointProblem: dimension n = " << n_
+         << (N != Dynamic ? " differs from the compile-time size " + std::to_string(N)
+                          : std::string(" must be >= 1"));
+      throw InvalidInput(os.str());
+    }
+  }
+  template <typename G>
+  static Map wrap(G g) {
+    return [g = std::move(g)](const VectorType& x, VectorType& out) mutable {
+      detail::invoke_map(g, x, out);
+    };
+  }
+
+  Index n_;
+  Map g_;
+  JacobianMap dg_;
+  JacobianSource source_;
+};
+
+// F: Rⁿ → Rᵐ (m ≥ n for least squares; m = n for engines through to_fixed_point).
+template <int N = Dynamic, int M = N>
+class RootProblem {
+ public:
+  using VectorType = Vector<N>;
+  using ResidualType = Vector<M>;
+  using JacobianType = Matrix<M, N>;
+  using Map = std::function<void(const VectorType&, ResidualType&)>;
+  using JacobianMap = std::function<void(const VectorType&, JacobianType&)>;
+
+  template <typename F>
+  static RootProblem from_map(F f, Index n = N, Index m = M) {
+    return RootProblem(n, m, wrap(std::move(f)), {}, JacobianSource::kFiniteDifference);
+  }
+  template <typename F>
+  static RootProblem with_autodiff(F f, Index n = N, Index m = M) {
+    JacobianMap df = [f, n, m](const VectorType& x, JacobianType& jac) mutable {
+      if constexpr (N == Dynamic || M == Dynamic) jac.resize(m, n);
+      autodiff_jacobian<N, M>(f, x, jac);
+    };
+    return RootProblem(n, m, wrap(std::move(f)), std::move(df), JacobianSource::kAutoDiff);
+  }
+  template <typename F, typename DF>
+  static RootProblem with_jacobian(F f, DF df, Index n = N, Index m = M) {
+    JacobianMap jm = [df = std::move(df), n, m](const VectorType& x, JacobianType& jac) mutable {
+      if constexpr (N == Dynamic || M == Dynamic) jac.resize(m, n);
+      detail::invoke_map(df, x, jac);
+    };
+    return RootProblem(n, m, wrap(std::move(f)), std::move(jm), JacobianSource::kUserSupplied);
+  }
+
+  Index size() const { return n_; }
+  Index residual_size() const { return m_; }
+  JacobianSource jacobian_source() const { return source_; }
+  bool has_jacobian() const { return static_cast<bool>(df_); }
+  void evaluate(const VectorType& x, ResidualType& f) const { f_(x, f); }
+  void jacobian(const VectorType& x, JacobianType& jac) const { df_(x, jac); }
+
+ private:
+  RootProblem(Index n, Index m, Map f, JacobianMap df, JacobianSource source)
+      : n_(n), m_(m), f_(std::move(f)), df_(std::move(df)), source_(source) {
+    if (n_ < 1 || m_ < 1 || (N != Dynamic && n_ != N) || (M != Dynamic && m_ != M)) {
+      std::ostringstream os;
+      os << "RootProblem: dimensions n = " << n_ << ", m = " << m_
+         << " are invalid or differ from the compile-time sizes";
+      throw InvalidInput(os.str());
+    }
+  }
+  template <typename F>
+  static Map wrap(F f) {
+    return [f = std::move(f)](const VectorType& x, ResidualType& out) mutable {
+      detail::invoke_map(f, x, out);
+    };
+  }
+
+  Index n_, m_;
+  Map f_;
+  JacobianMap df_;
+  JacobianSource source_;
+};
+
+}  // namespace nlobs

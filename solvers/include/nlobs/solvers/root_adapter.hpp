@@ -1,0 +1,72 @@
+#pragma once
+// Root → fixed point (METHODS §1): G(x) = x + Ψ F(x), ∂G = I + Ψ ∂F.
+// Ψ = I is the paper's choice for the square window; a scalar ψ damps (ψ < 0 flips the sign
+// when ∂F ≈ +I); a matrix Ψ ≈ −(∂F)⁻¹ turns Picard into a chord/Newton-like iteration.
+#include <cmath>
+#include <sstream>
+#include <variant>
+
+#include "nlobs/solvers/problem.hpp"
+
+namespace nlobs {
+
+struct IdentityScaling {};
+
+template <int N = Dynamic>
+using Preconditioner = std::variant<IdentityScaling, double, Matrix<N, N>>;
+
+template <int N>
+FixedPointProblem<N> to_fixed_point(const RootProblem<N, N>& root,
+                                    Preconditioner<N> psi = IdentityScaling{}) {
+  const Index n = root.size();
+  if (root.residual_size() != n) {
+    std::ostringstream os;
+    os << "to_fixed_point: F maps R^" << n << " to R^" << root.residual_size()
+       << "; a fixed-point form needs a square system (use a least-squares engine)";
+    throw InvalidInput(os.str());
+  }
+  if (const double* s = std::get_if<double>(&psi); s && !(std::isfinite(*s) && *s != 0.0)) {
+    std::ostringstream os;
+    os << "to_fixed_point: scalar Psi = " << *s << " must be finite and non-zero";
+    throw InvalidInput(os.str());
+  }
+  if (const auto* m = std::get_if<Matrix<N, N>>(&psi)) {
+    if (m->rows() != n || m->cols() != n) {
+      std::ostringstream os;
+      os << "to_fixed_point: Psi is " << m->rows() << "x" << m->cols() << ", expected " << n << "x"
+         << n;
+      throw InvalidInput(os.str());
+    }
+    if (!m->allFinite()) throw InvalidInput("to_fixed_point: Psi has non-finite entries");
+  }
+
+  using Vec = Vector<N>;
+  using Jac = Matrix<N, N>;
+  // Scratch for Ψ F(x) when Ψ is a matrix: an aliasing-free product without allocating.
+  auto g = [root, psi, scratch = Vec(n)](const Vec& x, Vec& out) mutable {
+    if (const auto* m = std::get_if<Matrix<N, N>>(&psi)) {
+      root.evaluate(x, scratch);
+      out.noalias() = *m * scratch;
+      out += x;
+    } else {
+      root.evaluate(x, out);
+      if (const double* s = std::get_if<double>(&psi)) out *= *s;
+      out += x;
+    }
+  };
+  if (!root.has_jacobian()) return FixedPointProblem<N>::from_map(std::move(g), n);
+  auto dg = [root, psi, scratch = Jac(n, n)](const Vec& x, Jac& jac) mutable {
+    root.jacobian(x, scratch);
+    if (const auto* m = std::get_if<Matrix<N, N>>(&psi)) {
+      jac.noalias() = *m * scratch;
+    } else {
+      jac = scratch;
+      if (const double* s = std::get_if<double>(&psi)) jac *= *s;
+    }
+    jac.diagonal().array() += 1.0;
+  };
+  return FixedPointProblem<N>::with_jacobian(std::move(g), std::move(dg), n,
+                                             root.jacobian_source());
+}
+
+}  // namespace nlobs

@@ -1,0 +1,14 @@
+#pragma once
+// Everything of the solver layer in one include.
+#include "nlobs/solvers/accelerated_engine.hpp"
+#include "nlobs/solvers/contraction.hpp"
+#include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/finite_difference.hpp"
+#include "nlobs/solvers/fixed_point_engines.hpp"
+#include "nlobs/solvers/newton_engine.hpp"
+#include "nlobs/solvers/problem.hpp"
+#include "nlobs/solvers/root_adapter.hpp"
+#include "nlobs/solvers/status.hpp"
+#include "nlobs/solvers/stop_criteria.hpp"
+#include "nlobs/solvers/summary.hpp"
+#include "nlobs/solvers/types.hpp"

@@ -1,0 +1,31 @@
+#pragma once
+// Why a solve ended. Every engine reports exactly one of these.
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+namespace nlobs {
+
+enum class Status {
+  kConverged,         // an enabled convergence criterion (step, residual, error bound) holds
+  kMaxIterations,     // StopCriteria::max_iterations reached
+  kMaxEvaluations,    // StopCriteria::max_evaluations reached
+  kStagnated,         // the step stopped shrinking (finite-precision floor, cycling)
+  kRepeatedIterates,  // three consecutive iterates are equal (paper, Remark 8)
+  kDiverged,          // the steps grow geometrically or the iterate left divergence_limit
+  kNonFinite,         // G (or F) returned inf/NaN; the last finite iterate is returned
+  kSingularJacobian,  // Newton: the Jacobian of F is (numerically) singular
+  kInvalidInput,      // only from solve_or_report(): bad dimensions, x0 or options
+};
+
+// Lowercase snake_case name used in reports and JSON ("converged", "max_iterations", ...).
+std::string_view to_string(Status status);
+
+// Thrown for bad input (dimension mismatch, non-finite initial guess, invalid options).
+// The message names the offending option or component and its value.
+class InvalidInput : public std::invalid_argument {
+ public:
+  explicit InvalidInput(const std::string& what) : std::invalid_argument(what) {}
+};
+
+}  // namespace nlobs

@@ -1,0 +1,44 @@
+#pragma once
+// Stop criteria of METHODS §1 (paper §3.3), selectable and combinable. All norms are max norms.
+#include <optional>
+
+namespace nlobs {
+
+enum class Combine {
+  kAny,  // converged as soon as one enabled convergence criterion holds
+  kAll,  // converged only when every enabled convergence criterion holds
+};
+
+struct StopCriteria {
+  // Step criterion, eq. (73): ‖x_l − x_{l−1}‖∞ ≤ step_tolerance. 1e-5 reproduces the paper.
+  std::optional<double> step_tolerance = 1e-8;
+  // Residual criterion: ‖G(x) − x‖∞ ≤ residual_tolerance (equals ‖F(x)‖∞ for a root problem
+  // adapted with Ψ = I), evaluated at the last point where the engine evaluated G.
+  std::optional<double> residual_tolerance;
+  // Error-bound criterion, Remark 6: with L the Lipschitz constant of G (max norm),
+  // ‖x_l − x_{l−1}‖∞ ≤ (1 − L) ε  ⇒  ‖x_{l−1} − p‖∞ ≤ ε. Enabled when error_tolerance is set.
+  std::optional<double> error_tolerance;
+  // L for the error bound and the a priori iteration count ⌈m / log10(1/L)⌉ (eq. 64).
+  // When unset, L is estimated from the ratio of consecutive steps (reported as an estimate).
+  std::optional<double> lipschitz_constant;
+  Combine combine = Combine::kAny;
+
+  // Stagnation, eq. (72): stop when the step has not shrunk for this many consecutive
+  // iterations (1 = the paper's rule; 0 = off). If over that stretch the step grew by more
+  // than divergence_growth, the run is reported as diverged instead.
+  int stagnation_patience = 5;
+  double divergence_growth = 10.0;
+  // Diverged when ‖x_l‖∞ exceeds divergence_limit · max(1, ‖x_0‖∞).
+  double divergence_limit = 1e12;
+  // Remark 8: three consecutive equal iterates end the run (status repeated_iterates).
+  bool stop_on_repeated_iterates = true;
+
+  int max_iterations = 10000;
+  int max_evaluations = 100000;
+};
+
+// Throws InvalidInput naming the option and its value (tolerance ≤ 0 or non-finite,
+// L ∉ [0, 1), negative patience, growth ≤ 1, limits ≤ 0, ...).
+void validate(const StopCriteria& criteria);
+
+}  // namespace nlobs

@@ -1,0 +1,29 @@
+#include "nlobs/solvers/status.hpp"
+
+namespace nlobs {
+
+std::string_view to_string(Status status) {
+  switch (status) {
+    case Status::kConverged:
+      return "converged";
+    case Status::kMaxIterations:
+      return "max_iterations";
+    case Status::kMaxEvaluations:
+      return "max_evaluations";
+    case Status::kStagnated:
+      return "stagnated";
+    case Status::kRepeatedIterates:
+      return "repeated_iterates";
+    case Status::kDiverged:
+      return "diverged";
+    case Status::kNonFinite:
+      return "non_finite";
+    case Status::kSingularJacobian:
+      return "singular_jacobian";
+    case Status::kInvalidInput:
+      return "invalid_input";
+  }
+  return "unknown";
+}
+
+}  // namespace nlobs

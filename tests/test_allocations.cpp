@@ -1,0 +1,100 @@
+// The fixed-size path allocates nothing on the heap during a solve: this binary replaces the
+// global operator new to count allocations around each solve.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+#include <vector>
+
+#include "nlobs/models/modified_chua.hpp"
+#include "nlobs/observers/window_map.hpp"
+#include "nlobs/solvers/solvers.hpp"
+
+namespace {
+std::atomic<long> g_allocations{0};
+}  // namespace
+
+void* operator new(std::size_t size) {
+  ++g_allocations;
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) {
+  return operator new(size);
+}
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p, std::size_t) noexcept {
+  std::free(p);
+}
+
+namespace nlobs {
+namespace {
+
+struct ChuaWindow {
+  WindowMap<ModifiedChua, 3> map{ModifiedChua{}};
+  Vector<3> outputs = simulate_window_outputs(map, Vector<3>(1.0, 2.1428, -0.1648));
+  FixedPointProblem<3> problem = window_fixed_point_problem(map, outputs);
+};
+
+long allocations_during_solve(Engine<3>& engine, const FixedPointProblem<3>& problem) {
+  Vector<3> x(5.0, 10.0, -5.0);
+  engine.solve(problem, x);  // warm-up (nothing should be lazily allocated either)
+  x = Vector<3>(5.0, 10.0, -5.0);
+  const long before = g_allocations.load();
+  const Summary s = engine.solve(problem, x);
+  const long after = g_allocations.load();
+  EXPECT_TRUE(s.converged()) << s.full_report();
+  return after - before;
+}
+
+TEST(Allocations, CounterSeesAllocations) {
+  const long before = g_allocations.load();
+  void* volatile p = ::operator new(64);  // the counter itself works
+  ::operator delete(p);
+  std::vector<double> v(100);
+  v[7] = 1.0;
+  EXPECT_GE(g_allocations.load() - before, 1);
+}
+
+TEST(Allocations, FixedSizeSolvesAllocateNothing) {
+  ChuaWindow cw;
+  SolverOptions o;
+  o.stop.step_tolerance = 1e-10;
+  o.stop.residual_tolerance = 1e-12;
+  PicardEngine<3> picard(o);
+  AitkenEngine<3> aitken(o);
+  SteffensenEngine<3> steffensen(o);
+  AndersonEngine<3> anderson({.depth = 3}, o);
+  NewtonEngine<3> newton({}, o);
+  NewtonEngine<3> newton_ls({.line_search = true}, o);
+  for (Engine<3>* e : std::initializer_list<Engine<3>*>{&picard, &aitken, &steffensen, &anderson,
+                                                        &newton, &newton_ls}) {
+    EXPECT_EQ(allocations_during_solve(*e, cw.problem), 0) << e->name();
+  }
+}
+
+TEST(Allocations, FiniteDifferenceAndMatrixPreconditionerAllocateNothing) {
+  ChuaWindow cw;
+  const auto f = [&cw](const Vector<3>& w, Vector<3>& r) { r = cw.outputs - cw.map(w); };
+  const auto by_fd = to_fixed_point(RootProblem<3>::from_map(f));
+  Matrix<3, 3> psi = Matrix<3, 3>::Identity();
+  const auto by_matrix = to_fixed_point<3>(RootProblem<3>::from_map(f), psi);
+  SolverOptions o;
+  o.stop.step_tolerance = 1e-10;
+  NewtonEngine<3> newton({}, o);
+  SteffensenEngine<3> steffensen(o);
+  EXPECT_EQ(allocations_during_solve(newton, by_fd), 0);
+  EXPECT_EQ(allocations_during_solve(steffensen, by_matrix), 0);
+}
+
+}  // namespace
+}  // namespace nlobs

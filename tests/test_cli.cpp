@@ -1,0 +1,73 @@
+// Runs the nlobs executable and checks the contract of `nlobs solve chua-window --json`.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace {
+
+struct CliRun {
+  int status = -1;
+  std::string out;
+};
+
+CliRun run(const std::string& args) {
+  CliRun r;
+  const std::string cmd = std::string(NLOBS_CLI_PATH) + " " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf{};
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) r.out.append(buf.data(), n);
+  const int rc = pclose(pipe);
+  r.status = WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+  return r;
+}
+
+TEST(Cli, SolveChuaWindowJsonContract) {
+  const CliRun r = run("solve chua-window --tol 1e-10 --json");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto rows = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(rows.is_array());
+  std::vector<std::string> names;
+  for (const auto& row : rows) {
+    for (const char* key :
+         {"engine", "status", "iterations", "evaluations", "solution", "error", "ns_per_solve"}) {
+      ASSERT_TRUE(row.contains(key)) << key << " missing in " << row.dump();
+    }
+    names.push_back(row["engine"]);
+    EXPECT_EQ(row["status"], "converged") << row.dump();
+    EXPECT_EQ(row["solution"].size(), 3U);
+    EXPECT_LT(row["error"].get<double>(), 1e-6) << row.dump();
+    EXPECT_GT(row["ns_per_solve"].get<double>(), 0.0);
+  }
+  const std::vector<std::string> expected = {"picard",        "aitken",       "steffensen",
+                                             "anderson",      "newton",       "kinsol:fp",
+                                             "kinsol:fp-aa2", "kinsol:newton"};
+  EXPECT_EQ(names, expected);
+}
+
+TEST(Cli, EngineSubsetAndTable) {
+  const CliRun r = run("solve chua-window --engines steffensen,newton --tol 1e-5");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("steffensen"), std::string::npos);
+  EXPECT_NE(r.out.find("kinsol:newton"), std::string::npos);  // KINSOL in the same run
+  EXPECT_EQ(r.out.find("picard"), std::string::npos);
+}
+
+TEST(Cli, UnknownEngineListsValidOnes) {
+  const CliRun r = run("solve chua-window --engines bogus");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.out.find("unknown engine 'bogus'"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("steffensen"), std::string::npos) << r.out;
+}
+
+TEST(Cli, InvalidToleranceIsAnError) {
+  const CliRun r = run("solve chua-window --tol -1");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.out.find("--tol"), std::string::npos) << r.out;
+}
+
+}  // namespace
