@@ -7,7 +7,7 @@
 
 #include "nlobs/solvers/solvers.hpp"
 #include "reference/chua_window.hpp"
-#include "reference/kinsol_solver.hpp"
+#include "reference/kinsol_adapter.hpp"
 
 namespace {
 
@@ -116,34 +116,13 @@ BENCHMARK(BM_Newton)->Arg(0)->Arg(1);
 void BM_Kinsol(benchmark::State& state) {
   const ChuaWindowCase& c = chua();
   const auto strategy = static_cast<KinsolStrategy>(state.range(0));
-  const nlobs::FixedPointProblem<3>& p = c.problem;
-  KinsolSolver::Function f;
-  KinsolSolver::Jacobian j;
-  if (strategy == KinsolStrategy::kNewtonLineSearch) {
-    f = [&p](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
-      nlobs::Vector<3> g;
-      p.evaluate(x, g);
-      out = g - x;
-    };
-    j = [&p](const Eigen::VectorXd& x, Eigen::MatrixXd& out) {
-      nlobs::Matrix<3, 3> dg;
-      p.jacobian(x, dg);
-      out = dg - nlobs::Matrix<3, 3>::Identity();
-    };
-  } else {
-    f = [&p](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
-      nlobs::Vector<3> g;
-      p.evaluate(x, g);
-      out = g;
-    };
-  }
-  KinsolSolver solver(3, {.strategy = strategy, .tolerance = kTolerance, .anderson_depth = 2}, f,
-                      j);
+  const auto solver = nlobs::reference::make_kinsol_solver(
+      c.problem, {.strategy = strategy, .tolerance = kTolerance, .anderson_depth = 2});
   Eigen::VectorXd x(3);
   nlobs::reference::KinsolResult r;
   for (auto _ : state) {
     x = c.initial_guess;
-    r = solver.solve(x);
+    r = solver->solve(x);
     benchmark::DoNotOptimize(x);
   }
   state.counters["iterations"] = static_cast<double>(r.iterations);

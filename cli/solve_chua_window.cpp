@@ -11,7 +11,7 @@
 
 #include "nlobs/solvers/solvers.hpp"
 #include "reference/chua_window.hpp"
-#include "reference/kinsol_solver.hpp"
+#include "reference/kinsol_adapter.hpp"
 
 namespace nlobs::cli {
 namespace {
@@ -82,30 +82,9 @@ SolveRow run_kinsol(const std::string& name, const reference::ChuaWindowCase& c,
   reference::KinsolOptions options;
   options.strategy = strategy_of(name);
   options.tolerance = tol;
-  const FixedPointProblem<3>& p = c.problem;
-  reference::KinsolSolver::Function function;
-  reference::KinsolSolver::Jacobian jacobian;
-  if (options.strategy == KinsolStrategy::kNewtonLineSearch) {
-    function = [&p](const Eigen::VectorXd& x, Eigen::VectorXd& f) {  // F = G(x) − x
-      Vector<3> g;
-      p.evaluate(x, g);
-      f = g - x;
-    };
-    jacobian = [&p](const Eigen::VectorXd& x, Eigen::MatrixXd& j) {  // ∂F = ∂G − I
-      Matrix<3, 3> dg;
-      p.jacobian(x, dg);
-      j = dg - Matrix<3, 3>::Identity();
-    };
-  } else {
-    function = [&p](const Eigen::VectorXd& x, Eigen::VectorXd& g) {
-      Vector<3> gx;
-      p.evaluate(x, gx);
-      g = gx;
-    };
-  }
-  reference::KinsolSolver solver(3, options, function, jacobian);
+  const auto solver = reference::make_kinsol_solver(c.problem, options);
   Eigen::VectorXd x = c.initial_guess;
-  const reference::KinsolResult r = solver.solve(x);
+  const reference::KinsolResult r = solver->solve(x);
   SolveRow row{name,
                kinsol_status(r),
                r.iterations,
@@ -116,7 +95,7 @@ SolveRow run_kinsol(const std::string& name, const reference::ChuaWindowCase& c,
   Eigen::VectorXd xr(3);
   row.ns_per_solve = time_per_solve([&] {
     xr = c.initial_guess;
-    solver.solve(xr);
+    solver->solve(xr);
   });
   return row;
 }

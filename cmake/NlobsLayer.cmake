@@ -1,0 +1,22 @@
+# nlobs_add_layer(<layer> [SOURCES ...] [DEPENDS ...]): the library of one layer, nlobs::<layer>,
+# with public headers under <layer>/include/nlobs/<layer>/. Without sources it is header-only.
+function(nlobs_add_layer layer)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPENDS" ${ARGN})
+  set(target nlobs_${layer})
+  set(include_dir $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
+                  $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+  if(ARG_SOURCES)
+    add_library(${target} ${ARG_SOURCES})
+    target_include_directories(${target} PUBLIC ${include_dir})
+    target_compile_features(${target} PUBLIC cxx_std_20)
+    target_link_libraries(${target} PUBLIC ${ARG_DEPENDS})
+    nlobs_target_warnings(${target})
+  else()
+    add_library(${target} INTERFACE)
+    target_include_directories(${target} INTERFACE ${include_dir})
+    target_compile_features(${target} INTERFACE cxx_std_20)
+    target_link_libraries(${target} INTERFACE ${ARG_DEPENDS})
+  endif()
+  add_library(nlobs::${layer} ALIAS ${target})
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${layer})
+endfunction()
