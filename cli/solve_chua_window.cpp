@@ -9,7 +9,7 @@
 #include <ostream>
 #include <stdexcept>
 
-#include "nlobs/solvers/solvers.hpp"
+#include "nlobs/solvers/engine_registry.hpp"
 #include "reference/chua_window.hpp"
 #include "reference/kinsol_adapter.hpp"
 
@@ -17,15 +17,6 @@ namespace nlobs::cli {
 namespace {
 
 using reference::KinsolStrategy;
-
-std::unique_ptr<Engine<3>> make_engine(const std::string& name, const SolverOptions& options) {
-  if (name == "picard") return std::make_unique<PicardEngine<3>>(options);
-  if (name == "aitken") return std::make_unique<AitkenEngine<3>>(options);
-  if (name == "steffensen") return std::make_unique<SteffensenEngine<3>>(options);
-  if (name == "anderson") return std::make_unique<AndersonEngine<3>>(AndersonOptions{}, options);
-  if (name == "newton") return std::make_unique<NewtonEngine<3>>(NewtonOptions{}, options);
-  return nullptr;
-}
 
 KinsolStrategy strategy_of(const std::string& name) {
   if (name == "kinsol:fp") return KinsolStrategy::kFixedPoint;
@@ -61,7 +52,7 @@ SolveRow run_engine(const std::string& name, const reference::ChuaWindowCase& c,
   SolverOptions options;
   options.stop.step_tolerance = tol;      // KINSOL's scsteptol
   options.stop.residual_tolerance = tol;  // KINSOL's fnormtol
-  std::unique_ptr<Engine<3>> engine = make_engine(name, options);
+  std::unique_ptr<Engine<3>> engine = EngineRegistry<3>::global().create(name, options);
   Vector<3> x = c.initial_guess;
   const Summary s = engine->solve(c.problem, x);
   SolveRow row{name,
@@ -125,15 +116,16 @@ std::vector<SolveRow> solve_chua_window(const std::vector<std::string>& engines,
     throw std::invalid_argument("--tol " + std::to_string(tolerance) +
                                 " is invalid: must be finite and > 0");
   }
-  const auto& ours = engine_names();
   const auto& refs = reference_names();
   std::vector<std::string> order;
   for (const std::string& e : engines) {
-    const bool known = std::find(ours.begin(), ours.end(), e) != ours.end() ||
-                       std::find(refs.begin(), refs.end(), e) != refs.end();
-    if (!known) {
-      throw std::invalid_argument("unknown engine '" + e + "'; valid engines: " + join(ours) +
-                                  ", " + join(refs));
+    const bool reference = std::find(refs.begin(), refs.end(), e) != refs.end();
+    if (!reference) {
+      try {
+        (void)EngineRegistry<3>::global().create(e);  // validates name and options
+      } catch (const InvalidInput& error) {
+        throw std::invalid_argument(std::string(error.what()) + "; references: " + join(refs));
+      }
     }
     if (std::find(order.begin(), order.end(), e) == order.end()) order.push_back(e);
   }
@@ -158,14 +150,14 @@ void print_table(const std::vector<SolveRow>& rows, double tolerance, std::ostre
                 "x0 = [5, 10, -5], tol = %g\n",
                 tolerance);
   out << line;
-  std::snprintf(line, sizeof line, "%-14s %-17s %6s %6s  %-34s %10s %12s\n", "engine", "status",
+  std::snprintf(line, sizeof line, "%-24s %-17s %6s %6s  %-34s %10s %12s\n", "engine", "status",
                 "iter", "evals", "solution", "|x-x*|inf", "ns/solve");
   out << line;
   for (const SolveRow& r : rows) {
     char sol[64];
     std::snprintf(sol, sizeof sol, "[%.6f, %.6f, %.6f]", r.solution[0], r.solution[1],
                   r.solution[2]);
-    std::snprintf(line, sizeof line, "%-14s %-17s %6ld %6ld  %-34s %10.2e %12.0f\n",
+    std::snprintf(line, sizeof line, "%-24s %-17s %6ld %6ld  %-34s %10.2e %12.0f\n",
                   r.engine.c_str(), r.status.c_str(), r.iterations, r.evaluations, sol, r.error,
                   r.ns_per_solve);
     out << line;

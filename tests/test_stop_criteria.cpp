@@ -210,9 +210,10 @@ TEST(Status, InvalidInputReportedBySolveOrReport) {
 }
 
 TEST(Status, EveryStatusHasAName) {
-  for (Status st : {Status::kConverged, Status::kMaxIterations, Status::kMaxEvaluations,
-                    Status::kStagnated, Status::kRepeatedIterates, Status::kDiverged,
-                    Status::kNonFinite, Status::kSingularJacobian, Status::kInvalidInput}) {
+  for (Status st :
+       {Status::kConverged, Status::kMaxIterations, Status::kMaxEvaluations, Status::kStagnated,
+        Status::kRepeatedIterates, Status::kDiverged, Status::kNonFinite, Status::kSingularJacobian,
+        Status::kInvalidInput, Status::kSolverFailure}) {
     EXPECT_NE(to_string(st), "unknown");
   }
 }
@@ -224,6 +225,7 @@ TEST(Summary, ReportsMentionTheEssentials) {
   const Summary s = SteffensenEngine<1>(o).solve(test::cosine_problem(), x);
   const std::string brief = s.brief_report(), full = s.full_report();
   EXPECT_NE(brief.find("steffensen: converged after"), std::string::npos) << brief;
+  EXPECT_NE(brief.find("|F|"), std::string::npos) << brief;
   EXPECT_NE(full.find("function evaluations"), std::string::npos);
   ASSERT_EQ(static_cast<int>(s.trace.size()), s.iterations);
   EXPECT_EQ(s.trace.back().step_norm, s.step_norm);

@@ -1,6 +1,7 @@
 #include "reference/kinsol_solver.hpp"
 
 #include <kinsol/kinsol.h>
+#include <kinsol/kinsol_ls.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
 #include <sunlinsol/sunlinsol_dense.h>
@@ -106,6 +107,7 @@ KinsolResult KinsolSolver::solve(Eigen::VectorXd& x) {
   free(name);
   KINGetNumNonlinSolvIters(s.kinsol, &r.iterations);
   KINGetNumFuncEvals(s.kinsol, &r.evaluations);
+  if (s.linear_solver) KINGetNumJacEvals(s.kinsol, &r.jacobian_evaluations);
   x = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(s.u), s.n);
   return r;
 }

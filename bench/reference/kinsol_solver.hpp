@@ -29,6 +29,7 @@ struct KinsolResult {
   bool success = false;   // flag >= 0 (KIN_SUCCESS, KIN_INITIAL_GUESS_OK, KIN_STEP_LT_STPTOL)
   long iterations = 0;    // KINGetNumNonlinSolvIters
   long evaluations = 0;   // KINGetNumFuncEvals
+  long jacobian_evaluations = 0;  // KINGetNumJacEvals (Newton only)
 };
 
 class KinsolSolver {

@@ -22,6 +22,8 @@ std::string_view to_string(Status status) {
       return "singular_jacobian";
     case Status::kInvalidInput:
       return "invalid_input";
+    case Status::kSolverFailure:
+      return "solver_failure";
   }
   return "unknown";
 }

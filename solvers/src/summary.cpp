@@ -1,5 +1,6 @@
 #include "nlobs/solvers/summary.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -20,7 +21,9 @@ std::string Summary::brief_report() const {
   os << to_string(status) << " after " << iterations << " iterations (" << function_evaluations
      << " evaluations";
   if (jacobian_evaluations > 0) os << ", " << jacobian_evaluations << " Jacobians";
-  os << "), |step| " << sci(step_norm) << ", |G(x)-x| " << sci(residual_norm);
+  os << "), |step| " << sci(step_norm);
+  if (!std::isnan(residual_norm)) os << ", |F| " << sci(residual_norm);
+  if (objective) os << ", f " << sci(*objective);
   if (error_bound)
     os << ", |x-p| <= " << sci(*error_bound) << (lipschitz_is_estimate ? " (est.)" : "");
   return os.str();
@@ -37,6 +40,7 @@ std::string Summary::full_report() const {
      << "  jacobian evaluations   " << jacobian_evaluations << '\n'
      << "  final step norm        " << sci(step_norm) << '\n'
      << "  final residual norm    " << sci(residual_norm) << '\n';
+  if (objective) os << "  objective              " << sci(*objective) << '\n';
   if (contraction_estimate) {
     os << "  contraction estimate   " << sci(*contraction_estimate) << '\n';
   }

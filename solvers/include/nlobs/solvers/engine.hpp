@@ -60,12 +60,11 @@ inline void require_lipschitz_for_error_bound(std::string_view engine, const Sto
 }
 
 template <int N>
-void check_initial_guess(std::string_view engine, const FixedPointProblem<N>& problem,
-                         const Vector<N>& x) {
-  if (x.size() != problem.size()) {
+void check_initial_guess(std::string_view engine, Index dimension, const Vector<N>& x) {
+  if (x.size() != dimension) {
     std::ostringstream os;
     os << engine << ": initial guess has size " << x.size() << " but the problem has dimension "
-       << problem.size();
+       << dimension;
     throw InvalidInput(os.str());
   }
   for (Index i = 0; i < x.size(); ++i) {
@@ -75,6 +74,12 @@ void check_initial_guess(std::string_view engine, const FixedPointProblem<N>& pr
       throw InvalidInput(os.str());
     }
   }
+}
+
+template <int N>
+void check_initial_guess(std::string_view engine, const FixedPointProblem<N>& problem,
+                         const Vector<N>& x) {
+  check_initial_guess<N>(engine, problem.size(), x);
 }
 
 // Dynamic-size user functions may resize their output; catch a wrong size at once.

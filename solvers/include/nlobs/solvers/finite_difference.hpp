@@ -18,35 +18,46 @@ struct FiniteDifferenceWorkspace {
   void resize(Index n) { xp.resize(n), gp.resize(n), gm.resize(n); }
 };
 
-// jac = ∂G(x); gx = G(x) is reused by the forward scheme. Returns the G evaluations spent.
-template <int N>
-int finite_difference_jacobian(const FixedPointProblem<N>& problem, const Vector<N>& x,
-                               const Vector<N>& gx, Matrix<N, N>& jac, FiniteDifference scheme,
-                               FiniteDifferenceWorkspace<N>& work) {
+// jac = ∂f(x) for any f: R^N → R^M called as f(x, out); fx = f(x) is reused by the forward
+// scheme. `work` holds the perturbed point and values. Returns the evaluations of f spent.
+template <int N, int M, typename F>
+int finite_difference_jacobian(F&& f, const Vector<N>& x, const Vector<M>& fx, Matrix<M, N>& jac,
+                               FiniteDifference scheme, FiniteDifferenceWorkspace<N>& xwork,
+                               Vector<M>& fp, Vector<M>& fm) {
   const double c = scheme == FiniteDifference::kForward
                        ? std::sqrt(std::numeric_limits<double>::epsilon())
                        : std::cbrt(std::numeric_limits<double>::epsilon());
   const Index n = x.size();
-  if constexpr (N == Dynamic) jac.resize(n, n);
+  if constexpr (N == Dynamic || M == Dynamic) jac.resize(fx.size(), n);
   int evaluations = 0;
-  work.xp = x;
+  Vector<N>& xp = xwork.xp;
+  xp = x;
   for (Index j = 0; j < n; ++j) {
-    const double h_raw = c * std::max(1.0, std::abs(x[j]));
-    work.xp[j] = x[j] + h_raw;
-    const double h = work.xp[j] - x[j];
-    problem.evaluate(work.xp, work.gp);
+    xp[j] = x[j] + c * std::max(1.0, std::abs(x[j]));
+    const double h = xp[j] - x[j];  // exactly representable step
+    f(xp, fp);
     ++evaluations;
     if (scheme == FiniteDifference::kForward) {
-      jac.col(j) = (work.gp - gx) / h;
+      jac.col(j) = (fp - fx) / h;
     } else {
-      work.xp[j] = x[j] - h;
-      problem.evaluate(work.xp, work.gm);
+      xp[j] = x[j] - h;
+      f(xp, fm);
       ++evaluations;
-      jac.col(j) = (work.gp - work.gm) / (2.0 * h);
+      jac.col(j) = (fp - fm) / (2.0 * h);
     }
-    work.xp[j] = x[j];
+    xp[j] = x[j];
   }
   return evaluations;
+}
+
+// ∂G of a fixed-point problem; gx = G(x).
+template <int N>
+int finite_difference_jacobian(const FixedPointProblem<N>& problem, const Vector<N>& x,
+                               const Vector<N>& gx, Matrix<N, N>& jac, FiniteDifference scheme,
+                               FiniteDifferenceWorkspace<N>& work) {
+  return finite_difference_jacobian<N, N>(
+      [&problem](const Vector<N>& at, Vector<N>& out) { problem.evaluate(at, out); }, x, gx, jac,
+      scheme, work, work.gp, work.gm);
 }
 
 }  // namespace nlobs

@@ -16,6 +16,7 @@ enum class Status {
   kNonFinite,         // G (or F) returned inf/NaN; the last finite iterate is returned
   kSingularJacobian,  // Newton: the Jacobian of F is (numerically) singular
   kInvalidInput,      // only from solve_or_report(): bad dimensions, x0 or options
+  kSolverFailure,     // a backend (Ceres, NLopt) reported a failure; see Summary::message
 };
 
 // Lowercase snake_case name used in reports and JSON ("converged", "max_iterations", ...).

@@ -38,7 +38,9 @@ struct Summary {
   // A priori iteration count ⌈m / log10(1/L)⌉ (eq. 64), m = −log10 of the error (else step)
   // tolerance: what a contraction with factor L needs to gain m digits.
   std::optional<int> a_priori_iterations;
-  std::string message;  // detail for kInvalidInput and kSingularJacobian
+  // Minimisation engines (NLopt): the objective at the returned x.
+  std::optional<double> objective;
+  std::string message;  // detail for kInvalidInput, kSingularJacobian, kSolverFailure, backends
   std::vector<TraceEntry> trace;
 
   bool converged() const { return status == Status::kConverged; }

@@ -1,0 +1,71 @@
+#include <cminpack-1/cminpack.h>
+
+#include <vector>
+
+#include "reference/root_reference.hpp"
+
+namespace nlobs::reference {
+namespace {
+
+struct Context {
+  const RootProblem<Dynamic>* problem;
+  Eigen::VectorXd x, f;
+  Eigen::MatrixXd j;
+};
+
+int callback(void* p, int n, const double* x, double* fvec, double* fjac, int ldfjac, int iflag) {
+  auto* c = static_cast<Context*>(p);
+  c->x = Eigen::Map<const Eigen::VectorXd>(x, n);
+  if (iflag == 1) {
+    c->problem->evaluate(c->x, c->f);
+    if (!c->f.allFinite()) return -1;  // negative: terminate
+    Eigen::Map<Eigen::VectorXd>(fvec, n) = c->f;
+  } else if (iflag == 2) {
+    c->problem->jacobian(c->x, c->j);
+    if (!c->j.allFinite()) return -1;
+    Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>>(fjac, n, n, Eigen::OuterStride<>(ldfjac)) =
+        c->j;
+  }
+  return 0;
+}
+
+}  // namespace
+
+ReferenceResult solve_minpack_hybrj(const RootProblem<Dynamic>& problem, Eigen::VectorXd& x,
+                                    const ReferenceOptions& options) {
+  const int n = static_cast<int>(x.size());
+  Context c{&problem, Eigen::VectorXd(n), Eigen::VectorXd(n), Eigen::MatrixXd(n, n)};
+  std::vector<double> fvec(n), fjac(n * n), diag(n, 1.0), r(n * (n + 1) / 2), qtf(n), wa1(n),
+      wa2(n), wa3(n), wa4(n);
+  int nfev = 0, njev = 0;
+  // mode 1: internal scaling; factor 100 and no printing, as MINPACK's hybrj1 driver.
+  const int info = hybrj(&callback, &c, n, x.data(), fvec.data(), fjac.data(), n, options.tolerance,
+                         static_cast<int>(options.max_evaluations), diag.data(), 1, 100.0, 0, &nfev,
+                         &njev, r.data(), static_cast<int>(r.size()), qtf.data(), wa1.data(),
+                         wa2.data(), wa3.data(), wa4.data());
+  ReferenceResult result;
+  result.f_evals = nfev;
+  result.j_evals = njev;
+  switch (info) {
+    case 1:
+      result.status = "converged";
+      break;
+    case 2:
+      result.status = "max_evaluations";
+      break;
+    case 3:
+      result.status = "xtol_too_small";
+      break;
+    case 4:
+      result.status = "not_making_progress_jacobian";
+      break;
+    case 5:
+      result.status = "not_making_progress";
+      break;
+    default:
+      result.status = info < 0 ? "non_finite" : "improper_input";
+  }
+  return result;
+}
+
+}  // namespace nlobs::reference

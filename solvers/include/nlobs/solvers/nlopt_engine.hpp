@@ -1,0 +1,314 @@
+#pragma once
+// Bounded minimisation with NLopt. Objectives: a scalar ObjectiveProblem (minimize()), or
+// ½‖F(x)‖₂² for a RootProblem or a FixedPointProblem (F = G − x) through solve(). Any NLopt
+// algorithm by name ("LN_BOBYQA", "LN_COBYLA", "LD_SLSQP", "LD_LBFGS", "GN_DIRECT_L", ...);
+// gradient-based ones (xD_*) get ∇(½‖F‖²) = Jᵀ F from the problem's Jacobian (AD or user) or
+// from finite differences. The nlopt::opt object is built once per dimension and reused by
+// every solve, so repeated small bounded problems (the MVT observer's β) pay no set-up.
+#include <cmath>
+#include <limits>
+#include <nlopt.hpp>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/objective_problem.hpp"
+#include "nlobs/solvers/residual_source.hpp"
+
+namespace nlobs {
+
+struct NloptOptions {
+  std::string algorithm = "LN_BOBYQA";
+  // Box bounds; empty = unbounded; ±inf allowed per component except for global (G*)
+  // algorithms, which need a finite box.
+  Eigen::VectorXd lower_bounds, upper_bounds;
+  // minimize(): stop once the objective is ≤ this (solve() uses ½ residual_tolerance²).
+  std::optional<double> stop_value;
+  double relative_step_tolerance = 0.0;  // NLopt xtol_rel; 0 = off
+  std::optional<double> initial_step;    // first step of derivative-free algorithms
+  FiniteDifference finite_difference = FiniteDifference::kCentral;
+};
+
+// NLopt's algorithm names ("LN_BOBYQA", ...), all of them.
+std::vector<std::string> nlopt_algorithm_names();
+
+template <int N = Dynamic>
+class NloptEngine : public Engine<N> {
+ public:
+  explicit NloptEngine(NloptOptions nlopt = {}, SolverOptions options = {})
+      : Engine<N>(std::move(options)), nlopt_(std::move(nlopt)) {
+    detail::require_lipschitz_for_error_bound(name(), this->options_.stop);
+    algorithm_ = nlopt_algorithm_from_string(nlopt_.algorithm.c_str());
+    if (static_cast<int>(algorithm_) < 0) {
+      std::string valid;
+      for (const std::string& a : nlopt_algorithm_names()) valid += (valid.empty() ? "" : ", ") + a;
+      throw InvalidInput("NloptOptions::algorithm = '" + nlopt_.algorithm +
+                         "' is not an NLopt algorithm; valid: " + valid);
+    }
+    const Eigen::VectorXd& lb = nlopt_.lower_bounds;
+    const Eigen::VectorXd& ub = nlopt_.upper_bounds;
+    if (lb.size() > 0 && ub.size() > 0 && lb.size() != ub.size()) {
+      throw InvalidInput("NloptOptions: lower_bounds and upper_bounds differ in size");
+    }
+    for (Index i = 0; i < std::min(lb.size(), ub.size()); ++i) {
+      if (!(lb[i] <= ub[i])) {
+        std::ostringstream os;
+        os << "NloptOptions: lower_bounds[" << i << "] = " << lb[i] << " > upper_bounds[" << i
+           << "] = " << ub[i];
+        throw InvalidInput(os.str());
+      }
+    }
+    if (is_global()) {
+      const Index n = std::max(lb.size(), ub.size());
+      if (lb.size() == 0 || ub.size() == 0 || !lb.allFinite() || !ub.allFinite() || n == 0) {
+        throw InvalidInput("NloptOptions: global algorithm " + nlopt_.algorithm +
+                           " needs finite lower_bounds and upper_bounds");
+      }
+    }
+    if (nlopt_.initial_step && !(*nlopt_.initial_step > 0.0)) {
+      throw InvalidInput("NloptOptions::initial_step must be > 0");
+    }
+  }
+
+  std::string_view name() const override { return "nlopt"; }
+  const NloptOptions& nlopt_options() const { return nlopt_; }
+  bool needs_gradient() const { return nlopt_.algorithm.size() > 1 && nlopt_.algorithm[1] == 'D'; }
+  bool is_global() const { return !nlopt_.algorithm.empty() && nlopt_.algorithm[0] == 'G'; }
+
+  // min ½‖G(x) − x‖₂².
+  Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override {
+    detail::check_initial_guess(name(), problem, x);
+    return run_residual<N>(detail::ResidualSource<N, N>(problem), x);
+  }
+  // min ½‖F(x)‖₂².
+  template <int M>
+  Summary solve(const RootProblem<N, M>& problem, Vector<N>& x) {
+    detail::check_initial_guess(name(), problem.size(), x);
+    return run_residual<M>(detail::ResidualSource<N, M>(problem), x);
+  }
+  // min f(x).
+  Summary minimize(const ObjectiveProblem<N>& problem, Vector<N>& x) {
+    detail::check_initial_guess(name(), problem.size(), x);
+    struct Context {
+      NloptEngine* engine;
+      const ObjectiveProblem<N>* problem;
+    } ctx{this, &problem};
+    const double stop = nlopt_.stop_value.value_or(-std::numeric_limits<double>::infinity());
+    Summary s = run(
+        x, stop,
+        +[](void* data, const Vector<N>& at, Vector<N>* grad) {
+          auto* c = static_cast<Context*>(data);
+          const double f = c->problem->evaluate(at);
+          ++c->engine->evaluations_;
+          if (grad != nullptr) {
+            if (c->problem->has_gradient()) {
+              c->problem->gradient(at, *grad);
+            } else {
+              c->engine->evaluations_ += c->engine->scalar_gradient(*c->problem, at, f, *grad);
+            }
+            ++c->engine->jacobians_;
+          }
+          return f;
+        },
+        &ctx);
+    s.residual_norm = std::numeric_limits<double>::quiet_NaN();  // not a residual problem
+    return s;
+  }
+
+ private:
+  using ObjectiveThunk = double (*)(void*, const Vector<N>&, Vector<N>*);
+
+  template <int M>
+  struct ResidualContext {
+    NloptEngine* engine;
+    const detail::ResidualSource<N, M>* source;
+    Vector<M> f, fp, fm;
+    Matrix<M, N> j;
+    FiniteDifferenceWorkspace<N> fd;
+  };
+
+  template <int M>
+  Summary run_residual(const detail::ResidualSource<N, M>& source, Vector<N>& x) {
+    const Index n = source.size(), m = source.residual_size();
+    ResidualContext<M> ctx{
+        this, &source, Vector<M>(m), Vector<M>(m), Vector<M>(m), Matrix<M, N>(m, n), {}};
+    ctx.fd.resize(n);
+    const std::optional<double>& ftol = this->options_.stop.residual_tolerance;
+    const double stop = ftol ? 0.5 * *ftol * *ftol : -std::numeric_limits<double>::infinity();
+    Summary s = run(
+        x, stop,
+        +[](void* data, const Vector<N>& at, Vector<N>* grad) {
+          auto* c = static_cast<ResidualContext<M>*>(data);
+          c->source->residual(at, c->f);
+          ++c->engine->evaluations_;
+          if (grad != nullptr) {
+            c->engine->evaluations_ +=
+                detail::residual_jacobian(*c->source, at, c->f, c->j,
+                                          c->engine->nlopt_.finite_difference, c->fd, c->fp, c->fm);
+            ++c->engine->jacobians_;
+            grad->noalias() = c->j.transpose() * c->f;  // ∇ ½‖F‖² = Jᵀ F
+          }
+          return 0.5 * c->f.squaredNorm();
+        },
+        &ctx);
+    source.residual(x, ctx.f);  // residual at the returned point, counted
+    ++s.function_evaluations;
+    s.residual_norm = ctx.f.allFinite() ? ctx.f.template lpNorm<Eigen::Infinity>()
+                                        : std::numeric_limits<double>::infinity();
+    return s;
+  }
+
+  // Central or forward differences of a scalar objective.
+  int scalar_gradient(const ObjectiveProblem<N>& p, const Vector<N>& x, double fx,
+                      Vector<N>& grad) {
+    Matrix<1, N> row(1, x.size());
+    Vector<1> f0(fx), fp, fm;
+    FiniteDifferenceWorkspace<N> work;
+    work.resize(x.size());
+    const int evals = finite_difference_jacobian<N, 1>(
+        [&p](const Vector<N>& at, Vector<1>& out) { out[0] = p.evaluate(at); }, x, f0, row,
+        nlopt_.finite_difference, work, fp, fm);
+    grad = row.transpose();
+    return evals;
+  }
+
+  static double trampoline(unsigned n, const double* x, double* grad, void* data) {
+    auto* self = static_cast<NloptEngine*>(data);
+    self->x_ = Eigen::Map<const Vector<N>>(x, n);
+    double f;
+    if (grad != nullptr) {
+      f = self->thunk_(self->context_, self->x_, &self->grad_);
+      Eigen::Map<Vector<N>>(grad, n) = self->grad_;
+      if (!self->grad_.allFinite()) f = std::numeric_limits<double>::quiet_NaN();
+    } else {
+      f = self->thunk_(self->context_, self->x_, nullptr);
+    }
+    if (!std::isfinite(f)) {
+      self->non_finite_ = true;
+      self->opt_->force_stop();  // NLopt cannot recover from NaN: stop, keep the best point
+      return std::numeric_limits<double>::max();
+    }
+    return f;
+  }
+
+  void prepare(Index n) {
+    opt_.emplace(static_cast<nlopt::algorithm>(algorithm_), static_cast<unsigned>(n));
+    auto bounds = [n](const Eigen::VectorXd& b, double fill) {
+      std::vector<double> v(static_cast<size_t>(n), fill);
+      for (Index i = 0; i < b.size(); ++i) v[static_cast<size_t>(i)] = b[i];
+      return v;
+    };
+    const double inf = std::numeric_limits<double>::infinity();
+    opt_->set_lower_bounds(bounds(nlopt_.lower_bounds, -inf));
+    opt_->set_upper_bounds(bounds(nlopt_.upper_bounds, inf));
+    const StopCriteria& stop = this->options_.stop;
+    if (stop.step_tolerance) opt_->set_xtol_abs(*stop.step_tolerance);
+    if (nlopt_.relative_step_tolerance > 0.0) opt_->set_xtol_rel(nlopt_.relative_step_tolerance);
+    opt_->set_maxeval(stop.max_evaluations);
+    if (nlopt_.initial_step) opt_->set_initial_step(*nlopt_.initial_step);
+    opt_->set_min_objective(&NloptEngine::trampoline, this);
+    xv_.assign(static_cast<size_t>(n), 0.0);
+    prepared_n_ = n;
+  }
+
+  void check_box(const Vector<N>& x) const {
+    auto check = [&](const Eigen::VectorXd& b, bool lower) {
+      if (b.size() == 0) return;
+      if (b.size() != x.size()) {
+        std::ostringstream os;
+        os << "nlopt: " << (lower ? "lower" : "upper") << "_bounds has size " << b.size()
+           << ", the problem has dimension " << x.size();
+        throw InvalidInput(os.str());
+      }
+      for (Index i = 0; i < x.size(); ++i) {
+        if (lower ? x[i] < b[i] : x[i] > b[i]) {
+          std::ostringstream os;
+          os << "nlopt: initial guess x0[" << i << "] = " << x[i] << " lies outside the box ("
+             << (lower ? "lower" : "upper") << " bound " << b[i] << ")";
+          throw InvalidInput(os.str());
+        }
+      }
+    };
+    check(nlopt_.lower_bounds, true);
+    check(nlopt_.upper_bounds, false);
+  }
+
+  Summary run(Vector<N>& x, double stop_value, ObjectiveThunk thunk, void* context) {
+    check_box(x);
+    const Index n = x.size();
+    if (!opt_ || prepared_n_ != n) prepare(n);
+    if constexpr (N == Dynamic) x_.resize(n), grad_.resize(n);
+    opt_->set_stopval(stop_value);
+    thunk_ = thunk;
+    context_ = context;
+    evaluations_ = jacobians_ = 0;
+    non_finite_ = false;
+    for (Index i = 0; i < n; ++i) xv_[static_cast<size_t>(i)] = x[i];
+
+    Summary s;
+    s.engine = name();
+    double f = std::numeric_limits<double>::quiet_NaN();
+    nlopt::result result = nlopt::FAILURE;
+    try {
+      result = opt_->optimize(xv_, f);
+    } catch (const nlopt::roundoff_limited&) {
+      result = nlopt::ROUNDOFF_LIMITED;
+    } catch (const nlopt::forced_stop&) {
+      result = nlopt::FORCED_STOP;
+    } catch (const std::exception& e) {
+      result = opt_->last_optimize_result();
+      s.message = e.what();
+    }
+    switch (result) {
+      case nlopt::SUCCESS:
+      case nlopt::STOPVAL_REACHED:
+      case nlopt::FTOL_REACHED:
+      case nlopt::XTOL_REACHED:
+        s.status = Status::kConverged;
+        break;
+      case nlopt::MAXEVAL_REACHED:
+        s.status = Status::kMaxEvaluations;
+        break;
+      case nlopt::MAXTIME_REACHED:
+        s.status = Status::kMaxIterations;
+        s.message = "NLopt time limit reached";
+        break;
+      case nlopt::ROUNDOFF_LIMITED:
+        s.status = Status::kStagnated;
+        s.message = "NLopt: roundoff limited";
+        break;
+      case nlopt::FORCED_STOP:
+        s.status = non_finite_ ? Status::kNonFinite : Status::kSolverFailure;
+        break;
+      default:
+        s.status = Status::kSolverFailure;
+        if (s.message.empty()) s.message = "NLopt failed (result " + std::to_string(result) + ")";
+        break;
+    }
+    const Vector<N> best = Eigen::Map<const Vector<N>>(xv_.data(), n);
+    if (best.allFinite()) {
+      s.step_norm = (best - x).template lpNorm<Eigen::Infinity>();  // from x0: NLopt hides steps
+      x = best;
+    }
+    s.iterations = opt_->get_numevals();  // NLopt counts objective evaluations, not iterations
+    s.function_evaluations = evaluations_;
+    s.jacobian_evaluations = jacobians_;
+    if (std::isfinite(f)) s.objective = f;
+    return s;
+  }
+
+  NloptOptions nlopt_;
+  nlopt_algorithm algorithm_;
+  std::optional<nlopt::opt> opt_;
+  Index prepared_n_ = -1;
+  std::vector<double> xv_;
+  Vector<N> x_ = zero_vector<N>(), grad_ = zero_vector<N>();
+  ObjectiveThunk thunk_ = nullptr;
+  void* context_ = nullptr;
+  int evaluations_ = 0, jacobians_ = 0;
+  bool non_finite_ = false;
+};
+
+}  // namespace nlobs

@@ -1,0 +1,125 @@
+#include "nlobs/solvers/engine_spec.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+namespace nlobs {
+
+EngineSpec parse_engine_spec(std::string_view text) {
+  EngineSpec spec;
+  spec.text = std::string(text);
+  const size_t colon = text.find(':');
+  spec.name = std::string(text.substr(0, colon));
+  if (spec.name.empty()) throw InvalidInput("engine spec '" + spec.text + "' has no engine name");
+  if (colon == std::string_view::npos) return spec;
+  std::string_view rest = text.substr(colon + 1);
+  while (true) {
+    const size_t comma = rest.find(',');
+    const std::string_view item = rest.substr(0, comma);
+    if (item.empty()) throw InvalidInput("engine spec '" + spec.text + "' has an empty item");
+    const size_t eq = item.find('=');
+    if (eq == std::string_view::npos) {
+      spec.words.emplace_back(item);
+    } else {
+      std::string key(item.substr(0, eq)), value(item.substr(eq + 1));
+      if (key.empty() || value.empty()) {
+        throw InvalidInput("engine spec '" + spec.text + "': item '" + std::string(item) +
+                           "' needs key=value");
+      }
+      for (const auto& kv : spec.values) {
+        if (kv.first == key) {
+          throw InvalidInput("engine spec '" + spec.text + "' sets '" + key + "' twice");
+        }
+      }
+      spec.values.emplace_back(std::move(key), std::move(value));
+    }
+    if (comma == std::string_view::npos) break;
+    rest = rest.substr(comma + 1);
+  }
+  return spec;
+}
+
+EngineSpecReader::EngineSpecReader(const EngineSpec& spec, std::vector<EngineOptionInfo> valid)
+    : spec_(spec), valid_(std::move(valid)), used_values_(spec.values.size(), false) {}
+
+void EngineSpecReader::fail(const std::string& what) const {
+  std::ostringstream os;
+  os << "engine spec '" << spec_.text << "': " << what << "; valid options of '" << spec_.name
+     << "': ";
+  if (valid_.empty()) os << "(none)";
+  for (size_t i = 0; i < valid_.size(); ++i) {
+    os << (i ? ", " : "") << valid_[i].key << " (" << valid_[i].description << ")";
+  }
+  throw InvalidInput(os.str());
+}
+
+std::optional<std::string> EngineSpecReader::text(const std::string& key) {
+  for (size_t i = 0; i < spec_.values.size(); ++i) {
+    if (spec_.values[i].first == key) {
+      used_values_[i] = true;
+      return spec_.values[i].second;
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<double> EngineSpecReader::number(const std::string& key) {
+  const auto t = text(key);
+  if (!t) return std::nullopt;
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(t->c_str(), &end);
+  if (end == t->c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
+    fail("'" + key + "=" + *t + "' is not a finite number");
+  }
+  return v;
+}
+
+std::optional<int> EngineSpecReader::integer(const std::string& key) {
+  const auto t = text(key);
+  if (!t) return std::nullopt;
+  char* end = nullptr;
+  errno = 0;
+  const long v = std::strtol(t->c_str(), &end, 10);
+  if (end == t->c_str() || *end != '\0' || errno == ERANGE || v < -1000000000L || v > 1000000000L) {
+    fail("'" + key + "=" + *t + "' is not an integer");
+  }
+  return static_cast<int>(v);
+}
+
+std::optional<bool> EngineSpecReader::boolean(const std::string& key) {
+  const auto t = text(key);
+  if (!t) return std::nullopt;
+  if (*t == "1" || *t == "true" || *t == "on") return true;
+  if (*t == "0" || *t == "false" || *t == "off") return false;
+  fail("'" + key + "=" + *t + "' is not 0/1, true/false or on/off");
+}
+
+std::optional<std::string> EngineSpecReader::word(const std::vector<std::string>& allowed) {
+  if (spec_.words.empty()) return std::nullopt;
+  if (spec_.words.size() > 1) fail("more than one bare word");
+  const std::string& w = spec_.words.front();
+  if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), w) == allowed.end()) {
+    std::string list;
+    for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+    fail("'" + w + "' is not one of: " + list);
+  }
+  word_used_ = true;
+  return w;
+}
+
+void EngineSpecReader::finish() const {
+  std::string unknown;
+  for (size_t i = 0; i < spec_.values.size(); ++i) {
+    if (!used_values_[i]) unknown += (unknown.empty() ? "" : ", ") + spec_.values[i].first;
+  }
+  if (!word_used_) {
+    for (const auto& w : spec_.words) unknown += (unknown.empty() ? "" : ", ") + w;
+  }
+  if (!unknown.empty()) fail("unknown option(s) " + unknown);
+}
+
+}  // namespace nlobs
