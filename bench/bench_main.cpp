@@ -75,5 +75,21 @@ int main(int argc, char** argv) {
   ratio(collector, "BM_Anderson/3", "BM_Kinsol/1");
   ratio(collector, "BM_Newton/0", "BM_Kinsol/2");
   ratio(collector, "BM_Newton/1", "BM_Kinsol/2");
+
+  auto ns = [&](const char* name) {
+    const auto it = collector.results.find(name);
+    return it == collector.results.end() ? 0.0 : it->second.ns;
+  };
+  if (ns("BM_CeresTinySolver") > 0 && ns("BM_CeresPreparedProblem") > 0) {
+    std::printf("\nCeres on the 6-output Chua window (m = 6, n = 3):\n");
+    std::printf(
+        "  TinySolver %.0f ns, prepared ceres::Problem %.0f ns, Problem per solve %.0f ns\n",
+        ns("BM_CeresTinySolver"), ns("BM_CeresPreparedProblem"), ns("BM_CeresProblemPerSolve"));
+  }
+  if (ns("BM_NloptKeptOpt") > 0) {
+    std::printf(
+        "NLopt LD_SLSQP, 3-D bounded quadratic: opt kept %.0f ns, rebuilt per solve %.0f ns\n",
+        ns("BM_NloptKeptOpt"), ns("BM_NloptOptPerSolve"));
+  }
   return 0;
 }

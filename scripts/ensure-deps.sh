@@ -7,8 +7,12 @@ set -euo pipefail
 packages=(
   g++ make cmake pkg-config
   libeigen3-dev        # linear algebra, fixed-size vectors
-  libceres-dev         # ceres::Jet forward-mode AD (and the least-squares engine later)
+  libceres-dev         # ceres::Jet forward-mode AD, least-squares engine (Ceres, TinySolver)
+  libgoogle-glog-dev   # Ceres' logging; the CLI silences it
+  libnlopt-cxx-dev     # bounded minimisation engine
   libsundials-dev      # KINSOL: reference solver compared in the same run
+  libcminpack-dev      # MINPACK hybrj: reference solver of the MGH suite
+  libgsl-dev           # GSL hybridsj / gnewton: reference solvers of the MGH suite
   libcli11-dev         # command-line parsing for the nlobs CLI
   nlohmann-json3-dev   # JSON output of the CLI
   libgtest-dev         # unit tests

@@ -9,6 +9,7 @@
 
 #include "nlobs/models/modified_chua.hpp"
 #include "nlobs/observers/window_map.hpp"
+#include "nlobs/solvers/ceres_engine.hpp"
 #include "nlobs/solvers/solvers.hpp"
 
 namespace {
@@ -76,8 +77,9 @@ TEST(Allocations, FixedSizeSolvesAllocateNothing) {
   AndersonEngine<3> anderson({.depth = 3}, o);
   NewtonEngine<3> newton({}, o);
   NewtonEngine<3> newton_ls({.line_search = true}, o);
+  CeresEngine<3> tiny({.backend = CeresOptions::Backend::kTinySolver}, o);
   for (Engine<3>* e : std::initializer_list<Engine<3>*>{&picard, &aitken, &steffensen, &anderson,
-                                                        &newton, &newton_ls}) {
+                                                        &newton, &newton_ls, &tiny}) {
     EXPECT_EQ(allocations_during_solve(*e, cw.problem), 0) << e->name();
   }
 }

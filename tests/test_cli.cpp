@@ -70,4 +70,56 @@ TEST(Cli, InvalidToleranceIsAnError) {
   EXPECT_NE(r.out.find("--tol"), std::string::npos) << r.out;
 }
 
+TEST(Cli, SolveAcceptsEngineSpecs) {
+  const CliRun r =
+      run("solve chua-window --tol 1e-8 --no-reference --json "
+          "--engines anderson:m=2,damping=0.5,ceres,nlopt:LD_SLSQP");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto rows = nlohmann::json::parse(r.out);
+  ASSERT_EQ(rows.size(), 3U) << r.out;
+  EXPECT_EQ(rows[0]["engine"], "anderson:m=2,damping=0.5");
+  EXPECT_EQ(rows[1]["engine"], "ceres");
+  EXPECT_EQ(rows[2]["engine"], "nlopt:LD_SLSQP");
+  EXPECT_EQ(rows[1]["status"], "converged");
+}
+
+TEST(Cli, SuiteMghJsonContract) {
+  const CliRun r = run("suite mgh --solvers ceres,minpack:hybrj --json");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto rows = nlohmann::json::parse(r.out);
+  ASSERT_EQ(rows.size(), 19U * 3U * 2U);  // cases x starts x solvers
+  int solved = 0;
+  for (const auto& row : rows) {
+    for (const char* key : {"problem", "n", "start_scale", "solver", "solved", "residual",
+                            "f_evals", "j_evals", "ns"}) {
+      ASSERT_TRUE(row.contains(key)) << key << " missing in " << row.dump();
+    }
+    solved += row["solved"].get<bool>();
+  }
+  EXPECT_GT(solved, 60);
+}
+
+TEST(Cli, SuiteTableEndsWithCounts) {
+  const CliRun r = run("suite mgh --solvers newton");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("rosenbrock n=2 (start x 100)"), std::string::npos);
+  EXPECT_NE(r.out.find("solved (|F|2 <= 1e-8 at the returned point), per solver:"),
+            std::string::npos);
+  EXPECT_NE(r.out.find("/ 57"), std::string::npos);
+  const CliRun bad = run("suite mgh --solvers nonsense");
+  EXPECT_NE(bad.status, 0);
+  EXPECT_NE(bad.out.find("unknown engine 'nonsense'"), std::string::npos) << bad.out;
+  EXPECT_NE(bad.out.find("minpack:hybrj"), std::string::npos) << bad.out;
+}
+
+TEST(Cli, ListEngines) {
+  const CliRun r = run("list engines");
+  ASSERT_EQ(r.status, 0) << r.out;
+  for (const char* e : {"picard", "aitken", "steffensen", "anderson", "newton", "ceres", "nlopt",
+                        "kinsol:fp-aa2", "gsl:gnewton"}) {
+    EXPECT_NE(r.out.find(e), std::string::npos) << e;
+  }
+  EXPECT_NE(run("list nothing").status, 0);
+}
+
 }  // namespace

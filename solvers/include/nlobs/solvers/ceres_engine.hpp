@@ -37,7 +37,7 @@ struct CeresOptions {
   Method method = Method::kLevenbergMarquardt;
   Backend backend = Backend::kAuto;
   // Box bounds on x; empty = none; ±inf allowed per component.
-  Eigen::VectorXd lower_bounds, upper_bounds;
+  Eigen::VectorXd lower_bounds{}, upper_bounds{};
   // Ceres' relative cost-change and gradient tolerances (the step tolerance comes from
   // StopCriteria::step_tolerance as Ceres' parameter_tolerance).
   double function_tolerance = 1e-10;
@@ -119,7 +119,7 @@ class CeresEngine : public Engine<N> {
     Matrix<M, N> j;
     FiniteDifferenceWorkspace<N> fd;
     int evaluations = 0, jacobians = 0;
-    bool non_finite = false, budget_exhausted = false, have_prev = false;
+    bool non_finite = false, jacobian_failed = false, budget_exhausted = false, have_prev = false;
     double last_step = 0.0;
 
     void resize(Index n, Index m) {
@@ -174,6 +174,7 @@ class CeresEngine : public Engine<N> {
     ++w.evaluations;
     if (!w.f.allFinite()) {
       w.non_finite = true;
+      w.jacobian_failed = w.jacobian_failed || jacobian != nullptr;
       return false;
     }
     Eigen::Map<Vector<M>>(residuals, m) = w.f;
@@ -182,7 +183,7 @@ class CeresEngine : public Engine<N> {
                                                  w.fd, w.fp, w.fm);
       ++w.jacobians;
       if (!w.j.allFinite()) {
-        w.non_finite = true;
+        w.non_finite = w.jacobian_failed = true;
         return false;
       }
       if (row_major) {
@@ -204,8 +205,12 @@ class CeresEngine : public Engine<N> {
                  Status status, int iterations) const {
     Summary s;
     s.engine = name();
-    if (w.non_finite && status != Status::kConverged) status = Status::kNonFinite;
-    if (w.budget_exhausted && status != Status::kConverged) status = Status::kMaxEvaluations;
+    // A non-finite value at a trial point is a rejected step (Ceres recovers); at a point where
+    // the Jacobian is formed, nothing the solver concludes afterwards can be trusted.
+    if (w.jacobian_failed || (w.non_finite && status != Status::kConverged)) {
+      status = Status::kNonFinite;
+    }
+    if (w.budget_exhausted) status = Status::kMaxEvaluations;  // cut short, whatever it claims
     source.residual(x, w.f);  // residual at the returned point, counted
     ++w.evaluations;
     s.status = status;
@@ -218,10 +223,20 @@ class CeresEngine : public Engine<N> {
     return s;
   }
 
+// GCC cannot see that TinySolver's cost is set by the (now pre-checked) first evaluation.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
   template <int M>
   Summary run_tiny(const detail::ResidualSource<N, M>& source, Vector<N>& x) {
     Workspace<M> w;  // fixed sizes: on the stack, nothing allocated
     w.resize(source.size(), source.residual_size());
+    // TinySolver does not check its first evaluation (it would read an unset cost): do it here.
+    source.residual(x, w.f);
+    ++w.evaluations;
+    if (!w.f.allFinite()) {
+      w.non_finite = true;
+      return finish<M>(source, w, x, Status::kNonFinite, 0);
+    }
     const StopCriteria& stop = this->options_.stop;
     ceres::TinySolver<TinyCost<M>> solver;
     solver.options.max_num_iterations = stop.max_iterations;
@@ -240,6 +255,7 @@ class CeresEngine : public Engine<N> {
     if (p.allFinite()) x = p;
     return finish<M>(source, w, x, status, summary.iterations);
   }
+#pragma GCC diagnostic pop
 
   // The cost functor TinySolver wants: sizes as enums, column-major Jacobian.
   template <int M>

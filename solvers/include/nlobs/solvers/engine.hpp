@@ -12,7 +12,7 @@
 namespace nlobs {
 
 struct SolverOptions {
-  StopCriteria stop;
+  StopCriteria stop{};
   bool record_trace = false;  // fill Summary::trace (allocates; off in hot loops)
 };
 

@@ -23,11 +23,11 @@ struct NloptOptions {
   std::string algorithm = "LN_BOBYQA";
   // Box bounds; empty = unbounded; ±inf allowed per component except for global (G*)
   // algorithms, which need a finite box.
-  Eigen::VectorXd lower_bounds, upper_bounds;
+  Eigen::VectorXd lower_bounds{}, upper_bounds{};
   // minimize(): stop once the objective is ≤ this (solve() uses ½ residual_tolerance²).
-  std::optional<double> stop_value;
+  std::optional<double> stop_value{};
   double relative_step_tolerance = 0.0;  // NLopt xtol_rel; 0 = off
-  std::optional<double> initial_step;    // first step of derivative-free algorithms
+  std::optional<double> initial_step{};  // first step of derivative-free algorithms
   FiniteDifference finite_difference = FiniteDifference::kCentral;
 };
 

@@ -14,13 +14,13 @@ struct StopCriteria {
   std::optional<double> step_tolerance = 1e-8;
   // Residual criterion: ‖G(x) − x‖∞ ≤ residual_tolerance (equals ‖F(x)‖∞ for a root problem
   // adapted with Ψ = I), evaluated at the last point where the engine evaluated G.
-  std::optional<double> residual_tolerance;
+  std::optional<double> residual_tolerance{};
   // Error-bound criterion, Remark 6: with L the Lipschitz constant of G (max norm),
   // ‖x_l − x_{l−1}‖∞ ≤ (1 − L) ε  ⇒  ‖x_{l−1} − p‖∞ ≤ ε. Enabled when error_tolerance is set.
-  std::optional<double> error_tolerance;
+  std::optional<double> error_tolerance{};
   // L for the error bound and the a priori iteration count ⌈m / log10(1/L)⌉ (eq. 64).
   // When unset, L is estimated from the ratio of consecutive steps (reported as an estimate).
-  std::optional<double> lipschitz_constant;
+  std::optional<double> lipschitz_constant{};
   Combine combine = Combine::kAny;
 
   // Stagnation, eq. (72): stop when the step has not shrunk for this many consecutive
