@@ -2,19 +2,19 @@
 // built per solve; NLopt on small bounded problems: one nlopt::opt kept vs rebuilt per solve.
 #include <benchmark/benchmark.h>
 
-#include "nlobs/models/modified_chua.hpp"
-#include "nlobs/observers/window_map.hpp"
 #include "nlobs/solvers/ceres_engine.hpp"
 #include "nlobs/solvers/nlopt_engine.hpp"
+#include "reference/chua_window.hpp"
 
 namespace {
 
 // The modified-Chua window of six outputs (m = 6, n = 3), solved in the least-squares sense.
 struct LongWindow {
-  nlobs::WindowMap<nlobs::ModifiedChua, 6> map{nlobs::ModifiedChua{}};
   Eigen::Vector3d truth{1.0, 2.1428, -0.1648};
   Eigen::Vector3d guess{1.5, 2.5, 0.3};
-  nlobs::RootProblem<3, 6> problem = nlobs::window_root_problem(map, map(truth));
+  std::unique_ptr<nlobs::OutputWindow<nlobs::Discretized<nlobs::ModifiedChua>>> window =
+      nlobs::reference::ChuaWindowCase::filled_window(truth, 6);
+  nlobs::RootProblem<3, nlobs::Dynamic> problem = nlobs::window_residual_problem(*window);
 };
 
 const LongWindow& window() {

@@ -62,6 +62,8 @@ TEST(BadInput, AndersonAndNewtonOptions) {
   EXPECT_NO_THROW(AndersonEngine<Dynamic>({.depth = 40}));
   EXPECT_INVALID(AndersonEngine<1>({.depth = 2, .damping = 0.0}), "damping = 0");
   EXPECT_INVALID(AndersonEngine<1>({.depth = 2, .damping = 1.5}), "damping = 1.5");
+  EXPECT_INVALID(AndersonEngine<1>({.depth = 2, .damping = 1.0, .condition_limit = 0.5}),
+                 "condition_limit = 0.5");
   EXPECT_INVALID(NewtonEngine<1>({.sufficient_decrease = 0.7}), "sufficient_decrease = 0.7");
   EXPECT_INVALID(NewtonEngine<1>({.backtrack_factor = 1.0}), "backtrack_factor = 1");
   EXPECT_INVALID(NewtonEngine<1>({.max_backtracks = 0}), "max_backtracks = 0");

@@ -7,46 +7,40 @@
 #include <numbers>
 
 #include "nlobs/models/modified_chua.hpp"
-#include "nlobs/observers/window_map.hpp"
 #include "nlobs/solvers/solvers.hpp"
+#include "reference/chua_window.hpp"
 
 namespace nlobs {
 namespace {
 
-const ModifiedChuaParameters kP{};
+const ModifiedChuaParameters kP{};  // T = 0.05 in paper_modified_chua()
 const Vector<3> kTrue(1.0, 2.1428, -0.1648);
 const Vector<3> kGuess(5.0, 10.0, -5.0);
 
-struct ChuaWindow {
-  WindowMap<ModifiedChua, 3> map{ModifiedChua{}};
-  Vector<3> outputs = simulate_window_outputs(map, kTrue);
-  FixedPointProblem<3> problem = window_fixed_point_problem(map, outputs);
-};
+using ChuaWindow = reference::ChuaWindowCase;
 
 TEST(ModifiedChua, RejectsInvalidParameters) {
   ModifiedChuaParameters p;
   p.a = 0.0;
   EXPECT_THROW(ModifiedChua{p}, std::invalid_argument);
-  p = {};
-  p.sampling_time = -0.05;
   try {
-    ModifiedChua m{p};
+    paper_modified_chua({}, -0.05);
     FAIL();
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("sampling_time = -0.05"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("step = -0.05"), std::string::npos) << e.what();
   }
 }
 
 TEST(WindowMap, MatchesPapersExpandedFormula) {
-  const WindowMap<ModifiedChua, 3> map{ModifiedChua{}};
-  const double alpha = kP.alpha, beta = kP.beta, a = kP.a, b = kP.b, d = kP.d, T = kP.sampling_time,
+  const double alpha = kP.alpha, beta = kP.beta, a = kP.a, b = kP.b, d = kP.d, T = 0.05,
                k = std::numbers::pi / (2.0 * a);
+  const ChuaWindow cw;
   for (const Vector<3>& w : {Vector<3>(0.3, -1.0, 2.0), kGuess, kTrue}) {
     // H1 = w1; H2 = (f(w))1; H3 = (f(f(w)))1, written out (eq. 80).
     const double h2 = w[0] + alpha * T * (w[1] + b * std::sin(k * w[0] + d));
     const double x2 = w[1] + T * (w[0] - w[1] + w[2]);
     const double h3 = h2 + alpha * T * (x2 + b * std::sin(k * h2 + d));
-    const Vector<3> h = map(w);
+    const Vector<Dynamic> h = cw.window->map(Vector<3>(w));
     EXPECT_NEAR(h[0], w[0], 1e-15);
     EXPECT_NEAR(h[1], h2, 1e-13);
     EXPECT_NEAR(h[2], h3, 1e-12);
@@ -60,7 +54,6 @@ TEST(WindowMap, MatchesPapersExpandedFormula) {
     const double h32 = 2.0 * alpha * T - alpha * T * T + alpha * alpha * T * T * b * k * c;
     Matrix<3, 3> dh;
     dh << 1.0, 0.0, 0.0, h21, alpha * T, 0.0, h31, h32, alpha * T * T;
-    ChuaWindow cw;
     Matrix<3, 3> dg;
     cw.problem.jacobian(w, dg);
     EXPECT_LT((dg - (Matrix<3, 3>::Identity() - dh)).cwiseAbs().maxCoeff(), 1e-12) << w.transpose();
@@ -97,6 +90,25 @@ TEST(ChuaWindow, AllEnginesAgreeAtTightTolerance) {
     for (const Vector<3>& b : solutions) EXPECT_LT((a - b).lpNorm<Eigen::Infinity>(), 1e-6);
     // Picard's error is about step/(1 − L) with L ≈ 0.973 (METHODS §1): still far below 1e-6.
     EXPECT_LT((a - kTrue).lpNorm<Eigen::Infinity>(), 1e-8);
+  }
+}
+
+TEST(ChuaWindow, AndersonConvergesAtEveryDepth) {
+  // Regression: once x1 is exact, the differences become nearly dependent; without the
+  // condition safeguard depth 3 jumped to x3 = -3.9e6 and stagnated.
+  ChuaWindow cw;
+  for (double tol : {1e-5, 1e-10}) {
+    for (int depth = 1; depth <= 6; ++depth) {
+      SolverOptions o;
+      o.stop.step_tolerance = tol;
+      o.stop.residual_tolerance = tol;
+      AndersonEngine<3> anderson({.depth = depth}, o);
+      Vector<3> x = kGuess;
+      const Summary s = anderson.solve(cw.problem, x);
+      EXPECT_TRUE(s.converged()) << "depth " << depth << " tol " << tol << '\n' << s.full_report();
+      EXPECT_LT(s.iterations, 40) << depth;
+      EXPECT_LT((x - kTrue).lpNorm<Eigen::Infinity>(), 1e-3) << depth;
+    }
   }
 }
 
@@ -138,14 +150,14 @@ TEST(ChuaWindow, NotAMaxNormContractionYetLocallyConvergent) {
   // so its spectral radius is 1 − αT² ≈ 0.973 — the slow rate the engines observe.
   Matrix<3, 3> j;
   cw.problem.jacobian(kTrue, j);
-  const double alpha_t = kP.alpha * kP.sampling_time;
-  EXPECT_NEAR(j.eigenvalues().cwiseAbs().maxCoeff(), 1.0 - alpha_t * kP.sampling_time, 1e-12);
+  const double alpha_t = kP.alpha * 0.05;
+  EXPECT_NEAR(j.eigenvalues().cwiseAbs().maxCoeff(), 1.0 - alpha_t * 0.05, 1e-12);
   Vector<3> x = kGuess;
   SolverOptions o;
   o.stop.step_tolerance = 1e-10;
   const Summary s = PicardEngine<3>(o).solve(cw.problem, x);
   ASSERT_TRUE(s.contraction_estimate.has_value());
-  EXPECT_NEAR(*s.contraction_estimate, 1.0 - alpha_t * kP.sampling_time, 1e-3);
+  EXPECT_NEAR(*s.contraction_estimate, 1.0 - alpha_t * 0.05, 1e-3);
 }
 
 }  // namespace

@@ -1,22 +1,36 @@
 #pragma once
-// The modified-Chua window problem of METHODS §1, shared by the CLI and the benchmarks:
-// true initial state [1.0, 2.1428, −0.1648], the window of its first three outputs,
-// initial guess [5, 10, −5]. Its fixed point is the true initial state.
+// The modified-Chua window problem of METHODS §1, shared by the CLI, tests and benchmarks:
+// true initial state [1.0, 2.1428, −0.1648], the window of its first three outputs, initial
+// guess [5, 10, −5]. Its fixed point is the true initial state.
 #include <Eigen/Core>
+#include <memory>
 
 #include "nlobs/models/modified_chua.hpp"
-#include "nlobs/observers/window_map.hpp"
+#include "nlobs/observers/window_problems.hpp"
 
 namespace nlobs::reference {
 
 struct ChuaWindowCase {
-  using Map = WindowMap<ModifiedChua, 3>;
-  Map map{ModifiedChua{}};
+  using Model = Discretized<ModifiedChua>;
   Eigen::Vector3d true_state{1.0, 2.1428, -0.1648};
   Eigen::Vector3d initial_guess{5.0, 10.0, -5.0};
-  Eigen::Vector3d outputs = simulate_window_outputs(map, true_state);
+  // Behind a pointer: the problems below refer to the window.
+  std::unique_ptr<OutputWindow<Model>> window = filled_window(true_state, 3);
   // G(w) = w + (Y − H(w)), ∂G by forward-mode AD.
-  FixedPointProblem<3> problem = window_fixed_point_problem(map, outputs);
+  FixedPointProblem<3> problem = square_window_problem(*window);
+
+  // The paper's model observed from x0 for `length` noise-free samples.
+  static std::unique_ptr<OutputWindow<Model>> filled_window(const Eigen::Vector3d& x0,
+                                                            Eigen::Index length) {
+    auto w = std::make_unique<OutputWindow<Model>>(paper_modified_chua(), length);
+    Eigen::Vector3d x = x0;
+    const Eigen::VectorXd u(0);
+    for (long k = 0; k < length; ++k) {
+      w->push(k, w->model().h(x), u);
+      x = w->model().f(x, Model::Input(), k);
+    }
+    return w;
+  }
 };
 
 }  // namespace nlobs::reference

@@ -24,8 +24,6 @@ ModifiedChua::ModifiedChua(ModifiedChuaParameters parameters)
   require(std::isfinite(p_.a) && p_.a != 0.0, "a", p_.a, "must be finite and non-zero");
   require(std::isfinite(p_.b), "b", p_.b, "must be finite");
   require(std::isfinite(p_.d), "d", p_.d, "must be finite");
-  require(std::isfinite(p_.sampling_time) && p_.sampling_time > 0.0, "sampling_time",
-          p_.sampling_time, "must be finite and > 0");
 }
 
 }  // namespace nlobs

@@ -104,6 +104,11 @@ class CeresEngine : public Engine<N> {
     return s;
   }
 
+  bool least_squares() const override { return true; }
+  Summary solve_least_squares(const RootProblem<N, Dynamic>& problem, Vector<N>& x) override {
+    return solve<Dynamic>(problem, x);
+  }
+
   // Least squares on F: Rⁿ → Rᵐ.
   template <int M>
   Summary solve(const RootProblem<N, M>& problem, Vector<N>& x) {

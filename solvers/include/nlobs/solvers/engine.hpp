@@ -24,6 +24,38 @@ class Engine {
   // Throws InvalidInput for a dimension mismatch or a non-finite initial guess. Every other
   // outcome, including a non-finite G value, is a Status in the returned Summary.
   virtual Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) = 0;
+
+  // F(x) = 0 for F: Rⁿ → Rᵐ in the least-squares sense. Engines for square systems (the
+  // fixed-point engines, Newton) accept m = n — through G(x) = x + F(x), built per call — and
+  // refuse m ≠ n; the Ceres and NLopt engines override this for any m.
+  virtual Summary solve_least_squares(const RootProblem<N, Dynamic>& problem, Vector<N>& x) {
+    if (problem.residual_size() != problem.size()) {
+      std::ostringstream os;
+      os << name() << " solves square systems only: F maps R^" << problem.size() << " to R^"
+         << problem.residual_size() << "; use a least-squares engine (ceres, nlopt)";
+      throw InvalidInput(os.str());
+    }
+    const auto g = [&problem](const Vector<N>& v, Vector<N>& out) {
+      Vector<Dynamic> f(problem.residual_size());
+      problem.evaluate(v, f);
+      out = v + f;
+    };
+    if (!problem.has_jacobian()) {
+      return solve(FixedPointProblem<N>::from_map(g, problem.size()), x);
+    }
+    const auto dg = [&problem](const Vector<N>& v, Matrix<N, N>& j) {
+      Matrix<Dynamic, N> df(problem.residual_size(), problem.size());
+      problem.jacobian(v, df);
+      j = df;
+      j.diagonal().array() += 1.0;
+    };
+    return solve(
+        FixedPointProblem<N>::with_jacobian(g, dg, problem.size(), problem.jacobian_source()), x);
+  }
+
+  // True for engines that solve m > n (Ceres, NLopt).
+  virtual bool least_squares() const { return false; }
+
   const SolverOptions& options() const { return options_; }
 
  protected:

@@ -126,12 +126,15 @@ class EngineRegistry {
            }});
     r.add({"anderson",
            "Anderson acceleration (type II)",
-           {{"m", "depth >= 0; default 3"}, {"damping", "beta in (0, 1]; default 1"}},
+           {{"m", "depth >= 0; default 3"},
+            {"damping", "beta in (0, 1]; default 1"},
+            {"cond", "drop old columns above this condition estimate; default 1e8"}},
            {"anderson", "anderson:m=3,damping=0.5"},
            [](EngineSpecReader& s, SolverOptions o) {
              AndersonOptions a;
              if (auto v = s.integer("m")) a.depth = *v;
              if (auto v = s.number("damping")) a.damping = *v;
+             if (auto v = s.number("cond")) a.condition_limit = *v;
              return std::make_unique<AndersonEngine<N>>(a, std::move(o));
            }});
     r.add({"newton",

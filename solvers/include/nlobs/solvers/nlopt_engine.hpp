@@ -5,6 +5,7 @@
 // gradient-based ones (xD_*) get ∇(½‖F‖²) = Jᵀ F from the problem's Jacobian (AD or user) or
 // from finite differences. The nlopt::opt object is built once per dimension and reused by
 // every solve, so repeated small bounded problems (the MVT observer's β) pay no set-up.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <nlopt.hpp>
@@ -40,13 +41,17 @@ class NloptEngine : public Engine<N> {
   explicit NloptEngine(NloptOptions nlopt = {}, SolverOptions options = {})
       : Engine<N>(std::move(options)), nlopt_(std::move(nlopt)) {
     detail::require_lipschitz_for_error_bound(name(), this->options_.stop);
-    algorithm_ = nlopt_algorithm_from_string(nlopt_.algorithm.c_str());
-    if (static_cast<int>(algorithm_) < 0) {
+    // Look the name up ourselves: nlopt_algorithm_from_string returns -1, not an enumerator,
+    // for an unknown name.
+    const std::vector<std::string> names = nlopt_algorithm_names();
+    const auto found = std::find(names.begin(), names.end(), nlopt_.algorithm);
+    if (found == names.end()) {
       std::string valid;
-      for (const std::string& a : nlopt_algorithm_names()) valid += (valid.empty() ? "" : ", ") + a;
+      for (const std::string& a : names) valid += (valid.empty() ? "" : ", ") + a;
       throw InvalidInput("NloptOptions::algorithm = '" + nlopt_.algorithm +
                          "' is not an NLopt algorithm; valid: " + valid);
     }
+    algorithm_ = static_cast<nlopt_algorithm>(found - names.begin());
     const Eigen::VectorXd& lb = nlopt_.lower_bounds;
     const Eigen::VectorXd& ub = nlopt_.upper_bounds;
     if (lb.size() > 0 && ub.size() > 0 && lb.size() != ub.size()) {
@@ -82,6 +87,11 @@ class NloptEngine : public Engine<N> {
     detail::check_initial_guess(name(), problem, x);
     return run_residual<N>(detail::ResidualSource<N, N>(problem), x);
   }
+  bool least_squares() const override { return true; }
+  Summary solve_least_squares(const RootProblem<N, Dynamic>& problem, Vector<N>& x) override {
+    return solve<Dynamic>(problem, x);
+  }
+
   // min ½‖F(x)‖₂².
   template <int M>
   Summary solve(const RootProblem<N, M>& problem, Vector<N>& x) {

@@ -9,7 +9,8 @@
 // not recomputed: a new column is orthogonalised against Q (modified Gram–Schmidt, O(nm)); when
 // the history is full the oldest column is removed with Givens rotations (O(m² + nm)). Then
 // γ = R⁻¹ Qᵀ f and ΔF γ = Q Qᵀ f. A new column that is numerically dependent on the history
-// (‖q‖ ≤ 1e-13 ‖Δf‖) is not added. Fixed N: all storage is on the stack (depth ≤
+// (‖q‖ ≤ 1e-13 ‖Δf‖) is not added, and the oldest columns are dropped while R is
+// ill-conditioned (condition_limit). Fixed N: all storage is on the stack (depth ≤
 // kMaxFixedDepth), so a solve never allocates; dynamic N allocates in start() when n changes.
 #include <cmath>
 #include <sstream>
@@ -25,6 +26,9 @@ namespace nlobs {
 struct AndersonOptions {
   int depth = 3;         // m ≥ 0
   double damping = 1.0;  // β ∈ (0, 1]
+  // Oldest history columns are dropped while max|R_ii| / min|R_ii| (a cheap lower bound on
+  // cond(R)) exceeds this: nearly dependent differences otherwise give huge γ and wild steps.
+  double condition_limit = 1e8;  // > 1
 };
 
 template <int N = Dynamic>
@@ -38,6 +42,12 @@ class AndersonMixing {
       os << "AndersonOptions::depth = " << options_.depth << " is invalid: must be >= 0"
          << (N != Dynamic ? " and <= " + std::to_string(kMaxFixedDepth) + " for fixed sizes"
                           : std::string());
+      throw InvalidInput(os.str());
+    }
+    if (!(options_.condition_limit > 1.0)) {
+      std::ostringstream os;
+      os << "AndersonOptions::condition_limit = " << options_.condition_limit
+         << " is invalid: must be > 1";
       throw InvalidInput(os.str());
     }
     if (!(options_.damping > 0.0 && options_.damping <= 1.0)) {
@@ -102,6 +112,12 @@ class AndersonMixing {
     q_.col(k) = v_ / rkk;
     dx_.col(k) = x - x_prev_;
     ++count_;
+    while (count_ > 1 && condition_estimate() > options_.condition_limit) remove_oldest();
+  }
+
+  double condition_estimate() const {
+    const auto d = r_.diagonal().head(count_).cwiseAbs();
+    return d.maxCoeff() / d.minCoeff();
   }
 
   // Drops column 0 of ΔF = QR (and of ΔX): R without its first column is upper Hessenberg;

@@ -1,0 +1,69 @@
+#pragma once
+// What a model is. Two shapes, both with sizes fixed at compile time where known
+// (Eigen::Dynamic allowed) and functions generic in the scalar T, so that solvers can
+// differentiate them by AD:
+//
+//   continuous:  x' = F(x, u, t),  y = h(x)
+//     static constexpr int kStates, kInputs, kOutputs;
+//     template <class T> State<T>  vector_field(const State<T>& x, const Input& u, double t) const;
+//     template <class T> Output<T> h(const State<T>& x) const;
+//
+//   discrete:    x⁺ = f(x, u, k),  y = h(x)   (a continuous model with a discretisation, or
+//     a model defined in discrete time)
+//     template <class T> State<T>  f(const State<T>& x, const Input& u, long k) const;
+//     template <class T> Output<T> h(const State<T>& x) const;
+//
+// Both may declare a domain: `std::string domain_violation(const State<double>& x) const`
+// returns an empty string inside and a message naming the state and the bound outside (the
+// lunar lander's mass must stay positive). Inputs are plain doubles: nothing differentiates
+// with respect to u.
+#include <Eigen/Core>
+#include <concepts>
+#include <string>
+
+namespace nlobs {
+
+template <typename T, int N>
+using ModelVector = Eigen::Matrix<T, N, 1>;
+
+template <typename M>
+concept ContinuousModel = requires(const M m, const ModelVector<double, M::kStates>& x,
+                                   const ModelVector<double, M::kInputs>& u) {
+  {m.vector_field(x, u, 0.0)};
+  {m.h(x)};
+};
+
+template <typename M>
+concept DiscreteModel = requires(const M m, const ModelVector<double, M::kStates>& x,
+                                 const ModelVector<double, M::kInputs>& u) {
+  {m.f(x, u, 0L)};
+  {m.h(x)};
+};
+
+// Sizes and vector types of a model with compile-time sizes.
+template <int N, int M, int P>
+struct ModelSizes {
+  static constexpr int kStates = N;
+  static constexpr int kInputs = M;
+  static constexpr int kOutputs = P;
+  template <typename T>
+  using State = ModelVector<T, N>;
+  template <typename T>
+  using Output = ModelVector<T, P>;
+  using Input = ModelVector<double, M>;
+  static constexpr Eigen::Index states() { return N; }
+  static constexpr Eigen::Index inputs() { return M; }
+  static constexpr Eigen::Index outputs() { return P; }
+};
+
+// The domain of a model that declares none: everywhere.
+template <typename M>
+std::string domain_violation_of(const M& model, const ModelVector<double, M::kStates>& x) {
+  if constexpr (requires { model.domain_violation(x); }) {
+    return model.domain_violation(x);
+  } else {
+    return {};
+  }
+}
+
+}  // namespace nlobs

@@ -1,0 +1,211 @@
+#pragma once
+// The classic observers the window estimators are compared with (METHODS §1), for any discrete
+// model x⁺ = f(x, u, k), y = h(x). Each reports x̂_k from the samples up to k − 1 (Luenberger,
+// sliding mode: eq. 89 form, x̂_{k+1} = f(x̂_k) + correction(y_k)) or up to k (EKF: filtered).
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "nlobs/models/model.hpp"
+#include "nlobs/observers/observer.hpp"
+#include "nlobs/solvers/autodiff.hpp"
+#include "nlobs/solvers/status.hpp"
+
+namespace nlobs {
+namespace detail {
+
+inline void require_shape(const char* who, const char* what, const Eigen::MatrixXd& m,
+                          Eigen::Index rows, Eigen::Index cols) {
+  if (m.rows() != rows || m.cols() != cols || !m.allFinite()) {
+    std::ostringstream os;
+    os << who << ": " << what << " must be a finite " << rows << "x" << cols << " matrix (got "
+       << m.rows() << "x" << m.cols() << ")";
+    throw InvalidInput(os.str());
+  }
+}
+
+}  // namespace detail
+
+// x̂⁺ = f(x̂, u, k) + L (y − h(x̂)), constant gain L (n × p).
+template <DiscreteModel Model>
+class LuenbergerObserver final : public Observer {
+ public:
+  LuenbergerObserver(Model model, Eigen::MatrixXd gain, Eigen::VectorXd initial)
+      : model_(std::move(model)), gain_(std::move(gain)), initial_(std::move(initial)) {
+    detail::require_shape("luenberger", "the gain L", gain_, model_.states(), model_.outputs());
+    detail::require_shape("luenberger", "the initial estimate", initial_, model_.states(), 1);
+    reset();
+  }
+  std::string name() const override { return "luenberger"; }
+  void reset() override { x_ = initial_; }
+  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
+    step_.estimate = x_;
+    step_.measurement_missing = !y.allFinite();
+    Eigen::VectorXd next = f(x_, u, k);
+    if (!step_.measurement_missing) next += gain_ * (y - h(x_));
+    x_ = next;
+    return step_;
+  }
+
+ private:
+  Eigen::VectorXd f(const Eigen::VectorXd& x, const Eigen::VectorXd& u, long k) const {
+    return model_.f(ModelVector<double, Model::kStates>(x), ModelVector<double, Model::kInputs>(u),
+                    k);
+  }
+  Eigen::VectorXd h(const Eigen::VectorXd& x) const {
+    return model_.h(ModelVector<double, Model::kStates>(x));
+  }
+  Model model_;
+  Eigen::MatrixXd gain_;
+  Eigen::VectorXd initial_, x_;
+  ObserverStep step_;
+};
+
+// x̂⁺ = f(x̂, u, k) + Q e + R sat(e / γ), e = y − h(x̂), sat = clamp to [−1, 1] per entry
+// (Q, R: n × p gains; γ > 0 the boundary layer).
+template <DiscreteModel Model>
+class SlidingModeObserver final : public Observer {
+ public:
+  SlidingModeObserver(Model model, Eigen::MatrixXd q, Eigen::MatrixXd r, double gamma,
+                      Eigen::VectorXd initial)
+      : model_(std::move(model)),
+        q_(std::move(q)),
+        r_(std::move(r)),
+        gamma_(gamma),
+        initial_(std::move(initial)) {
+    detail::require_shape("sliding_mode", "Q", q_, model_.states(), model_.outputs());
+    detail::require_shape("sliding_mode", "R", r_, model_.states(), model_.outputs());
+    detail::require_shape("sliding_mode", "the initial estimate", initial_, model_.states(), 1);
+    if (!(gamma_ > 0.0) || !std::isfinite(gamma_)) {
+      throw InvalidInput("sliding_mode: gamma = " + std::to_string(gamma_) + " must be > 0");
+    }
+    reset();
+  }
+  std::string name() const override { return "sliding_mode"; }
+  void reset() override { x_ = initial_; }
+  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
+    step_.estimate = x_;
+    step_.measurement_missing = !y.allFinite();
+    Eigen::VectorXd next = model_.f(ModelVector<double, Model::kStates>(x_),
+                                    ModelVector<double, Model::kInputs>(u), k);
+    if (!step_.measurement_missing) {
+      const Eigen::VectorXd e =
+          y - Eigen::VectorXd(model_.h(ModelVector<double, Model::kStates>(x_)));
+      next += q_ * e + r_ * (e / gamma_).cwiseMax(-1.0).cwiseMin(1.0);
+    }
+    x_ = next;
+    return step_;
+  }
+
+ private:
+  Model model_;
+  Eigen::MatrixXd q_, r_;
+  double gamma_;
+  Eigen::VectorXd initial_, x_;
+  ObserverStep step_;
+};
+
+// Extended Kalman filter with Jacobians of f and h by forward-mode AD (ceres::Jet):
+//   update with y_k:  K = P Hᵀ (H P Hᵀ + R)⁻¹, x̂ ← x̂ + K (y − h(x̂)), P ← (I − K H) P (I − K H)ᵀ + K
+//   R Kᵀ report x̂_k, then predict: x̂ ← f(x̂, u_k, k), P ← F P Fᵀ + Q.
+struct EkfOptions {
+  Eigen::MatrixXd process_covariance;      // Q (n × n); empty: 1e-6 I
+  Eigen::MatrixXd measurement_covariance;  // R (p × p); empty: 1e-4 I
+  Eigen::MatrixXd initial_covariance;      // P0 (n × n); empty: I
+};
+
+template <DiscreteModel Model>
+class ExtendedKalmanFilter final : public Observer {
+ public:
+  ExtendedKalmanFilter(Model model, Eigen::VectorXd initial, EkfOptions options = {})
+      : model_(std::move(model)), initial_(std::move(initial)) {
+    const Eigen::Index n = model_.states(), p = model_.outputs();
+    q_ = options.process_covariance.size()
+             ? options.process_covariance
+             : Eigen::MatrixXd(1e-6 * Eigen::MatrixXd::Identity(n, n));
+    r_ = options.measurement_covariance.size()
+             ? options.measurement_covariance
+             : Eigen::MatrixXd(1e-4 * Eigen::MatrixXd::Identity(p, p));
+    p0_ = options.initial_covariance.size() ? options.initial_covariance
+                                            : Eigen::MatrixXd(Eigen::MatrixXd::Identity(n, n));
+    detail::require_shape("ekf", "the initial estimate", initial_, n, 1);
+    detail::require_shape("ekf", "process_covariance Q", q_, n, n);
+    detail::require_shape("ekf", "measurement_covariance R", r_, p, p);
+    detail::require_shape("ekf", "initial_covariance P0", p0_, n, n);
+    const char* names[] = {"process_covariance Q", "measurement_covariance R",
+                           "initial_covariance P0"};
+    const Eigen::MatrixXd* mats[] = {&q_, &r_, &p0_};
+    for (int i = 0; i < 3; ++i) {
+      const Eigen::LDLT<Eigen::MatrixXd> ldlt(*mats[i]);
+      if (!mats[i]->isApprox(mats[i]->transpose()) || ldlt.info() != Eigen::Success ||
+          !ldlt.isPositive()) {
+        throw InvalidInput(std::string("ekf: ") + names[i] +
+                           " must be symmetric positive semi-definite");
+      }
+    }
+    reset();
+  }
+  std::string name() const override { return "ekf"; }
+  void reset() override {
+    x_ = initial_;
+    p_ = p0_;
+  }
+  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
+    const Eigen::Index n = model_.states();
+    step_.measurement_missing = !y.allFinite();
+    if (!step_.measurement_missing) {
+      Eigen::MatrixXd hj;
+      jacobian_h(x_, hj);
+      const Eigen::MatrixXd s = hj * p_ * hj.transpose() + r_;
+      const Eigen::MatrixXd gain = p_ * hj.transpose() * s.inverse();
+      const Eigen::VectorXd innovation =
+          y - Eigen::VectorXd(model_.h(ModelVector<double, Model::kStates>(x_)));
+      const Eigen::VectorXd updated = x_ + gain * innovation;
+      if (updated.allFinite()) {
+        const Eigen::MatrixXd ikh = Eigen::MatrixXd::Identity(n, n) - gain * hj;
+        x_ = updated;
+        p_ = ikh * p_ * ikh.transpose() + gain * r_ * gain.transpose();  // Joseph form
+      }
+    }
+    step_.estimate = x_;
+    Eigen::MatrixXd fj;
+    jacobian_f(x_, u, k, fj);
+    x_ = model_.f(ModelVector<double, Model::kStates>(x_), ModelVector<double, Model::kInputs>(u),
+                  k);
+    p_ = fj * p_ * fj.transpose() + q_;
+    return step_;
+  }
+
+ private:
+  void jacobian_f(const Eigen::VectorXd& x, const Eigen::VectorXd& u, long k,
+                  Eigen::MatrixXd& j) const {
+    const ModelVector<double, Model::kInputs> uu(u);
+    auto f = [this, &uu, k](const auto& v) {
+      using T = typename std::decay_t<decltype(v)>::Scalar;
+      return ModelVector<T, Model::kStates>(model_.f(ModelVector<T, Model::kStates>(v), uu, k));
+    };
+    Matrix<Model::kStates, Model::kStates> jac(x.size(), x.size());
+    autodiff_jacobian<Model::kStates, Model::kStates>(f, ModelVector<double, Model::kStates>(x),
+                                                      jac);
+    j = jac;
+  }
+  void jacobian_h(const Eigen::VectorXd& x, Eigen::MatrixXd& j) const {
+    auto h = [this](const auto& v) {
+      using T = typename std::decay_t<decltype(v)>::Scalar;
+      return ModelVector<T, Model::kOutputs>(model_.h(ModelVector<T, Model::kStates>(v)));
+    };
+    Matrix<Model::kOutputs, Model::kStates> jac(model_.outputs(), x.size());
+    autodiff_jacobian<Model::kStates, Model::kOutputs>(h, ModelVector<double, Model::kStates>(x),
+                                                       jac);
+    j = jac;
+  }
+
+  Model model_;
+  Eigen::VectorXd initial_, x_;
+  Eigen::MatrixXd q_, r_, p0_, p_;
+  ObserverStep step_;
+};
+
+}  // namespace nlobs

@@ -1,0 +1,32 @@
+#pragma once
+// What the simulation harness runs side by side: anything that turns a stream of samples
+// (y_k, u_k) into estimates x̂_k. Sizes are dynamic at this interface; observers keep their
+// own (possibly fixed-size) state inside.
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+
+#include "nlobs/solvers/summary.hpp"
+
+namespace nlobs {
+
+struct ObserverStep {
+  Eigen::VectorXd estimate;          // x̂_k
+  bool ready = true;                 // false while a window fills (the estimate coasts on f)
+  bool measurement_missing = false;  // y_k had a non-finite entry: skipped, estimate coasts
+  std::optional<Summary> summary;    // the engine's summary when this step solved a window
+};
+
+class Observer {
+ public:
+  virtual ~Observer() = default;
+  virtual std::string name() const = 0;              // e.g. "window:steffensen", "luenberger"
+  virtual std::string engine() const { return {}; }  // engine spec, for window estimators
+  // Window length N for window estimators (0 otherwise): the harness's "after the window".
+  virtual Eigen::Index window() const { return 0; }
+  virtual void reset() = 0;  // back to the initial guess, empty window
+  // Sample k (consecutive from 0). A non-finite y means a missing measurement.
+  virtual const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) = 0;
+};
+
+}  // namespace nlobs

@@ -1,0 +1,123 @@
+#pragma once
+// The simulation harness: simulate the true system from x0 (stopping with a clear message if
+// it leaves its domain), add seeded Gaussian measurement noise, run several observers side by
+// side on identical measurements, and measure them: per-state MSE (paper eq. 92) over the
+// whole run and after the window has filled, iterations and evaluations per step (mean, max,
+// first window), time per step, failures counted by status.
+#include <Eigen/Core>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "nlobs/models/model.hpp"
+#include "nlobs/observers/observer.hpp"
+#include "nlobs/solvers/status.hpp"
+
+namespace nlobs {
+
+// Samples k = 0..steps−1: x (n × K), y (p × K, noisy as measured), u (m × K), t (K).
+struct Measurements {
+  Eigen::MatrixXd x;  // true states (empty when the data came from a file)
+  Eigen::MatrixXd y;
+  Eigen::MatrixXd u;
+  Eigen::VectorXd t;
+  bool has_truth() const { return x.size() > 0; }
+  Eigen::Index steps() const { return y.cols(); }
+  std::string stop_message;  // why the simulation ended early (domain), empty otherwise
+};
+
+struct SimulationOptions {
+  long steps = 400;
+  double noise_std = 0.0;  // σ of additive Gaussian noise on every output
+  std::uint64_t seed = 1;
+  double sample_time = 1.0;                           // t_k = k · sample_time
+  std::function<Eigen::VectorXd(long k)> input = {};  // u_k; empty: no inputs
+};
+
+// Throws InvalidInput for steps < 1, σ < 0 or non-finite, or an x0 of the wrong size.
+template <DiscreteModel Model>
+Measurements simulate(const Model& model, const Eigen::VectorXd& x0, const SimulationOptions& o) {
+  const Eigen::Index n = model.states(), p = model.outputs(), m = model.inputs();
+  if (o.steps < 1) throw InvalidInput("simulate: steps must be >= 1");
+  if (!(o.noise_std >= 0.0) || !std::isfinite(o.noise_std)) {
+    throw InvalidInput("simulate: noise_std must be finite and >= 0");
+  }
+  if (x0.size() != n || !x0.allFinite()) {
+    std::ostringstream os;
+    os << "simulate: x0 must be " << n << " finite numbers";
+    throw InvalidInput(os.str());
+  }
+  Measurements data;
+  data.x.resize(n, o.steps);
+  data.y.resize(p, o.steps);
+  data.u.resize(m, o.steps);
+  data.t.resize(o.steps);
+  std::mt19937_64 rng(o.seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  ModelVector<double, Model::kStates> x = x0;
+  for (long k = 0; k < o.steps; ++k) {
+    const std::string violation = domain_violation_of(model, x);
+    if (!violation.empty()) {
+      std::ostringstream os;
+      os << "stopped at sample " << k << " (t = " << k * o.sample_time << "): " << violation;
+      data.stop_message = os.str();
+      data.x.conservativeResize(n, k);
+      data.y.conservativeResize(p, k);
+      data.u.conservativeResize(m, k);
+      data.t.conservativeResize(k);
+      break;
+    }
+    const Eigen::VectorXd u = o.input ? o.input(k) : Eigen::VectorXd::Zero(m);
+    if (u.size() != m) throw InvalidInput("simulate: the input signal has the wrong size");
+    data.x.col(k) = x;
+    data.t[k] = static_cast<double>(k) * o.sample_time;
+    data.u.col(k) = u;
+    Eigen::VectorXd y = model.h(x);
+    if (o.noise_std > 0.0) {
+      for (Eigen::Index i = 0; i < p; ++i) y[i] += o.noise_std * noise(rng);
+    }
+    data.y.col(k) = y;
+    x = model.f(x, ModelVector<double, Model::kInputs>(u), k);
+  }
+  return data;
+}
+
+struct ObserverMetrics {
+  std::string name, engine;
+  Eigen::VectorXd mse;               // per state, all samples (empty without truth)
+  Eigen::VectorXd mse_after_window;  // per state, samples k ≥ settle index
+  double iterations_mean = 0.0;
+  int iterations_max = 0;
+  int first_window_iterations = 0;  // -1 if no window was solved
+  double evaluations_mean = 0.0;
+  double ns_per_step = 0.0;
+  int solves = 0;
+  std::map<std::string, int>
+      failures;  // status name → count (solves not converged, missing samples)
+  std::optional<Summary> first_window;  // with its trace when the engine records one
+};
+
+struct RunResult {
+  std::vector<ObserverMetrics> metrics;
+  std::vector<Eigen::MatrixXd> estimates;  // per observer: n × K
+  long settle_index = 0;                   // first sample of "after the window"
+};
+
+// Runs every observer over the same measurements (each reset first). `settle_index`: the
+// first sample counted in mse_after_window (the longest window's N − 1 when negative).
+RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Observer>>& observers,
+                        long settle_index = -1,
+                        const std::function<void(long done, long total)>& progress = {});
+
+// Mean squared error per state (eq. 92) over samples [from, K).
+Eigen::VectorXd mean_squared_error(const Eigen::MatrixXd& truth, const Eigen::MatrixXd& estimate,
+                                   long from = 0);
+
+}  // namespace nlobs

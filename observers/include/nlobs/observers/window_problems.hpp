@@ -1,0 +1,47 @@
+#pragma once
+// The problems a window poses (METHODS §1), built once and re-evaluated on whatever the window
+// holds at the time (the window must outlive them):
+//   square_window_problem:  G(w) = w + (Y − H(w))       (N·p = n; Ψ = I, the paper's form)
+//   window_residual_problem: F(w) = Y − H(w) ∈ R^{N·p}  (any N; least squares when N·p > n)
+// Jacobians by forward-mode AD through the model. For fixed-size models the square problem
+// evaluates without allocating.
+#include <sstream>
+
+#include "nlobs/observers/output_window.hpp"
+#include "nlobs/solvers/problem.hpp"
+
+namespace nlobs {
+
+template <DiscreteModel Model>
+FixedPointProblem<Model::kStates> square_window_problem(const OutputWindow<Model>& window) {
+  constexpr int N = Model::kStates;
+  if (window.rows() != window.states()) {
+    std::ostringstream os;
+    os << "square_window_problem: the window has " << window.rows() << " equations for "
+       << window.states() << " states; use window_residual_problem (least squares)";
+    throw InvalidInput(os.str());
+  }
+  const OutputWindow<Model>* win = &window;
+  return FixedPointProblem<N>::with_autodiff(
+      [win](const auto& w) {
+        using T = typename std::decay_t<decltype(w)>::Scalar;
+        Vector<N, T> h(w.size());
+        win->map_into(Vector<N, T>(w), h);
+        return Vector<N, T>(w + win->outputs().template cast<T>() - h);
+      },
+      window.states());
+}
+
+template <DiscreteModel Model>
+RootProblem<Model::kStates, Dynamic> window_residual_problem(const OutputWindow<Model>& window) {
+  constexpr int N = Model::kStates;
+  const OutputWindow<Model>* win = &window;
+  return RootProblem<N, Dynamic>::with_autodiff(
+      [win](const auto& w) {
+        using T = typename std::decay_t<decltype(w)>::Scalar;
+        return Vector<Dynamic, T>(win->residual(Vector<N, T>(w)));
+      },
+      window.states(), window.rows());
+}
+
+}  // namespace nlobs

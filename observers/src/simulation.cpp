@@ -1,0 +1,77 @@
+#include "nlobs/observers/simulation.hpp"
+
+#include <algorithm>
+
+namespace nlobs {
+
+Eigen::VectorXd mean_squared_error(const Eigen::MatrixXd& truth, const Eigen::MatrixXd& estimate,
+                                   long from) {
+  const long count = static_cast<long>(truth.cols()) - from;
+  if (truth.rows() != estimate.rows() || truth.cols() != estimate.cols()) {
+    throw InvalidInput("mean_squared_error: truth and estimate differ in shape");
+  }
+  if (count <= 0) return Eigen::VectorXd::Constant(truth.rows(), std::nan(""));
+  const auto diff = truth.rightCols(count) - estimate.rightCols(count);
+  return diff.array().square().rowwise().sum() / static_cast<double>(count);
+}
+
+RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Observer>>& observers,
+                        long settle_index,
+                        const std::function<void(long done, long total)>& progress) {
+  RunResult result;
+  const long steps = static_cast<long>(data.steps());
+  if (settle_index < 0) {
+    Eigen::Index longest = 1;
+    for (const auto& o : observers) longest = std::max(longest, o->window());
+    settle_index = static_cast<long>(longest) - 1;
+  }
+  result.settle_index = settle_index;
+  const long total = steps * static_cast<long>(observers.size());
+  long done = 0;
+  for (auto& observer : observers) {
+    observer->reset();
+    ObserverMetrics m;
+    m.name = observer->name();
+    m.engine = observer->engine();
+    m.first_window_iterations = -1;
+    Eigen::MatrixXd estimate(data.x.rows() > 0 ? data.x.rows() : 0, steps);
+    long iterations_sum = 0, evaluations_sum = 0;
+    double elapsed_ns = 0.0;
+    for (long k = 0; k < steps; ++k) {
+      const Eigen::VectorXd y = data.y.col(k), u = data.u.col(k);
+      const auto t0 = std::chrono::steady_clock::now();
+      const ObserverStep& s = observer->step(k, y, u);
+      elapsed_ns +=
+          std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count();
+      if (estimate.rows() == 0) estimate.resize(s.estimate.size(), steps);
+      estimate.col(k) = s.estimate;
+      if (s.measurement_missing) ++m.failures["missing_measurement"];
+      if (s.summary) {
+        ++m.solves;
+        iterations_sum += s.summary->iterations;
+        evaluations_sum += s.summary->function_evaluations;
+        m.iterations_max = std::max(m.iterations_max, s.summary->iterations);
+        if (m.first_window_iterations < 0) {
+          m.first_window_iterations = s.summary->iterations;
+          m.first_window = s.summary;
+        }
+        if (!s.summary->converged()) ++m.failures[std::string(to_string(s.summary->status))];
+      }
+      if (progress) progress(++done, total);
+    }
+    if (m.solves > 0) {
+      m.iterations_mean = static_cast<double>(iterations_sum) / m.solves;
+      m.evaluations_mean = static_cast<double>(evaluations_sum) / m.solves;
+    }
+    m.ns_per_step = steps > 0 ? elapsed_ns / static_cast<double>(steps) : 0.0;
+    if (data.has_truth()) {
+      m.mse = mean_squared_error(data.x, estimate, 0);
+      m.mse_after_window = mean_squared_error(data.x, estimate, settle_index);
+    }
+    result.metrics.push_back(std::move(m));
+    result.estimates.push_back(std::move(estimate));
+  }
+  return result;
+}
+
+}  // namespace nlobs
