@@ -23,7 +23,8 @@ test: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
 
 demo: build
-	$(BUILD)/cli/nlobs solve chua-window --tol 1e-5
+	$(BUILD)/cli/nlobs run chua-fp --out $(BUILD)/demo
+	@echo "plots: $(BUILD)/demo/states.png errors.png first_window.png (summary.json, trajectories.csv beside them)"
 
 bench: build
 	$(BUILD)/bench/nlobs_bench --benchmark_min_time=0.2

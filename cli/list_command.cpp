@@ -3,16 +3,45 @@
 #include <ostream>
 #include <stdexcept>
 
+#include "model_catalog.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 #include "reference/mgh_suite.hpp"
+#include "scenario.hpp"
 #include "solve_chua_window.hpp"
 
 namespace nlobs::cli {
 
 void print_list(const std::string& what, std::ostream& out) {
-  if (!what.empty() && what != "engines") {
-    throw std::invalid_argument("nothing to list under '" + what + "'; valid: engines");
+  const bool all = what.empty();
+  if (!all && what != "engines" && what != "models" && what != "observers" && what != "scenarios") {
+    throw std::invalid_argument("nothing to list under '" + what +
+                                "'; valid: models, engines, observers, scenarios");
   }
+  if (all || what == "models") {
+    out << "models (JSON: {\"name\", \"parameters\", \"scheme\": euler|rk4, \"step\"}):\n";
+    for (const auto& m : model_catalog()) {
+      out << "  " << m.name << " — " << m.description << '\n';
+      if (!m.parameters.empty()) {
+        out << "      parameters:";
+        for (const auto& p : m.parameters) out << ' ' << p;
+        out << '\n';
+      }
+    }
+  }
+  if (all || what == "observers") {
+    out << "observers (scenario \"observers\" entries):\n"
+        << "  window — any engine x output window: engine, tol, window (N; 0 = square), "
+           "warm_start (propagated|previous)\n"
+        << "  luenberger — constant gain: gain (n x p)\n"
+        << "  sliding_mode — Q, R (n x p), gamma (saturation boundary layer)\n"
+        << "  ekf — extended Kalman filter, AD Jacobians: process_covariance, "
+           "measurement_covariance, initial_covariance\n";
+  }
+  if (all || what == "scenarios") {
+    out << "scenarios (nlobs run NAME, or a JSON file):\n";
+    for (const auto& s : builtin_scenarios()) out << "  " << s << '\n';
+  }
+  if (!all && what != "engines") return;
   out << "engines (spec: name[:word][,key=value...]):\n";
   for (const auto& e : EngineRegistry<Dynamic>::global().entries()) {
     out << "  " << e.name << " — " << e.description << '\n';

@@ -9,6 +9,7 @@
 
 #include "list_command.hpp"
 #include "reference/mgh_suite.hpp"
+#include "run_command.hpp"
 #include "solve_chua_window.hpp"
 #include "suite_mgh.hpp"
 
@@ -56,10 +57,27 @@ int main(int argc, char** argv) {
                   "Comma-separated engine specs and references (default: all)");
   mgh->add_flag("--json", mgh_json, "Print a JSON array instead of the tables");
 
+  // nlobs run
+  CLI::App* run = app.add_subcommand("run", "Run a scenario: simulate, observe, measure");
+  std::string scenario;
+  long steps = 0;
+  double noise = -1.0;
+  std::uint64_t seed = 0;
+  nlobs::cli::RunOptions run_options;
+  run->add_option("scenario", scenario, "Built-in scenario name or JSON scenario file")->required();
+  CLI::Option* steps_opt = run->add_option("--steps", steps, "Number of samples");
+  CLI::Option* noise_opt =
+      run->add_option("--noise", noise, "Std. deviation of Gaussian measurement noise");
+  CLI::Option* seed_opt = run->add_option("--seed", seed, "Seed of the noise generator");
+  run->add_option("--out", run_options.out_dir,
+                  "Directory for summary.json, trajectories.csv and PNG plots");
+  run->add_option("--data", run_options.data_file,
+                  "Observe recorded measurements (CSV: t, y1..yp[, u1..um]) instead of simulating");
+
   // nlobs list
-  CLI::App* list = app.add_subcommand("list", "List engines (and, later, models, observers)");
+  CLI::App* list = app.add_subcommand("list", "List models, engines, observers, scenarios");
   std::string list_what;
-  list->add_option("what", list_what, "engines (default: everything)");
+  list->add_option("what", list_what, "models | engines | observers | scenarios (default: all)");
 
   CLI11_PARSE(app, argc, argv);
   // Ceres logs failed evaluations through glog even when told to be silent; the statuses in
@@ -89,6 +107,11 @@ int main(int argc, char** argv) {
       } else {
         nlobs::cli::print_suite_tables(rows, std::cout);
       }
+    } else if (*run) {
+      if (*steps_opt) run_options.steps = steps;
+      if (*noise_opt) run_options.noise = noise;
+      if (*seed_opt) run_options.seed = seed;
+      nlobs::cli::run_scenario(scenario, run_options, std::cout, std::cerr);
     } else if (*list) {
       nlobs::cli::print_list(list_what, std::cout);
     }

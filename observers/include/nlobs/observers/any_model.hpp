@@ -20,11 +20,15 @@ class AnyModel {
   using State = ModelVector<T, Eigen::Dynamic>;
   using Input = ModelVector<double, Eigen::Dynamic>;
 
+  // `sample_time`: the time between samples k and k + 1 (0 when the model does not say).
   template <DiscreteModel Model>
-  AnyModel(std::string name, Model model)
-      : name_(std::move(name)), impl_(std::make_shared<Impl<Model>>(std::move(model))) {}
+  AnyModel(std::string name, Model model, double sample_time = 0.0)
+      : name_(std::move(name)),
+        sample_time_(sample_time),
+        impl_(std::make_shared<Impl<Model>>(std::move(model))) {}
 
   const std::string& name() const { return name_; }
+  double sample_time() const { return sample_time_; }
   Eigen::Index states() const { return impl_->states(); }
   Eigen::Index inputs() const { return impl_->inputs(); }
   Eigen::Index outputs() const { return impl_->outputs(); }
@@ -88,6 +92,7 @@ class AnyModel {
   };
 
   std::string name_;
+  double sample_time_ = 0.0;
   std::shared_ptr<const Base> impl_;
 };
 

@@ -66,7 +66,8 @@ Measurements simulate(const Model& model, const Eigen::VectorXd& x0, const Simul
     const std::string violation = domain_violation_of(model, x);
     if (!violation.empty()) {
       std::ostringstream os;
-      os << "stopped at sample " << k << " (t = " << k * o.sample_time << "): " << violation;
+      os << "stopped at sample " << k << " (t = " << static_cast<double>(k) * o.sample_time
+         << "): " << violation;
       data.stop_message = os.str();
       data.x.conservativeResize(n, k);
       data.y.conservativeResize(p, k);

@@ -63,7 +63,14 @@ class WindowEstimator final : public Observer {
     reset();
   }
 
-  std::string name() const override { return "window:" + spec_; }
+  std::string name() const override {
+    return "window:" + spec_ + (square_ ? "" : ",N=" + std::to_string(state_->window.length()));
+  }
+  // An engine for the first window after each reset only (e.g. one that records its trace for
+  // a convergence plot), so that the engine of every other step stays lean.
+  void set_first_window_engine(std::unique_ptr<Engine<N>> engine) {
+    first_engine_ = std::move(engine);
+  }
   std::string engine() const override { return spec_; }
   Eigen::Index window() const override { return state_->window.length(); }
   const OutputWindow<Model>& output_window() const { return state_->window; }
@@ -75,6 +82,7 @@ class WindowEstimator final : public Observer {
     coast_ = initial_guess_;
     history_.assign(static_cast<size_t>(state_->window.length()), initial_guess_);
     have_solution_ = false;
+    solved_once_ = false;
   }
 
   const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
@@ -97,8 +105,10 @@ class WindowEstimator final : public Observer {
     if (step_.ready) {
       // Guess for w = x̂[k−N+1]: warm start, or the estimate kept for that sample.
       State w = have_solution_ ? next_guess_ : history_[static_cast<size_t>((k + 1) % length)];
+      Engine<N>& engine = (first_engine_ && !solved_once_) ? *first_engine_ : *engine_;
+      solved_once_ = true;
       const Summary s =
-          square_ ? engine_->solve(*fixed_point_, w) : engine_->solve_least_squares(*root_, w);
+          square_ ? engine.solve(*fixed_point_, w) : engine.solve_least_squares(*root_, w);
       step_.summary = s;
       if (usable(s.status) && w.allFinite()) {
         have_solution_ = true;
@@ -151,6 +161,8 @@ class WindowEstimator final : public Observer {
   Eigen::VectorXd last_u_;
   std::vector<State> history_;  // estimates of the last N samples, by k mod N
   bool have_solution_ = false;
+  std::unique_ptr<Engine<N>> first_engine_;
+  bool solved_once_ = false;
 };
 
 }  // namespace nlobs

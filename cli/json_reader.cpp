@@ -1,0 +1,139 @@
+#include "json_reader.hpp"
+
+#include <cmath>
+
+namespace nlobs::cli {
+
+JsonReader::JsonReader(const nlohmann::json& object, std::string where)
+    : object_(object), where_(std::move(where)) {
+  if (!object_.is_object()) fail("expected an object");
+}
+
+void JsonReader::fail(const std::string& what) const {
+  throw std::invalid_argument(where_ + ": " + what);
+}
+
+const nlohmann::json& JsonReader::get(const std::string& key) {
+  read_.insert(key);
+  return object_.at(key);
+}
+
+std::optional<double> JsonReader::number(const std::string& key) {
+  if (!has(key)) return std::nullopt;
+  const auto& v = get(key);
+  if (!v.is_number() || !std::isfinite(v.get<double>())) {
+    fail("'" + key + "' must be a finite number, got " + v.dump());
+  }
+  return v.get<double>();
+}
+
+std::optional<long> JsonReader::integer(const std::string& key) {
+  if (!has(key)) return std::nullopt;
+  const auto& v = get(key);
+  if (!v.is_number_integer()) fail("'" + key + "' must be an integer, got " + v.dump());
+  return v.get<long>();
+}
+
+std::optional<bool> JsonReader::boolean(const std::string& key) {
+  if (!has(key)) return std::nullopt;
+  const auto& v = get(key);
+  if (!v.is_boolean()) fail("'" + key + "' must be true or false, got " + v.dump());
+  return v.get<bool>();
+}
+
+std::optional<std::string> JsonReader::text(const std::string& key) {
+  if (!has(key)) return std::nullopt;
+  const auto& v = get(key);
+  if (!v.is_string()) fail("'" + key + "' must be a string, got " + v.dump());
+  return v.get<std::string>();
+}
+
+std::optional<Eigen::VectorXd> JsonReader::vector(const std::string& key) {
+  if (!has(key)) return std::nullopt;
+  const auto& v = get(key);
+  if (!v.is_array()) fail("'" + key + "' must be an array of numbers, got " + v.dump());
+  Eigen::VectorXd out(static_cast<Eigen::Index>(v.size()));
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (!v[i].is_number() || !std::isfinite(v[i].get<double>())) {
+      fail("'" + key + "[" + std::to_string(i) + "]' must be a finite number, got " + v[i].dump());
+    }
+    out[static_cast<Eigen::Index>(i)] = v[i].get<double>();
+  }
+  return out;
+}
+
+std::optional<Eigen::MatrixXd> JsonReader::matrix(const std::string& key) {
+  if (!has(key)) return std::nullopt;
+  const auto& v = get(key);
+  if (!v.is_array() || v.empty()) fail("'" + key + "' must be a non-empty array");
+  if (!v[0].is_array()) {  // a column
+    Eigen::MatrixXd out(static_cast<Eigen::Index>(v.size()), 1);
+    for (size_t i = 0; i < v.size(); ++i) {
+      if (!v[i].is_number()) fail("'" + key + "' must hold numbers or rows of numbers");
+      out(static_cast<Eigen::Index>(i), 0) = v[i].get<double>();
+    }
+    return out;
+  }
+  const size_t cols = v[0].size();
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(v.size()), static_cast<Eigen::Index>(cols));
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (!v[i].is_array() || v[i].size() != cols) {
+      fail("'" + key + "' row " + std::to_string(i) + " must have " + std::to_string(cols) +
+           " numbers");
+    }
+    for (size_t j = 0; j < cols; ++j) {
+      if (!v[i][j].is_number() || !std::isfinite(v[i][j].get<double>())) {
+        fail("'" + key + "[" + std::to_string(i) + "][" + std::to_string(j) +
+             "]' must be a finite number");
+      }
+      out(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = v[i][j].get<double>();
+    }
+  }
+  return out;
+}
+
+std::optional<JsonReader> JsonReader::object(const std::string& key) {
+  if (!has(key)) return std::nullopt;
+  const auto& v = get(key);
+  if (!v.is_object()) fail("'" + key + "' must be an object, got " + v.dump());
+  return JsonReader(v, where_ + "." + key);
+}
+
+std::vector<JsonReader> JsonReader::objects(const std::string& key) {
+  std::vector<JsonReader> out;
+  if (!has(key)) return out;
+  const auto& v = get(key);
+  if (!v.is_array()) fail("'" + key + "' must be an array of objects");
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (!v[i].is_object()) fail("'" + key + "[" + std::to_string(i) + "]' must be an object");
+    out.emplace_back(v[i], where_ + "." + key + "[" + std::to_string(i) + "]");
+  }
+  return out;
+}
+
+double JsonReader::required_number(const std::string& key) {
+  if (!has(key)) fail("missing field '" + key + "'");
+  return *number(key);
+}
+
+std::string JsonReader::required_text(const std::string& key) {
+  if (!has(key)) fail("missing field '" + key + "'");
+  return *text(key);
+}
+
+Eigen::VectorXd JsonReader::required_vector(const std::string& key) {
+  if (!has(key)) fail("missing field '" + key + "'");
+  return *vector(key);
+}
+
+void JsonReader::finish(const std::vector<std::string>& valid) const {
+  for (auto it = object_.begin(); it != object_.end(); ++it) {
+    if (!read_.count(it.key())) {
+      std::string list;
+      for (const auto& v : valid) list += (list.empty() ? "" : ", ") + v;
+      fail("unknown key '" + it.key() + "'; valid keys: " + list);
+    }
+  }
+}
+
+}  // namespace nlobs::cli

@@ -1,0 +1,45 @@
+#pragma once
+// Strict reading of JSON objects: every key must be known, every value of the right type, and
+// an error names the file and the path ("scenario.json: observers[2].tol: expected a number").
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace nlobs::cli {
+
+class JsonReader {
+ public:
+  JsonReader(const nlohmann::json& object, std::string where);
+
+  [[noreturn]] void fail(const std::string& what) const;
+  const std::string& where() const { return where_; }
+  bool has(const std::string& key) const { return object_.contains(key); }
+
+  std::optional<double> number(const std::string& key);
+  std::optional<long> integer(const std::string& key);
+  std::optional<bool> boolean(const std::string& key);
+  std::optional<std::string> text(const std::string& key);
+  std::optional<Eigen::VectorXd> vector(const std::string& key);
+  // A matrix as an array of rows; a flat array is a column.
+  std::optional<Eigen::MatrixXd> matrix(const std::string& key);
+  std::optional<JsonReader> object(const std::string& key);
+  std::vector<JsonReader> objects(const std::string& key);
+  double required_number(const std::string& key);
+  std::string required_text(const std::string& key);
+  Eigen::VectorXd required_vector(const std::string& key);
+
+  // Throws naming the first key nobody read, listing the valid ones.
+  void finish(const std::vector<std::string>& valid) const;
+
+ private:
+  const nlohmann::json& get(const std::string& key);
+  const nlohmann::json& object_;
+  std::string where_;
+  std::set<std::string> read_;
+};
+
+}  // namespace nlobs::cli

@@ -1,0 +1,367 @@
+#include "run_command.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <nlohmann/json.hpp>
+#include <ostream>
+#include <sstream>
+#include <stdexcept>
+
+#include "nlobs/observers/simulation.hpp"
+#include "scenario.hpp"
+
+namespace nlobs::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Writes through a temporary name and renames at the end: nothing half-written looks complete.
+void write_atomically(const fs::path& path, const std::string& content) {
+  const fs::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+    out << content;
+    if (!out) throw std::runtime_error("writing " + tmp.string() + " failed");
+  }
+  fs::rename(tmp, path);
+}
+
+// Recorded measurements: columns t, y1..yp[, u1..um]; an optional header line.
+Measurements read_data(const std::string& file, const AnyModel& model) {
+  std::ifstream in(file);
+  if (!in) throw std::invalid_argument("cannot read data file '" + file + "'");
+  const Eigen::Index p = model.outputs(), m = model.inputs();
+  std::vector<std::vector<double>> rows;
+  std::string line;
+  long number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
+    std::vector<double> values;
+    bool numeric = true;
+    for (const std::string& c : cells) {
+      char* end = nullptr;
+      const double v = std::strtod(c.c_str(), &end);
+      // An empty cell or "nan" is a missing measurement; anything else must parse fully.
+      std::string trimmed = c;
+      trimmed.erase(0, trimmed.find_first_not_of(" \t"));
+      if (trimmed.empty() || trimmed == "nan" || trimmed == "NaN") {
+        values.push_back(std::nan(""));
+        continue;
+      }
+      if (end == c.c_str() || *end != '\0') {
+        numeric = false;
+        break;
+      }
+      values.push_back(v);
+    }
+    if (!numeric) {
+      if (rows.empty() && number == 1) continue;  // header
+      throw std::invalid_argument(file + ":" + std::to_string(number) +
+                                  ": malformed row (a cell is not a number): '" + line + "'");
+    }
+    const size_t expected = static_cast<size_t>(1 + p + m);
+    if (values.size() != expected) {
+      std::ostringstream os;
+      os << file << ":" << number << ": expected " << expected << " columns (t, " << p << " outputs"
+         << (m ? ", " + std::to_string(m) + " inputs" : "") << "), got " << values.size();
+      throw std::invalid_argument(os.str());
+    }
+    if (!std::isfinite(values[0])) {
+      throw std::invalid_argument(file + ":" + std::to_string(number) + ": time is missing");
+    }
+    for (Eigen::Index j = 0; j < m; ++j) {
+      if (!std::isfinite(values[static_cast<size_t>(1 + p + j)])) {
+        throw std::invalid_argument(file + ":" + std::to_string(number) + ": input u" +
+                                    std::to_string(j + 1) + " is missing");
+      }
+    }
+    rows.push_back(std::move(values));
+  }
+  if (rows.empty()) throw std::invalid_argument(file + ": no data rows");
+  Measurements data;
+  const Eigen::Index k = static_cast<Eigen::Index>(rows.size());
+  data.t.resize(k);
+  data.y.resize(p, k);
+  data.u.resize(m, k);
+  for (Eigen::Index i = 0; i < k; ++i) {
+    const auto& r = rows[static_cast<size_t>(i)];
+    data.t[i] = r[0];
+    for (Eigen::Index j = 0; j < p; ++j) data.y(j, i) = r[static_cast<size_t>(1 + j)];
+    for (Eigen::Index j = 0; j < m; ++j) data.u(j, i) = r[static_cast<size_t>(1 + p + j)];
+  }
+  return data;
+}
+
+nlohmann::json number_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+nlohmann::json vector_or_null(const Eigen::VectorXd& v) {
+  nlohmann::json a = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(number_or_null(v[i]));
+  return a;
+}
+
+std::string fmt(double v, const char* f = "%.3e") {
+  if (!std::isfinite(v)) return "-";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+void print_table(const Scenario& s, const Measurements& data, const RunResult& r,
+                 std::ostream& out) {
+  char line[512];
+  out << "scenario " << s.name << ": " << data.steps() << " samples, noise sigma " << s.noise
+      << ", seed " << s.seed << "; 'after' counts samples k >= " << r.settle_index << "\n";
+  std::snprintf(line, sizeof line, "%-26s %-11s %-11s %-11s %8s %6s %6s %9s %10s  %s\n", "observer",
+                "MSE (all)", "MSE (after)", "paper MSE", "iter", "max", "first", "paper 1st",
+                "us/step", "failures");
+  out << line;
+  for (const ObserverMetrics& m : r.metrics) {
+    const double mse = m.mse.size() ? m.mse.mean() : NAN;
+    const double after = m.mse_after_window.size() ? m.mse_after_window.mean() : NAN;
+    double paper_mse = NAN, paper_first = NAN;
+    if (auto it = s.reported.find(m.name); it != s.reported.end()) {
+      if (it->second.count("mse")) paper_mse = it->second.at("mse");
+      if (it->second.count("first_window_iterations")) {
+        paper_first = it->second.at("first_window_iterations");
+      }
+    }
+    std::string failures;
+    for (const auto& [status, count] : m.failures) {
+      failures += (failures.empty() ? "" : ", ") + status + " " + std::to_string(count);
+    }
+    std::snprintf(
+        line, sizeof line, "%-26s %-11s %-11s %-11s %8s %6s %6s %9s %10.2f  %s\n", m.name.c_str(),
+        fmt(mse).c_str(), fmt(after).c_str(), fmt(paper_mse, "%.4f").c_str(),
+        m.solves ? fmt(m.iterations_mean, "%.1f").c_str() : "-",
+        m.solves ? std::to_string(m.iterations_max).c_str() : "-",
+        m.first_window_iterations >= 0 ? std::to_string(m.first_window_iterations).c_str() : "-",
+        fmt(paper_first, "%.0f").c_str(), m.ns_per_step / 1e3,
+        failures.empty() ? "none" : failures.c_str());
+    out << line;
+  }
+  out << "MSE: mean over states of (1/K) sum_k (x_i[k] - xhat_i[k])^2 (paper eq. 92); per-state "
+         "values in summary.json.\n";
+}
+
+nlohmann::json summary_json(const Scenario& s, const Measurements& data, const RunResult& r,
+                            const std::string& source) {
+  nlohmann::json observers = nlohmann::json::array();
+  for (const ObserverMetrics& m : r.metrics) {
+    nlohmann::json o{{"name", m.name},
+                     {"engine", m.engine},
+                     {"iterations_mean", m.iterations_mean},
+                     {"iterations_max", m.iterations_max},
+                     {"first_window_iterations", m.first_window_iterations},
+                     {"evaluations_mean", m.evaluations_mean},
+                     {"ns_per_step", m.ns_per_step},
+                     {"failures", m.failures}};
+    if (data.has_truth()) {
+      o["mse"] = vector_or_null(m.mse);
+      o["mse_after_window"] = vector_or_null(m.mse_after_window);
+    }
+    observers.push_back(o);
+  }
+  nlohmann::json j{{"scenario", s.name}, {"steps", data.steps()},  {"noise_std", s.noise},
+                   {"seed", s.seed},     {"observers", observers}, {"settle_index", r.settle_index},
+                   {"source", source}};
+  if (!data.stop_message.empty()) j["stop_message"] = data.stop_message;
+  return j;
+}
+
+std::string trajectories_csv(const Measurements& data, const RunResult& r) {
+  std::ostringstream os;
+  os << std::setprecision(12);
+  const Eigen::Index n = r.estimates.empty() ? data.x.rows() : r.estimates.front().rows();
+  os << "t";
+  if (data.has_truth()) {
+    for (Eigen::Index i = 0; i < n; ++i) os << ",x" << i + 1;
+  }
+  for (const auto& m : r.metrics) {
+    for (Eigen::Index i = 0; i < n; ++i) os << "," << m.name << ".x" << i + 1;
+  }
+  os << '\n';
+  for (Eigen::Index k = 0; k < data.steps(); ++k) {
+    os << data.t[k];
+    if (data.has_truth()) {
+      for (Eigen::Index i = 0; i < n; ++i) os << ',' << data.x(i, k);
+    }
+    for (const auto& e : r.estimates) {
+      for (Eigen::Index i = 0; i < n; ++i) os << ',' << e(i, k);
+    }
+    os << '\n';
+  }
+  return os.str();
+}
+
+// The step norm per iteration at the first window, one block per window estimator.
+std::string first_window_csv(const RunResult& r, std::vector<std::string>* names) {
+  std::ostringstream os;
+  os << std::setprecision(12) << "# observer iteration step_norm\n";
+  for (const auto& m : r.metrics) {
+    if (!m.first_window || m.first_window->trace.empty()) continue;
+    names->push_back(m.name);
+    for (const TraceEntry& t : m.first_window->trace) {
+      os << m.name << ' ' << t.iteration << ' ' << std::max(t.step_norm, 1e-300) << '\n';
+    }
+    os << "\n\n";  // gnuplot index separator
+  }
+  return os.str();
+}
+
+bool have_gnuplot() {
+  return std::system("command -v gnuplot >/dev/null 2>&1") == 0;
+}
+
+// PNG plots through gnuplot: estimates vs truth, errors, and the first window's convergence.
+std::vector<std::string> plot(const fs::path& dir, const Measurements& data, const RunResult& r,
+                              const std::vector<std::string>& traced) {
+  std::vector<std::string> written;
+  const Eigen::Index n = r.estimates.empty() ? 0 : r.estimates.front().rows();
+  const long observers = static_cast<long>(r.metrics.size());
+  const long offset = data.has_truth() ? n : 0;
+  std::ostringstream g;
+  g << "set datafile separator ','\nset key outside right\nset grid\nset termoption noenhanced\n"
+    << "set terminal pngcairo size 1200," << 300 * std::max<Eigen::Index>(n, 1) << "\n";
+  g << "set output '" << (dir / "states.png").string() << "'\nset multiplot layout " << n << ",1\n";
+  for (Eigen::Index i = 0; i < n; ++i) {
+    g << "set ylabel 'x" << i + 1 << "'\nplot ";
+    if (data.has_truth())
+      g << "'trajectories.csv' using 1:" << i + 2 << " with lines lw 2 title 'true', ";
+    for (long o = 0; o < observers; ++o) {
+      g << "'trajectories.csv' using 1:" << 2 + offset + o * n + i << " with lines title '"
+        << r.metrics[static_cast<size_t>(o)].name << "'" << (o + 1 < observers ? ", " : "\n");
+    }
+  }
+  g << "unset multiplot\n";
+  written.push_back("states.png");
+  if (data.has_truth()) {
+    g << "set output '" << (dir / "errors.png").string() << "'\nset logscale y\n"
+      << "set multiplot layout " << n << ",1\n";
+    for (Eigen::Index i = 0; i < n; ++i) {
+      g << "set ylabel '|x" << i + 1 << " - xhat" << i + 1 << "|'\nplot ";
+      for (long o = 0; o < observers; ++o) {
+        g << "'trajectories.csv' using 1:(abs($" << i + 2 << " - $" << 2 + offset + o * n + i
+          << ")+1e-16) with lines title '" << r.metrics[static_cast<size_t>(o)].name << "'"
+          << (o + 1 < observers ? ", " : "\n");
+      }
+    }
+    g << "unset multiplot\nunset logscale y\n";
+    written.push_back("errors.png");
+  }
+  if (!traced.empty()) {
+    g << "set datafile separator whitespace\nset terminal pngcairo size 1000,600\n"
+      << "set output '" << (dir / "first_window.png").string() << "'\nset logscale y\n"
+      << "set xlabel 'iteration'\nset ylabel 'step norm (max)'\nplot ";
+    for (size_t i = 0; i < traced.size(); ++i) {
+      g << "'first_window.dat' index " << i << " using 2:3 with linespoints title '" << traced[i]
+        << "'" << (i + 1 < traced.size() ? ", " : "\n");
+    }
+    written.push_back("first_window.png");
+  }
+  write_atomically(dir / "plots.gp", g.str());
+  const std::string cmd = "cd '" + dir.string() + "' && gnuplot plots.gp 2>gnuplot.log";
+  if (std::system(cmd.c_str()) != 0) {
+    throw std::runtime_error("gnuplot failed; see " + (dir / "gnuplot.log").string());
+  }
+  return written;
+}
+
+}  // namespace
+
+void run_scenario(const std::string& name, const RunOptions& options, std::ostream& out,
+                  std::ostream& err) {
+  Scenario s = load_scenario(name);
+  if (options.steps) {
+    if (*options.steps < 1) throw std::invalid_argument("--steps must be >= 1");
+    s.steps = *options.steps;
+  }
+  if (options.noise) {
+    if (!(*options.noise >= 0.0)) throw std::invalid_argument("--noise must be >= 0");
+    s.noise = *options.noise;
+  }
+  if (options.seed) s.seed = *options.seed;
+  const AnyModel model = scenario_model(s);
+
+  Measurements data;
+  std::string source = "simulation";
+  if (options.data_file.empty()) {
+    SimulationOptions sim;
+    sim.steps = s.steps;
+    sim.noise_std = s.noise;
+    sim.seed = s.seed;
+    sim.sample_time = model.sample_time() > 0 ? model.sample_time() : 1.0;
+    sim.input = [&s, &model](long k) { return scenario_input(s, model, k); };
+    data = simulate(model, s.x0, sim);
+    if (!data.stop_message.empty()) err << "nlobs: simulation " << data.stop_message << '\n';
+    if (data.steps() == 0) throw std::runtime_error("the simulation produced no samples");
+  } else {
+    data = read_data(options.data_file, model);
+    source = options.data_file;
+  }
+
+  Eigen::Index longest = 1;
+  auto observers = make_observers(s, model, !options.out_dir.empty());
+  for (const auto& o : observers) longest = std::max(longest, o->window());
+  if (longest > data.steps()) {
+    std::ostringstream os;
+    os << "a window of " << longest << " samples is longer than the data (" << data.steps()
+       << " samples)";
+    throw std::invalid_argument(os.str());
+  }
+
+  const auto start = std::chrono::steady_clock::now();
+  auto last = start;
+  bool printed = false;
+  const RunResult r = run_observers(data, observers, -1, [&](long done, long total) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now - start < std::chrono::seconds(1) ||
+        (now - last < std::chrono::milliseconds(250) && done < total)) {
+      return;
+    }
+    last = now;
+    printed = true;
+    err << "\rnlobs run " << s.name << ": " << (100 * done / total) << "% of " << total
+        << " observer steps" << std::flush;
+  });
+  if (printed) err << '\n';
+
+  print_table(s, data, r, out);
+
+  if (!options.out_dir.empty()) {
+    const fs::path dir(options.out_dir);
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) throw std::runtime_error("cannot create " + dir.string() + ": " + ec.message());
+    write_atomically(dir / "trajectories.csv", trajectories_csv(data, r));
+    std::vector<std::string> traced;
+    write_atomically(dir / "first_window.dat", first_window_csv(r, &traced));
+    write_atomically(dir / "scenario.json", to_json(s).dump(2) + "\n");
+    std::vector<std::string> plots;
+    if (have_gnuplot()) {
+      plots = plot(dir, data, r, traced);
+    } else {
+      err << "nlobs: gnuplot not found: no PNG plots (apt-get install gnuplot-nox)\n";
+    }
+    // Last: summary.json marks a complete output directory.
+    write_atomically(dir / "summary.json", summary_json(s, data, r, source).dump(2) + "\n");
+    out << "wrote " << (dir / "summary.json").string() << ", trajectories.csv, scenario.json";
+    for (const auto& p : plots) out << ", " << p;
+    out << '\n';
+  }
+}
+
+}  // namespace nlobs::cli

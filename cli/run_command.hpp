@@ -1,0 +1,23 @@
+#pragma once
+// `nlobs run SCENARIO [--steps N] [--noise SIGMA] [--seed S] [--out DIR] [--data FILE.csv]`.
+#include <cstdint>
+#include <iosfwd>
+#include <optional>
+#include <string>
+
+namespace nlobs::cli {
+
+struct RunOptions {
+  std::optional<long> steps{};
+  std::optional<double> noise{};
+  std::optional<std::uint64_t> seed{};
+  std::string out_dir{};    // empty: no files
+  std::string data_file{};  // empty: simulate
+};
+
+// Prints the table to `out` (progress and notices to `err`); writes the files when asked.
+// Throws std::invalid_argument / std::runtime_error with a message naming what was wrong.
+void run_scenario(const std::string& scenario, const RunOptions& options, std::ostream& out,
+                  std::ostream& err);
+
+}  // namespace nlobs::cli

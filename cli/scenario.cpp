@@ -1,0 +1,278 @@
+#include "scenario.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "json_reader.hpp"
+#include "model_catalog.hpp"
+#include "nlobs/observers/baselines.hpp"
+#include "nlobs/observers/window_estimator.hpp"
+#include "nlobs/solvers/engine_registry.hpp"
+
+namespace nlobs::cli {
+namespace {
+
+nlohmann::json matrix_json(const Eigen::MatrixXd& m) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < m.rows(); ++i) {
+    nlohmann::json row = nlohmann::json::array();
+    for (Eigen::Index j = 0; j < m.cols(); ++j) row.push_back(m(i, j));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+nlohmann::json vector_json(const Eigen::VectorXd& v) {
+  return std::vector<double>(v.data(), v.data() + v.size());
+}
+
+// The paper's experiment (METHODS §1). The paper omits the true state, the run length and
+// the noise: x0 = [1, 2.1428, -0.1648] reproduces its first-window fixed point; 400 samples
+// (20 s at T = 0.05); noise-free by default (--noise adds it).
+const char* kChuaFp = R"({
+  "name": "chua-fp",
+  "model": {"name": "modified-chua", "scheme": "euler", "step": 0.05},
+  "x0": [1.0, 2.1428, -0.1648],
+  "initial_guess": [5.0, 10.0, -5.0],
+  "steps": 400,
+  "noise": 0.0,
+  "seed": 1,
+  "observers": [
+    {"type": "window", "engine": "picard", "tol": 1e-5},
+    {"type": "window", "engine": "aitken", "tol": 1e-5},
+    {"type": "window", "engine": "steffensen", "tol": 1e-5},
+    {"type": "window", "engine": "anderson", "tol": 1e-5},
+    {"type": "window", "engine": "newton", "tol": 1e-5},
+    {"type": "window", "engine": "ceres", "tol": 1e-8, "window": 6},
+    {"type": "luenberger", "gain": [0.5, 0.4, 0.2]},
+    {"type": "sliding_mode", "Q": [0.1, 0.2, 0.1], "R": [4.1, 2.1, 3.9], "gamma": 10},
+    {"type": "ekf", "process_covariance": [[1e-6, 0, 0], [0, 1e-6, 0], [0, 0, 1e-6]],
+     "measurement_covariance": [[1e-4]], "initial_covariance": [[10, 0, 0], [0, 10, 0], [0, 0, 10]]}
+  ],
+  "reported": {
+    "window:picard": {"mse": 0.0165, "first_window_iterations": 284},
+    "window:aitken": {"mse": 0.0165, "first_window_iterations": 139},
+    "window:steffensen": {"mse": 0.0165, "first_window_iterations": 42},
+    "window:newton": {"mse": 0.0180, "first_window_iterations": 3},
+    "luenberger": {"mse": 0.3335},
+    "sliding_mode": {"mse": 0.3025}
+  }
+})";
+
+}  // namespace
+
+std::vector<std::string> builtin_scenarios() {
+  return {"chua-fp"};
+}
+
+Scenario load_scenario(const std::string& name_or_file) {
+  if (name_or_file == "chua-fp") {
+    return parse_scenario(nlohmann::json::parse(kChuaFp), "built-in scenario chua-fp");
+  }
+  std::ifstream in(name_or_file);
+  if (!in) {
+    std::string list;
+    for (const auto& s : builtin_scenarios()) list += (list.empty() ? "" : ", ") + s;
+    throw std::invalid_argument("'" + name_or_file + "' is neither a built-in scenario (" + list +
+                                ") nor a readable JSON file");
+  }
+  nlohmann::json json;
+  try {
+    json = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw std::invalid_argument(name_or_file + ": not valid JSON: " + e.what());
+  }
+  return parse_scenario(json, name_or_file);
+}
+
+Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
+  JsonReader r(json, where);
+  Scenario s;
+  s.name = r.required_text("name");
+  if (!r.has("model")) r.fail("missing field 'model'");
+  {
+    auto m = r.object("model");
+    s.model = json.at("model");
+    make_model(*m);  // validates now, naming the key
+  }
+  s.x0 = r.required_vector("x0");
+  s.initial_guess = r.required_vector("initial_guess");
+  if (auto v = r.integer("steps")) {
+    if (*v < 1) r.fail("'steps' must be >= 1");
+    s.steps = *v;
+  }
+  if (auto v = r.number("noise")) {
+    if (*v < 0) r.fail("'noise' must be >= 0");
+    s.noise = *v;
+  }
+  if (auto v = r.integer("seed")) s.seed = static_cast<std::uint64_t>(*v);
+  if (auto in = r.object("input")) {
+    s.input.kind = in->text("kind").value_or("zero");
+    if (s.input.kind != "zero" && s.input.kind != "constant" && s.input.kind != "sin") {
+      in->fail("'kind' must be zero, constant or sin");
+    }
+    s.input.value = in->number("value").value_or(0.0);
+    s.input.amplitude = in->number("amplitude").value_or(1.0);
+    s.input.frequency = in->number("frequency").value_or(1.0);
+    in->finish({"kind", "value", "amplitude", "frequency"});
+  }
+  for (JsonReader& o : r.objects("observers")) {
+    ObserverSpec spec;
+    spec.type = o.required_text("type");
+    if (spec.type == "window") {
+      spec.engine = o.text("engine").value_or("newton");
+      spec.tol = o.number("tol");
+      spec.window = o.integer("window").value_or(0);
+      spec.warm_start = o.text("warm_start").value_or("propagated");
+      if (spec.warm_start != "propagated" && spec.warm_start != "previous") {
+        o.fail("'warm_start' must be propagated or previous");
+      }
+      spec.initial = o.vector("initial");
+      o.finish({"type", "engine", "tol", "window", "warm_start", "initial"});
+    } else if (spec.type == "luenberger") {
+      spec.gain = o.matrix("gain").value_or(Eigen::MatrixXd());
+      if (spec.gain.size() == 0) o.fail("missing field 'gain'");
+      spec.initial = o.vector("initial");
+      o.finish({"type", "gain", "initial"});
+    } else if (spec.type == "sliding_mode") {
+      spec.q = o.matrix("Q").value_or(Eigen::MatrixXd());
+      spec.r = o.matrix("R").value_or(Eigen::MatrixXd());
+      if (spec.q.size() == 0 || spec.r.size() == 0) o.fail("missing field 'Q' or 'R'");
+      spec.gamma = o.required_number("gamma");
+      spec.initial = o.vector("initial");
+      o.finish({"type", "Q", "R", "gamma", "initial"});
+    } else if (spec.type == "ekf") {
+      spec.process_covariance = o.matrix("process_covariance").value_or(Eigen::MatrixXd());
+      spec.measurement_covariance = o.matrix("measurement_covariance").value_or(Eigen::MatrixXd());
+      spec.initial_covariance = o.matrix("initial_covariance").value_or(Eigen::MatrixXd());
+      spec.initial = o.vector("initial");
+      o.finish({"type", "process_covariance", "measurement_covariance", "initial_covariance",
+                "initial"});
+    } else {
+      o.fail("unknown observer type '" + spec.type +
+             "'; valid: window, luenberger, sliding_mode, ekf");
+    }
+    s.observers.push_back(std::move(spec));
+  }
+  if (s.observers.empty()) r.fail("'observers' must list at least one observer");
+  if (auto rep = r.object("reported")) {
+    const nlohmann::json& raw = json.at("reported");
+    for (auto it = raw.begin(); it != raw.end(); ++it) {
+      auto entry = rep->object(it.key());
+      for (const char* key : {"mse", "first_window_iterations"}) {
+        if (auto v = entry->number(key)) s.reported[it.key()][key] = *v;
+      }
+      entry->finish({"mse", "first_window_iterations"});
+    }
+  }
+  r.finish({"name", "model", "x0", "initial_guess", "steps", "noise", "seed", "input", "observers",
+            "reported"});
+  // Sizes against the model, now that everything parsed.
+  const AnyModel model = scenario_model(s);
+  if (s.x0.size() != model.states() || s.initial_guess.size() != model.states()) {
+    r.fail("'x0' and 'initial_guess' must have " + std::to_string(model.states()) +
+           " entries (the model's states)");
+  }
+  return s;
+}
+
+nlohmann::json to_json(const Scenario& s) {
+  nlohmann::json j;
+  j["name"] = s.name;
+  j["model"] = s.model;
+  j["x0"] = vector_json(s.x0);
+  j["initial_guess"] = vector_json(s.initial_guess);
+  j["steps"] = s.steps;
+  j["noise"] = s.noise;
+  j["seed"] = s.seed;
+  j["input"] = {{"kind", s.input.kind},
+                {"value", s.input.value},
+                {"amplitude", s.input.amplitude},
+                {"frequency", s.input.frequency}};
+  nlohmann::json observers = nlohmann::json::array();
+  for (const ObserverSpec& o : s.observers) {
+    nlohmann::json jo{{"type", o.type}};
+    if (o.type == "window") {
+      jo["engine"] = o.engine;
+      if (o.tol) jo["tol"] = *o.tol;
+      jo["window"] = o.window;
+      jo["warm_start"] = o.warm_start;
+    } else if (o.type == "luenberger") {
+      jo["gain"] = matrix_json(o.gain);
+    } else if (o.type == "sliding_mode") {
+      jo["Q"] = matrix_json(o.q);
+      jo["R"] = matrix_json(o.r);
+      jo["gamma"] = o.gamma;
+    } else if (o.type == "ekf") {
+      if (o.process_covariance.size()) jo["process_covariance"] = matrix_json(o.process_covariance);
+      if (o.measurement_covariance.size()) {
+        jo["measurement_covariance"] = matrix_json(o.measurement_covariance);
+      }
+      if (o.initial_covariance.size()) jo["initial_covariance"] = matrix_json(o.initial_covariance);
+    }
+    if (o.initial) jo["initial"] = vector_json(*o.initial);
+    observers.push_back(jo);
+  }
+  j["observers"] = observers;
+  if (!s.reported.empty()) j["reported"] = s.reported;
+  return j;
+}
+
+AnyModel scenario_model(const Scenario& s) {
+  JsonReader m(s.model, s.name + ".model");
+  return make_model(m);
+}
+
+Eigen::VectorXd scenario_input(const Scenario& s, const AnyModel& model, long k) {
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(model.inputs());
+  if (u.size() == 0 || s.input.kind == "zero") return u;
+  // Inputs are held over a sample.
+  const double t = static_cast<double>(k) * model.sample_time();
+  u.setConstant(s.input.kind == "constant" ? s.input.value
+                                           : s.input.amplitude * std::sin(s.input.frequency * t));
+  return u;
+}
+
+std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& s, const AnyModel& model,
+                                                      bool trace_first_window) {
+  std::vector<std::unique_ptr<Observer>> out;
+  for (size_t i = 0; i < s.observers.size(); ++i) {
+    const ObserverSpec& o = s.observers[i];
+    const std::string where = s.name + ".observers[" + std::to_string(i) + "]";
+    const Eigen::VectorXd start = o.initial.value_or(s.initial_guess);
+    try {
+      if (o.type == "window") {
+        SolverOptions options;
+        if (o.tol) {
+          options.stop.step_tolerance = *o.tol;
+          options.stop.residual_tolerance = *o.tol;
+        }
+        auto& registry = EngineRegistry<Dynamic>::global();
+        auto estimator = std::make_unique<WindowEstimator<AnyModel>>(
+            model, registry.create(o.engine, options), o.engine, start,
+            WindowEstimatorOptions{o.window, o.warm_start == "previous" ? WarmStart::kPrevious
+                                                                        : WarmStart::kPropagated});
+        if (trace_first_window) {
+          options.record_trace = true;
+          estimator->set_first_window_engine(registry.create(o.engine, options));
+        }
+        out.push_back(std::move(estimator));
+      } else if (o.type == "luenberger") {
+        out.push_back(std::make_unique<LuenbergerObserver<AnyModel>>(model, o.gain, start));
+      } else if (o.type == "sliding_mode") {
+        out.push_back(
+            std::make_unique<SlidingModeObserver<AnyModel>>(model, o.q, o.r, o.gamma, start));
+      } else {
+        out.push_back(std::make_unique<ExtendedKalmanFilter<AnyModel>>(
+            model, start,
+            EkfOptions{o.process_covariance, o.measurement_covariance, o.initial_covariance}));
+      }
+    } catch (const InvalidInput& e) {
+      throw std::invalid_argument(where + ": " + e.what());
+    }
+  }
+  return out;
+}
+
+}  // namespace nlobs::cli

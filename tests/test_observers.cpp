@@ -1,0 +1,324 @@
+// Observer layer: models, output window, window estimators, baselines, harness.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "nlobs/models/modified_chua.hpp"
+#include "nlobs/models/odeint_discretization.hpp"
+#include "nlobs/models/systems.hpp"
+#include "nlobs/observers/any_model.hpp"
+#include "nlobs/observers/baselines.hpp"
+#include "nlobs/observers/simulation.hpp"
+#include "nlobs/observers/window_estimator.hpp"
+#include "nlobs/solvers/engine_registry.hpp"
+
+namespace nlobs {
+namespace {
+
+using Chua = Discretized<ModifiedChua>;
+const Eigen::Vector3d kTrue(1.0, 2.1428, -0.1648);
+const Eigen::Vector3d kGuess(5.0, 10.0, -5.0);
+
+Measurements chua_data(long steps, double noise = 0.0) {
+  SimulationOptions o;
+  o.steps = steps;
+  o.noise_std = noise;
+  o.sample_time = 0.05;
+  return simulate(paper_modified_chua(), kTrue, o);
+}
+
+// A linear discrete model x⁺ = A x + B u, y = C x, for baselines with known behaviour.
+struct Linear2 : ModelSizes<2, 1, 1> {
+  Eigen::Matrix2d a{{0.9, 0.2}, {-0.1, 0.8}};
+  Eigen::Vector2d b{0.0, 1.0};
+  template <typename T>
+  State<T> f(const State<T>& x, const Input& u, long) const {
+    return a.cast<T>() * x + (b * u[0]).cast<T>();
+  }
+  template <typename T>
+  Output<T> h(const State<T>& x) const {
+    return Output<T>(x[0]);
+  }
+};
+
+TEST(Models, DiscretisationsConverge) {
+  // Harmonic oscillator over one period: RK4 error O(h^4), Euler O(h).
+  const OscillatorNonlinearOutput osc;
+  for (double h : {0.1, 0.05}) {
+    const Discretized<OscillatorNonlinearOutput> euler(osc, h, Scheme::kEuler),
+        rk4(osc, h, Scheme::kRk4);
+    Eigen::Vector2d xe(1.0, 0.0), xr(1.0, 0.0);
+    const long steps = std::lround(2.0 * M_PI / h);
+    for (long k = 0; k < steps; ++k) {
+      xe = euler.f(xe, {}, k);
+      xr = rk4.f(xr, {}, k);
+    }
+    const double t = static_cast<double>(steps) * h;
+    const Eigen::Vector2d exact(std::cos(t), -std::sin(t));
+    EXPECT_LT((xr - exact).norm(), 1e-4) << h;
+    EXPECT_GT((xe - exact).norm(), 100 * (xr - exact).norm()) << h;
+  }
+  EXPECT_THROW(Discretized<Duffing>(Duffing{}, 0.0), std::invalid_argument);
+}
+
+TEST(Models, OdeintAdaptiveIntegrationIsAccurate) {
+  // One period of the oscillator in 10 samples: dopri5 with tight tolerances is exact to
+  // ~1e-9, where RK4 with the same sample step is off by ~1e-4.
+  const double h = 2.0 * M_PI / 10.0;
+  const OdeintDiscretized<OscillatorNonlinearOutput> adaptive(OscillatorNonlinearOutput{}, h);
+  const Discretized<OscillatorNonlinearOutput> rk4(OscillatorNonlinearOutput{}, h, Scheme::kRk4);
+  Eigen::Vector2d xa(1.0, 0.0), xr(1.0, 0.0);
+  for (long k = 0; k < 10; ++k) {
+    xa = adaptive.f(xa, {}, k);
+    xr = rk4.f(xr, {}, k);
+  }
+  EXPECT_LT((xa - Eigen::Vector2d(1.0, 0.0)).norm(), 1e-8);
+  EXPECT_GT((xr - Eigen::Vector2d(1.0, 0.0)).norm(), 1e-4);
+  // Time-varying systems see the right t: the pendulum's friction c(t).
+  const OdeintDiscretized<PendulumTimeVaryingFriction> pend(PendulumTimeVaryingFriction{}, 0.01);
+  const Discretized<PendulumTimeVaryingFriction> pend_rk4(PendulumTimeVaryingFriction{}, 0.01,
+                                                          Scheme::kRk4);
+  Eigen::Vector2d pa(0.5, 0.0), pr(0.5, 0.0);
+  for (long k = 0; k < 300; ++k) {
+    pa = pend.f(pa, {}, k);
+    pr = pend_rk4.f(pr, {}, k);
+  }
+  EXPECT_LT((pa - pr).norm(), 1e-7);
+  EXPECT_THROW(OdeintDiscretized<Duffing>(Duffing{}, -1.0), std::invalid_argument);
+}
+
+TEST(Models, LanderLeavesItsDomainWithAClearMessage) {
+  LunarLander lander;
+  const Discretized<LunarLander> model(lander, 0.01, Scheme::kRk4);
+  SimulationOptions o;
+  o.steps = 100000;
+  o.sample_time = 0.01;
+  o.input = [](long) { return Eigen::VectorXd::Constant(1, 1.0); };
+  const Measurements m = simulate(model, Eigen::Vector3d(-700.0, 0.0, 1500.0), o);
+  EXPECT_LT(m.steps(), 100000);
+  EXPECT_NE(m.stop_message.find("mass x3"), std::string::npos) << m.stop_message;
+  EXPECT_NE(m.stop_message.find("leaves its domain"), std::string::npos);
+  EXPECT_GT(m.x.row(2).minCoeff(), 0.0);  // every recorded state is inside the domain
+}
+
+TEST(Models, SystemsMatchTheirEquations) {
+  const Eigen::Vector3d x(0.3, -0.7, 1.1);
+  const Eigen::Vector3d dl = Lorenz{}.vector_field(x, {}, 0.0);
+  EXPECT_NEAR(dl[0], 10.0 * (-0.7 - 0.3), 1e-14);
+  EXPECT_NEAR(dl[1], 0.3 * (28.0 - 1.1) + 0.7, 1e-14);
+  EXPECT_NEAR(dl[2], 0.3 * -0.7 - 8.0 / 3.0 * 1.1, 1e-14);
+  const Eigen::Vector3d dc = ChaoticNoLinear{}.vector_field(x, {}, 0.0);
+  EXPECT_NEAR(dc[0], std::log(0.1 + std::exp(-1.0)), 1e-14);
+  EXPECT_EQ(ChaoticNoLinear{}.h(x), Eigen::Vector2d(0.3, -0.7));
+  const Eigen::Vector4d xr(0.1, 0.2, 0.3, 0.4);
+  const Eigen::Vector4d dr =
+      FlexibleJointRobot{}.vector_field(xr, Eigen::Matrix<double, 1, 1>(0.5), 0.0);
+  EXPECT_NEAR(dr[1], -48.6 * 0.1 - 1.25 * 0.2 + 48.6 * 0.3 + 21.6 * 0.5, 1e-12);
+  EXPECT_NEAR(dr[3], 19.5 * 0.1 - 19.5 * 0.3 - 3.33 * std::sin(0.3), 1e-12);
+  EXPECT_NEAR(OscillatorNonlinearOutput{}.h(Eigen::Vector2d(0.5, 3.0))[0], 0.75, 1e-15);
+}
+
+TEST(OutputWindow, RingBufferAndMap) {
+  OutputWindow<Chua> w(paper_modified_chua(), 4);
+  EXPECT_THROW(OutputWindow<Chua>(paper_modified_chua(), 2), InvalidInput);  // N·p < n
+  const Measurements m = chua_data(10);
+  for (long k = 0; k < 7; ++k) w.push(k, m.y.col(k), Eigen::VectorXd(0));
+  EXPECT_TRUE(w.full());
+  EXPECT_EQ(w.first_index(), 3);
+  for (int j = 0; j < 4; ++j) EXPECT_EQ(w.outputs()[j], m.y(0, 3 + j));  // oldest first
+  // H of the true state at the window's first sample reproduces Y.
+  const Eigen::Vector3d x3 = m.x.col(3);
+  EXPECT_LT((w.map(x3) - w.outputs()).lpNorm<Eigen::Infinity>(), 1e-14);
+  EXPECT_LT((w.propagate(x3, 3) - m.x.col(6)).lpNorm<Eigen::Infinity>(), 1e-14);
+  EXPECT_THROW(w.push(9, m.y.col(9), Eigen::VectorXd(0)), InvalidInput);  // not consecutive
+  EXPECT_THROW(w.push(7, Eigen::VectorXd::Constant(1, NAN), Eigen::VectorXd(0)), InvalidInput);
+  EXPECT_THROW(w.push(7, Eigen::VectorXd::Zero(2), Eigen::VectorXd(0)), InvalidInput);
+}
+
+std::unique_ptr<Observer> window_estimator(const std::string& spec, double tol, long window = 0,
+                                           WarmStart warm = WarmStart::kPropagated) {
+  SolverOptions o;
+  o.stop.step_tolerance = tol;
+  o.stop.residual_tolerance = tol;
+  return std::make_unique<WindowEstimator<Chua>>(paper_modified_chua(),
+                                                 EngineRegistry<3>::global().create(spec, o), spec,
+                                                 kGuess, WindowEstimatorOptions{window, warm});
+}
+
+TEST(WindowEstimator, NoiseFreeRecoveryByEveryEngine) {
+  const Measurements data = chua_data(120);
+  std::vector<std::unique_ptr<Observer>> observers;
+  for (const char* e :
+       {"picard", "aitken", "steffensen", "anderson", "newton", "ceres", "nlopt:LD_SLSQP"}) {
+    observers.push_back(window_estimator(e, 1e-10));
+  }
+  observers.push_back(window_estimator("ceres", 1e-10, 6));
+  auto result = run_observers(data, observers);
+  for (size_t i = 0; i < observers.size(); ++i) {
+    const long from = observers[i]->window() - 1;
+    const Eigen::MatrixXd err = (result.estimates[i] - data.x).rightCols(data.steps() - from);
+    EXPECT_LT(err.cwiseAbs().maxCoeff(), 1e-6) << observers[i]->name();
+  }
+}
+
+TEST(WindowEstimator, NotReadyThenCoastsThenSolves) {
+  auto est = window_estimator("newton", 1e-10);
+  const Measurements data = chua_data(5);
+  const Chua model = paper_modified_chua();
+  Eigen::Vector3d coast = kGuess;
+  for (long k = 0; k < 3; ++k) {
+    const ObserverStep& s = est->step(k, data.y.col(k), Eigen::VectorXd(0));
+    if (k < 2) {
+      EXPECT_FALSE(s.ready);
+      EXPECT_FALSE(s.summary.has_value());
+      EXPECT_LT((s.estimate - coast).norm(), 1e-15);  // the initial guess carried through f
+      coast = model.f(coast, {}, k);
+    } else {
+      EXPECT_TRUE(s.ready);
+      ASSERT_TRUE(s.summary.has_value());
+      EXPECT_TRUE(s.summary->converged());
+      EXPECT_LT((s.estimate - data.x.col(2)).norm(), 1e-8);
+    }
+  }
+}
+
+TEST(WindowEstimator, MissingMeasurementSkipsAndRecovers) {
+  Measurements data = chua_data(30);
+  data.y(0, 10) = NAN;
+  std::vector<std::unique_ptr<Observer>> observers;
+  observers.push_back(window_estimator("steffensen", 1e-10));
+  const auto r = run_observers(data, observers);
+  EXPECT_EQ(r.metrics[0].failures.at("missing_measurement"), 1);
+  // Three samples after the gap (11, 12, 13) the window is full again and exact.
+  EXPECT_LT((r.estimates[0].col(13) - data.x.col(13)).norm(), 1e-8);
+  EXPECT_LT((r.estimates[0].col(29) - data.x.col(29)).norm(), 1e-8);
+  EXPECT_TRUE(r.estimates[0].allFinite());
+}
+
+TEST(WindowEstimator, SquareEnginesRefuseLongWindows) {
+  SolverOptions o;
+  try {
+    WindowEstimator<Chua> e(paper_modified_chua(), EngineRegistry<3>::global().create("picard"),
+                            "picard", kGuess, {6});
+    FAIL();
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("use ceres or nlopt"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(
+      WindowEstimator<Chua>(paper_modified_chua(), EngineRegistry<3>::global().create("newton"),
+                            "newton", Eigen::Vector3d(NAN, 0, 0)),
+      InvalidInput);
+}
+
+TEST(WindowEstimator, PropagatedWarmStartNeedsFewerIterations) {
+  const Measurements data = chua_data(200);
+  std::vector<std::unique_ptr<Observer>> observers;
+  observers.push_back(window_estimator("picard", 1e-5, 0, WarmStart::kPrevious));
+  observers.push_back(window_estimator("picard", 1e-5, 0, WarmStart::kPropagated));
+  const auto r = run_observers(data, observers);
+  EXPECT_LT(r.metrics[1].iterations_mean * 10, r.metrics[0].iterations_mean);
+}
+
+TEST(WindowEstimator, LongWindowAttenuatesNoiseInX3) {
+  // METHODS §1: with N = n = 3 noise is amplified ~37× in x3; least squares on N = 6 cures it.
+  const Measurements data = chua_data(400, 0.01);
+  std::vector<std::unique_ptr<Observer>> observers;
+  observers.push_back(window_estimator("newton", 1e-10));
+  observers.push_back(window_estimator("ceres", 1e-10, 6));
+  const auto r = run_observers(data, observers);
+  EXPECT_LT(10 * r.metrics[1].mse_after_window[2], r.metrics[0].mse_after_window[2]);
+}
+
+TEST(Baselines, LuenbergerErrorFollowsALC) {
+  // Linear model: e⁺ = (A − L C) e exactly.
+  const Linear2 model;
+  const Eigen::Vector2d gain(0.5, 0.3);
+  const Eigen::Vector2d x0(1.0, -1.0), guess(0.0, 0.0);
+  LuenbergerObserver<Linear2> obs(model, gain, guess);
+  Eigen::Matrix2d alc = model.a;
+  alc.col(0) -= gain;
+  Eigen::Vector2d x = x0, e = x0 - guess;
+  for (long k = 0; k < 20; ++k) {
+    const Eigen::VectorXd u = Eigen::VectorXd::Constant(1, std::sin(0.3 * static_cast<double>(k)));
+    const ObserverStep& s = obs.step(k, model.h(x), u);
+    EXPECT_LT((x - s.estimate - e).norm(), 1e-12) << k;
+    e = alc * e;
+    x = model.f(x, Linear2::Input(u), k);
+  }
+  EXPECT_THROW(LuenbergerObserver<Linear2>(model, Eigen::Vector3d::Ones(), guess), InvalidInput);
+}
+
+TEST(Baselines, EkfOnALinearSystemIsTheKalmanFilter) {
+  // Noise-free linear system: the EKF converges to the state; with an exact initial state it
+  // stays exact.
+  const Linear2 model;
+  ExtendedKalmanFilter<Linear2> ekf(
+      model, Eigen::Vector2d(0.0, 0.0),
+      {Eigen::Matrix2d::Identity() * 1e-8, Eigen::Matrix<double, 1, 1>(1e-6),
+       Eigen::Matrix2d::Identity()});
+  Eigen::Vector2d x(1.0, -1.0);
+  double last = 0.0;
+  for (long k = 0; k < 60; ++k) {
+    const Eigen::VectorXd u = Eigen::VectorXd::Constant(1, 0.1);
+    last = (ekf.step(k, model.h(x), u).estimate - x).norm();
+    x = model.f(x, Linear2::Input(u), k);
+  }
+  EXPECT_LT(last, 1e-6);
+  EXPECT_THROW(ExtendedKalmanFilter<Linear2>(model, Eigen::Vector2d::Zero(),
+                                             {-Eigen::Matrix2d::Identity(), {}, {}}),
+               InvalidInput);
+}
+
+TEST(Baselines, SlidingModeSaturates) {
+  const Linear2 model;
+  const Eigen::Vector2d q(0.0, 0.0), r(1.0, 0.0);
+  SlidingModeObserver<Linear2> smo(model, q, r, 0.5, Eigen::Vector2d(0.0, 0.0));
+  // y − ŷ = 10 ≫ γ: the correction is R · sat(20) = R.
+  smo.step(0, Eigen::VectorXd::Constant(1, 10.0), Eigen::VectorXd::Zero(1));
+  const ObserverStep& s = smo.step(1, Eigen::VectorXd::Constant(1, 0.0), Eigen::VectorXd::Zero(1));
+  EXPECT_NEAR(s.estimate[0], 1.0, 1e-15);
+  EXPECT_THROW(SlidingModeObserver<Linear2>(model, q, r, 0.0, Eigen::Vector2d::Zero()),
+               InvalidInput);
+}
+
+TEST(Harness, MseOnAHandCheckableCase) {
+  Eigen::MatrixXd truth(2, 4), estimate(2, 4);
+  truth << 0, 0, 0, 0, 1, 1, 1, 1;
+  estimate << 1, 1, 0, 0, 1, 3, 1, 1;
+  const Eigen::VectorXd all = mean_squared_error(truth, estimate);
+  EXPECT_DOUBLE_EQ(all[0], 0.5);  // (1 + 1) / 4
+  EXPECT_DOUBLE_EQ(all[1], 1.0);  // 4 / 4
+  const Eigen::VectorXd after = mean_squared_error(truth, estimate, 2);
+  EXPECT_DOUBLE_EQ(after[0], 0.0);
+  EXPECT_DOUBLE_EQ(after[1], 0.0);
+}
+
+TEST(Harness, SeededNoiseIsReproducible) {
+  const Measurements a = chua_data(50, 0.1), b = chua_data(50, 0.1);
+  EXPECT_EQ(a.y, b.y);
+  EXPECT_EQ(a.x, b.x);
+  const Eigen::VectorXd noise = (a.y - chua_data(50).y).row(0).transpose();
+  EXPECT_NEAR(std::sqrt(noise.squaredNorm() / 50.0), 0.1, 0.03);
+  SimulationOptions bad;
+  bad.noise_std = -1.0;
+  EXPECT_THROW(simulate(paper_modified_chua(), kTrue, bad), InvalidInput);
+}
+
+TEST(AnyModel, MatchesTheStaticModelIncludingJacobians) {
+  const AnyModel any("modified-chua", paper_modified_chua(), 0.05);
+  const Chua model = paper_modified_chua();
+  const Eigen::VectorXd x = kTrue;
+  EXPECT_EQ(any.states(), 3);
+  EXPECT_EQ(any.sample_time(), 0.05);
+  EXPECT_LT((any.f(x, Eigen::VectorXd(0), 3) - model.f(kTrue, {}, 3)).norm(), 1e-15);
+  // A window estimator over the run-time model recovers the state too.
+  std::vector<std::unique_ptr<Observer>> observers;
+  observers.push_back(std::make_unique<WindowEstimator<AnyModel>>(
+      any, EngineRegistry<Dynamic>::global().create("newton:tol=1e-12"), "newton", kGuess));
+  const Measurements data = chua_data(20);
+  const auto r = run_observers(data, observers);
+  EXPECT_LT((r.estimates[0].col(19) - data.x.col(19)).norm(), 1e-8);
+}
+
+}  // namespace
+}  // namespace nlobs
