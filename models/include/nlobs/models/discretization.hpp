@@ -12,8 +12,10 @@ namespace nlobs {
 
 enum class Scheme { kEuler, kRk4 };
 
+// What every discretisation of a continuous model shares: the model, the sample step h
+// (t_k = k h), sizes, the output map and the domain.
 template <ContinuousModel Model>
-class Discretized {
+class SampledModel {
  public:
   static constexpr int kStates = Model::kStates;
   static constexpr int kInputs = Model::kInputs;
@@ -22,33 +24,11 @@ class Discretized {
   using State = ModelVector<T, kStates>;
   using Input = ModelVector<double, kInputs>;
 
-  // Throws std::invalid_argument when the step is not finite and > 0.
-  Discretized(Model model, double step, Scheme scheme = Scheme::kEuler)
-      : model_(std::move(model)), step_(step), scheme_(scheme) {
-    if (!(step_ > 0.0) || !std::isfinite(step_)) {
-      std::ostringstream os;
-      os << "discretisation step = " << step_ << " is invalid: must be finite and > 0";
-      throw std::invalid_argument(os.str());
-    }
-  }
-
   const Model& model() const { return model_; }
   double step() const { return step_; }
-  Scheme scheme() const { return scheme_; }
   Eigen::Index states() const { return model_.states(); }
   Eigen::Index inputs() const { return model_.inputs(); }
   Eigen::Index outputs() const { return model_.outputs(); }
-
-  template <typename T>
-  State<T> f(const State<T>& x, const Input& u, long k) const {
-    const double t = static_cast<double>(k) * step_, h = step_;
-    if (scheme_ == Scheme::kEuler) return x + h * model_.vector_field(x, u, t);
-    const State<T> k1 = model_.vector_field(x, u, t);
-    const State<T> k2 = model_.vector_field(State<T>(x + (h / 2) * k1), u, t + h / 2);
-    const State<T> k3 = model_.vector_field(State<T>(x + (h / 2) * k2), u, t + h / 2);
-    const State<T> k4 = model_.vector_field(State<T>(x + h * k3), u, t + h);
-    return x + (h / 6) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-  }
 
   template <typename T>
   auto h(const State<T>& x) const {
@@ -59,9 +39,44 @@ class Discretized {
     return domain_violation_of(model_, x);
   }
 
- private:
+ protected:
+  // Throws std::invalid_argument when the step is not finite and > 0.
+  SampledModel(Model model, double step) : model_(std::move(model)), step_(step) {
+    if (!(step_ > 0.0) || !std::isfinite(step_)) {
+      std::ostringstream os;
+      os << "discretisation step = " << step_ << " is invalid: must be finite and > 0";
+      throw std::invalid_argument(os.str());
+    }
+  }
   Model model_;
   double step_;
+};
+
+template <ContinuousModel Model>
+class Discretized : public SampledModel<Model> {
+ public:
+  using typename SampledModel<Model>::Input;
+  template <typename T>
+  using State = typename SampledModel<Model>::template State<T>;
+
+  Discretized(Model model, double step, Scheme scheme = Scheme::kEuler)
+      : SampledModel<Model>(std::move(model), step), scheme_(scheme) {}
+
+  Scheme scheme() const { return scheme_; }
+
+  template <typename T>
+  State<T> f(const State<T>& x, const Input& u, long k) const {
+    const Model& m = this->model_;
+    const double t = static_cast<double>(k) * this->step_, h = this->step_;
+    if (scheme_ == Scheme::kEuler) return x + h * m.vector_field(x, u, t);
+    const State<T> k1 = m.vector_field(x, u, t);
+    const State<T> k2 = m.vector_field(State<T>(x + (h / 2) * k1), u, t + h / 2);
+    const State<T> k3 = m.vector_field(State<T>(x + (h / 2) * k2), u, t + h / 2);
+    const State<T> k4 = m.vector_field(State<T>(x + h * k3), u, t + h);
+    return x + (h / 6) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+  }
+
+ private:
   Scheme scheme_;
 };
 

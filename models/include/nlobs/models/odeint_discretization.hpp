@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "nlobs/models/model.hpp"
+#include "nlobs/models/discretization.hpp"
 
 namespace nlobs {
 
@@ -19,32 +19,18 @@ struct OdeintOptions {
 };
 
 template <ContinuousModel Model>
-class OdeintDiscretized {
+class OdeintDiscretized : public SampledModel<Model> {
  public:
-  static constexpr int kStates = Model::kStates;
-  static constexpr int kInputs = Model::kInputs;
-  static constexpr int kOutputs = Model::kOutputs;
+  using typename SampledModel<Model>::Input;
   template <typename T>
-  using State = ModelVector<T, kStates>;
-  using Input = ModelVector<double, kInputs>;
+  using State = typename SampledModel<Model>::template State<T>;
 
   OdeintDiscretized(Model model, double step, OdeintOptions options = {})
-      : model_(std::move(model)), step_(step), options_(options) {
-    if (!(step_ > 0.0) || !std::isfinite(step_)) {
-      std::ostringstream os;
-      os << "discretisation step = " << step_ << " is invalid: must be finite and > 0";
-      throw std::invalid_argument(os.str());
-    }
+      : SampledModel<Model>(std::move(model), step), options_(options) {
     if (!(options_.absolute_tolerance > 0.0) || !(options_.relative_tolerance > 0.0)) {
       throw std::invalid_argument("OdeintOptions: tolerances must be > 0");
     }
   }
-
-  const Model& model() const { return model_; }
-  double step() const { return step_; }
-  Eigen::Index states() const { return model_.states(); }
-  Eigen::Index inputs() const { return model_.inputs(); }
-  Eigen::Index outputs() const { return model_.outputs(); }
 
   template <typename T>
   State<T> f(const State<T>& x, const Input& u, long k) const {
@@ -56,28 +42,17 @@ class OdeintDiscretized {
     const auto rhs = [this, &u](const Buffer& s, Buffer& ds, double t) {
       const State<double> xs =
           Eigen::Map<const State<double>>(s.data(), static_cast<Eigen::Index>(s.size()));
-      const State<double> d = model_.vector_field(xs, u, t);
+      const State<double> d = this->model_.vector_field(xs, u, t);
       ds.assign(d.data(), d.data() + d.size());
     };
-    const double t0 = static_cast<double>(k) * step_;
+    const double t0 = static_cast<double>(k) * this->step_;
     odeint::integrate_adaptive(odeint::make_controlled<odeint::runge_kutta_dopri5<Buffer>>(
                                    options_.absolute_tolerance, options_.relative_tolerance),
-                               rhs, state, t0, t0 + step_, step_ / 10.0);
+                               rhs, state, t0, t0 + this->step_, this->step_ / 10.0);
     return Eigen::Map<const State<double>>(state.data(), x.size());
   }
 
-  template <typename T>
-  auto h(const State<T>& x) const {
-    return model_.h(x);
-  }
-
-  std::string domain_violation(const State<double>& x) const {
-    return domain_violation_of(model_, x);
-  }
-
  private:
-  Model model_;
-  double step_;
   OdeintOptions options_;
 };
 
