@@ -54,12 +54,13 @@ class WindowEstimator final : public Observer {
       throw InvalidInput(os.str());
     }
     square_ = state_->window.rows() == n;
-    if (!square_) probe_least_squares();
     // Built once; they read the window, which never moves (it lives behind a unique_ptr).
-    fixed_point_ = std::make_unique<FixedPointProblem<N>>(
-        square_ ? square_window_problem(state_->window)
-                : FixedPointProblem<N>::from_map([](const State& w, State& g) { g = w; }, n));
-    root_ = std::make_unique<RootProblem<N, Dynamic>>(window_residual_problem(state_->window));
+    if (square_) {
+      fixed_point_ = std::make_unique<FixedPointProblem<N>>(square_window_problem(state_->window));
+    } else {
+      require_least_squares_engine();
+      root_ = std::make_unique<RootProblem<N, Dynamic>>(window_residual_problem(state_->window));
+    }
     reset();
   }
 
@@ -133,7 +134,7 @@ class WindowEstimator final : public Observer {
     return (n + p - 1) / p;  // the square window when p divides n
   }
 
-  void probe_least_squares() const {
+  void require_least_squares_engine() const {
     if (engine_->least_squares()) return;
     std::ostringstream os;
     os << "a window of N = " << state_->window.length() << " samples gives "
