@@ -9,15 +9,7 @@
 namespace nlobs {
 namespace {
 
-template <typename F>
-std::string message_of(F&& f) {
-  try {
-    f();
-  } catch (const InvalidInput& e) {
-    return e.what();
-  }
-  return "<no exception>";
-}
+using test::message_of;
 
 #define EXPECT_INVALID(expr, fragment)                                   \
   EXPECT_NE(message_of([&] { expr; }).find(fragment), std::string::npos) \

@@ -8,15 +8,7 @@
 namespace nlobs {
 namespace {
 
-template <typename F>
-std::string message_of(F&& f) {
-  try {
-    f();
-  } catch (const InvalidInput& e) {
-    return e.what();
-  }
-  return "<no exception>";
-}
+using test::message_of;
 
 TEST(EngineSpec, Parses) {
   const EngineSpec s = parse_engine_spec("nlopt:LN_BOBYQA,xtol_rel=1e-6");

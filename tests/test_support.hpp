@@ -2,6 +2,7 @@
 // Small problems with known answers, shared by the solver tests.
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "nlobs/solvers/solvers.hpp"
 
@@ -26,6 +27,17 @@ inline FixedPointProblem<3> diagonal_linear_problem(const Eigen::Vector3d& rates
   return FixedPointProblem<3>::with_jacobian(
       [rates, b](const Vector<3>& x, Vector<3>& g) { g = rates.cwiseProduct(x) + b; },
       [rates](const Vector<3>& /*x*/, Matrix<3, 3>& j) { j = rates.asDiagonal(); });
+}
+
+// The message of the InvalidInput that f throws, or "<no exception>".
+template <typename F>
+std::string message_of(F&& f) {
+  try {
+    f();
+  } catch (const InvalidInput& e) {
+    return e.what();
+  }
+  return "<no exception>";
 }
 
 inline SolverOptions tolerance(double step) {

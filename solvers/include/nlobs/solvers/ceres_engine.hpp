@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "nlobs/solvers/box_bounds.hpp"
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/residual_source.hpp"
 
@@ -67,19 +68,7 @@ class CeresEngine : public Engine<N> {
         fail("backend = kTinySolver is Levenberg-Marquardt only");
       }
     }
-    if (ceres_.lower_bounds.size() > 0 && ceres_.upper_bounds.size() > 0) {
-      if (ceres_.lower_bounds.size() != ceres_.upper_bounds.size()) {
-        fail("lower_bounds and upper_bounds differ in size");
-      }
-      for (Index i = 0; i < ceres_.lower_bounds.size(); ++i) {
-        if (!(ceres_.lower_bounds[i] <= ceres_.upper_bounds[i])) {
-          std::ostringstream os;
-          os << "lower_bounds[" << i << "] = " << ceres_.lower_bounds[i] << " > upper_bounds[" << i
-             << "] = " << ceres_.upper_bounds[i];
-          fail(os.str());
-        }
-      }
-    }
+    detail::validate_box("CeresOptions", ceres_.lower_bounds, ceres_.upper_bounds);
   }
 
   std::string_view name() const override { return "ceres"; }
@@ -135,33 +124,11 @@ class CeresEngine : public Engine<N> {
 
   template <int M>
   Summary run(const detail::ResidualSource<N, M>& source, Vector<N>& x) {
-    check_bounds(x);
+    detail::require_inside_box<N>("ceres", ceres_.lower_bounds, ceres_.upper_bounds, x);
     if constexpr (N != Dynamic) {
       if (uses_tiny_solver()) return run_tiny<M>(source, x);
     }
     return run_solver<M>(source, x);
-  }
-
-  void check_bounds(const Vector<N>& x) const {
-    auto check = [&](const Eigen::VectorXd& b, bool lower) {
-      if (b.size() == 0) return;
-      if (b.size() != x.size()) {
-        std::ostringstream os;
-        os << "ceres: " << (lower ? "lower" : "upper") << "_bounds has size " << b.size()
-           << ", the problem has dimension " << x.size();
-        throw InvalidInput(os.str());
-      }
-      for (Index i = 0; i < x.size(); ++i) {
-        if (lower ? x[i] < b[i] : x[i] > b[i]) {
-          std::ostringstream os;
-          os << "ceres: initial guess x0[" << i << "] = " << x[i] << " lies outside the box ("
-             << (lower ? "lower" : "upper") << " bound " << b[i] << ")";
-          throw InvalidInput(os.str());
-        }
-      }
-    };
-    check(ceres_.lower_bounds, true);
-    check(ceres_.upper_bounds, false);
   }
 
   // F (and ∂F when `jacobian` is non-null, column-major m×n) at x; false when non-finite

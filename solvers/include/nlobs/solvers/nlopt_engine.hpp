@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "nlobs/solvers/box_bounds.hpp"
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/objective_problem.hpp"
 #include "nlobs/solvers/residual_source.hpp"
@@ -54,17 +55,7 @@ class NloptEngine : public Engine<N> {
     algorithm_ = static_cast<nlopt_algorithm>(found - names.begin());
     const Eigen::VectorXd& lb = nlopt_.lower_bounds;
     const Eigen::VectorXd& ub = nlopt_.upper_bounds;
-    if (lb.size() > 0 && ub.size() > 0 && lb.size() != ub.size()) {
-      throw InvalidInput("NloptOptions: lower_bounds and upper_bounds differ in size");
-    }
-    for (Index i = 0; i < std::min(lb.size(), ub.size()); ++i) {
-      if (!(lb[i] <= ub[i])) {
-        std::ostringstream os;
-        os << "NloptOptions: lower_bounds[" << i << "] = " << lb[i] << " > upper_bounds[" << i
-           << "] = " << ub[i];
-        throw InvalidInput(os.str());
-      }
-    }
+    detail::validate_box("NloptOptions", lb, ub);
     if (is_global()) {
       const Index n = std::max(lb.size(), ub.size());
       if (lb.size() == 0 || ub.size() == 0 || !lb.allFinite() || !ub.allFinite() || n == 0) {
@@ -223,30 +214,8 @@ class NloptEngine : public Engine<N> {
     prepared_n_ = n;
   }
 
-  void check_box(const Vector<N>& x) const {
-    auto check = [&](const Eigen::VectorXd& b, bool lower) {
-      if (b.size() == 0) return;
-      if (b.size() != x.size()) {
-        std::ostringstream os;
-        os << "nlopt: " << (lower ? "lower" : "upper") << "_bounds has size " << b.size()
-           << ", the problem has dimension " << x.size();
-        throw InvalidInput(os.str());
-      }
-      for (Index i = 0; i < x.size(); ++i) {
-        if (lower ? x[i] < b[i] : x[i] > b[i]) {
-          std::ostringstream os;
-          os << "nlopt: initial guess x0[" << i << "] = " << x[i] << " lies outside the box ("
-             << (lower ? "lower" : "upper") << " bound " << b[i] << ")";
-          throw InvalidInput(os.str());
-        }
-      }
-    };
-    check(nlopt_.lower_bounds, true);
-    check(nlopt_.upper_bounds, false);
-  }
-
   Summary run(Vector<N>& x, double stop_value, ObjectiveThunk thunk, void* context) {
-    check_box(x);
+    detail::require_inside_box<N>("nlopt", nlopt_.lower_bounds, nlopt_.upper_bounds, x);
     const Index n = x.size();
     if (!opt_ || prepared_n_ != n) prepare(n);
     if constexpr (N == Dynamic) x_.resize(n), grad_.resize(n);
