@@ -35,10 +35,10 @@ sanitize: deps
 	cmake --build build-asan -j $(JOBS)
 	ctest --test-dir build-asan --output-on-failure -j $(JOBS)
 
-format:
+format: deps
 	find solvers observers models bench cli tests examples -name '*.hpp' -o -name '*.cpp' | xargs clang-format -i
 
-format-check:
+format-check: deps
 	find solvers observers models bench cli tests examples -name '*.hpp' -o -name '*.cpp' | xargs clang-format --dry-run --Werror
 
 clean:

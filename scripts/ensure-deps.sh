@@ -6,6 +6,7 @@ set -euo pipefail
 
 packages=(
   g++ make cmake pkg-config
+  clang-format         # the formatting check CI runs (make format-check)
   libeigen3-dev        # linear algebra, fixed-size vectors
   libceres-dev         # ceres::Jet forward-mode AD, least-squares engine (Ceres, TinySolver)
   libgoogle-glog-dev   # Ceres' logging; the CLI silences it
