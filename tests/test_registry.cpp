@@ -147,6 +147,11 @@ TEST(EngineRegistry, UsersRegisterTheirOwn) {
             }).find("already registered"),
             std::string::npos);
   EXPECT_THROW(registry.add({"bad:name", "", {}, {}, nullptr}), InvalidInput);
+  EXPECT_NE(message_of([&] {
+              registry.add({"nofactory", "", {}, {}, nullptr});
+            }).find("has no factory"),
+            std::string::npos);
+  EXPECT_FALSE(registry.contains("nofactory"));
 }
 
 }  // namespace

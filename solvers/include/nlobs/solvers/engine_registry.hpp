@@ -45,7 +45,7 @@ class EngineRegistry {
     return common;
   }
 
-  // Throws InvalidInput if the name is taken or empty.
+  // Throws InvalidInput if the name is empty, malformed or taken, or the factory is empty.
   void add(Entry entry) {
     std::lock_guard<std::mutex> lock(mutex_);
     if (entry.name.empty() || entry.name.find_first_of(":,=") != std::string::npos) {
@@ -54,7 +54,9 @@ class EngineRegistry {
     if (entries_.count(entry.name)) {
       throw InvalidInput("an engine named '" + entry.name + "' is already registered");
     }
-    entries_.emplace(entry.name, std::move(entry));
+    if (!entry.make) throw InvalidInput("engine '" + entry.name + "' has no factory");
+    const std::string name = entry.name;
+    entries_.emplace(name, std::move(entry));
   }
 
   bool contains(const std::string& name) const {
