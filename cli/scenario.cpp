@@ -91,11 +91,9 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
   Scenario s;
   s.name = r.required_text("name");
   if (!r.has("model")) r.fail("missing field 'model'");
-  {
-    auto m = r.object("model");
-    s.model = json.at("model");
-    make_model(*m);  // validates now, naming the key
-  }
+  auto model_spec = r.object("model");
+  s.model = json.at("model");
+  const AnyModel model = make_model(*model_spec);  // validates now, naming the key
   s.x0 = r.required_vector("x0");
   s.initial_guess = r.required_vector("initial_guess");
   if (auto v = r.integer("steps")) {
@@ -169,7 +167,6 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
   r.finish({"name", "model", "x0", "initial_guess", "steps", "noise", "seed", "input", "observers",
             "reported"});
   // Sizes against the model, now that everything parsed.
-  const AnyModel model = scenario_model(s);
   if (s.x0.size() != model.states() || s.initial_guess.size() != model.states()) {
     r.fail("'x0' and 'initial_guess' must have " + std::to_string(model.states()) +
            " entries (the model's states)");

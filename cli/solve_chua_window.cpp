@@ -1,10 +1,8 @@
 #include "solve_chua_window.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <functional>
 #include <memory>
 #include <ostream>
 #include <stdexcept>
@@ -12,6 +10,7 @@
 #include "nlobs/solvers/engine_registry.hpp"
 #include "reference/chua_window.hpp"
 #include "reference/kinsol_adapter.hpp"
+#include "reference/timing.hpp"
 
 namespace nlobs::cli {
 namespace {
@@ -22,22 +21,6 @@ KinsolStrategy strategy_of(const std::string& name) {
   if (name == "kinsol:fp") return KinsolStrategy::kFixedPoint;
   if (name == "kinsol:fp-aa2") return KinsolStrategy::kFixedPointAnderson;
   return KinsolStrategy::kNewtonLineSearch;
-}
-
-// Mean wall time of `solve_once` over batches totalling at least 20 ms (at least 3 calls).
-double time_per_solve(const std::function<void()>& solve_once) {
-  using Clock = std::chrono::steady_clock;
-  long calls = 0;
-  long batch = 1;
-  const auto start = Clock::now();
-  double elapsed_ns = 0.0;
-  while (elapsed_ns < 2e7 || calls < 3) {
-    for (long i = 0; i < batch; ++i) solve_once();
-    calls += batch;
-    batch *= 2;
-    elapsed_ns = std::chrono::duration<double, std::nano>(Clock::now() - start).count();
-  }
-  return elapsed_ns / static_cast<double>(calls);
 }
 
 std::string kinsol_status(const reference::KinsolResult& r) {
@@ -62,10 +45,13 @@ SolveRow run_engine(const std::string& name, const reference::ChuaWindowCase& c,
                x,
                (x - c.true_state).lpNorm<Eigen::Infinity>(),
                0.0};
-  row.ns_per_solve = time_per_solve([&] {
-    Vector<3> xr = c.initial_guess;
-    engine->solve(c.problem, xr);
-  });
+  // At least 3 solves and 20 ms in total.
+  row.ns_per_solve = reference::mean_ns_per_call(
+      [&] {
+        Vector<3> xr = c.initial_guess;
+        engine->solve(c.problem, xr);
+      },
+      2e7, 3);
   return row;
 }
 
@@ -84,10 +70,12 @@ SolveRow run_kinsol(const std::string& name, const reference::ChuaWindowCase& c,
                (x - c.true_state).lpNorm<Eigen::Infinity>(),
                0.0};
   Eigen::VectorXd xr(3);
-  row.ns_per_solve = time_per_solve([&] {
-    xr = c.initial_guess;
-    solver->solve(xr);
-  });
+  row.ns_per_solve = reference::mean_ns_per_call(
+      [&] {
+        xr = c.initial_guess;
+        solver->solve(xr);
+      },
+      2e7, 3);
   return row;
 }
 

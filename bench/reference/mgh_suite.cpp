@@ -1,7 +1,6 @@
 #include "reference/mgh_suite.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -11,6 +10,7 @@
 #include "reference/kinsol_solver.hpp"
 #include "reference/mgh_problems.hpp"
 #include "reference/root_reference.hpp"
+#include "reference/timing.hpp"
 
 namespace nlobs::reference {
 namespace {
@@ -20,21 +20,10 @@ struct Outcome {
   long f_evals = 0, j_evals = 0;
 };
 
-// Mean wall time of `solve` (which restarts from the initial guess each call): once, then
-// repeated up to ~2 ms in total for quick solves.
-template <typename Solve>
-double time_per_solve(Solve&& solve) {
-  using Clock = std::chrono::steady_clock;
-  auto t0 = Clock::now();
-  solve();
-  double first = std::chrono::duration<double, std::nano>(Clock::now() - t0).count();
-  if (first >= 1e6) return first;
-  const long repeats = std::min<long>(200, static_cast<long>(2e6 / std::max(first, 1.0)));
-  t0 = Clock::now();
-  for (long i = 0; i < repeats; ++i) solve();
-  return std::chrono::duration<double, std::nano>(Clock::now() - t0).count() /
-         static_cast<double>(std::max<long>(repeats, 1));
-}
+// Each (pair, solver) is timed over ~1 ms of repeated solves, at most 201 of them: the whole
+// suite stays a few seconds.
+constexpr double kTimingNs = 1e6;
+constexpr long kMaxTimedCalls = 201;
 
 bool is_reference(const std::string& s) {
   const auto refs = reference_suite_solvers();
@@ -140,20 +129,24 @@ std::vector<SuiteRow> run_mgh_suite(const std::vector<std::string>& solvers,
         Eigen::VectorXd x = x0;
         Outcome outcome;
         if (is_reference(s)) {
-          row.ns = time_per_solve([&] {
-            x = x0;
-            outcome = run_reference(s, c, x, budget);
-          });
+          row.ns = mean_ns_per_call(
+              [&] {
+                x = x0;
+                outcome = run_reference(s, c, x, budget);
+              },
+              kTimingNs, 1, kMaxTimedCalls);
         } else {
           SolverOptions o = base;
           o.stop.max_evaluations = static_cast<int>(budget);
           auto engine = registry.create(s, o);
-          row.ns = time_per_solve([&] {
-            x = x0;
-            const Summary sum = solve_or_report(*engine, fixed_point, x);
-            outcome = {std::string(to_string(sum.status)), sum.function_evaluations,
-                       sum.jacobian_evaluations};
-          });
+          row.ns = mean_ns_per_call(
+              [&] {
+                x = x0;
+                const Summary sum = solve_or_report(*engine, fixed_point, x);
+                outcome = {std::string(to_string(sum.status)), sum.function_evaluations,
+                           sum.jacobian_evaluations};
+              },
+              kTimingNs, 1, kMaxTimedCalls);
         }
         Eigen::VectorXd f(c.n);
         c.problem.evaluate(x, f);
