@@ -250,6 +250,33 @@ TEST(WindowEstimator, MultiOutputWindowByLeastSquares) {
   EXPECT_LT((r.estimates[0].rightCols(49) - data.x.rightCols(49)).cwiseAbs().maxCoeff(), 1e-8);
 }
 
+// p = n: each sample determines the state alone (N = 1), so x̂[k] = w* with no propagation.
+struct FullOutput : ModelSizes<2, 0, 2> {
+  Duffing d;
+  template <typename T>
+  State<T> f(const State<T>& x, const Input&, long) const {
+    return x + 0.01 * d.vector_field(x, Input(), 0.0);
+  }
+  template <typename T>
+  Output<T> h(const State<T>& x) const {
+    return Output<T>(x[0] + 0.1 * x[1] * x[1], x[1]);
+  }
+};
+
+TEST(WindowEstimator, OneSampleWindowWhenTheOutputIsTheState) {
+  SimulationOptions o;
+  o.steps = 20;
+  const FullOutput model;
+  const Measurements data = simulate(model, Eigen::Vector2d(0.5, 0.2), o);
+  std::vector<std::unique_ptr<Observer>> observers;
+  observers.push_back(std::make_unique<WindowEstimator<FullOutput>>(
+      model, EngineRegistry<2>::global().create("newton:tol=1e-13"), "newton",
+      Eigen::Vector2d(0.0, 0.0)));
+  EXPECT_EQ(observers[0]->window(), 1);
+  const auto r = run_observers(data, observers);
+  EXPECT_LT((r.estimates[0] - data.x).cwiseAbs().maxCoeff(), 1e-12);
+}
+
 TEST(Baselines, LuenbergerErrorFollowsALC) {
   // Linear model: e⁺ = (A − L C) e exactly.
   const Linear2 model;

@@ -116,12 +116,15 @@ class OutputWindow {
     return stacked_.template cast<T>() - map(w);
   }
 
-  // f^{steps}(w) along the window's inputs, from its first sample.
-  State<double> propagate(const State<double>& w, Eigen::Index steps) const {
-    State<double> x = w;
+  // f^{steps}(x0) along the window's inputs, x0 being the state at window position `from`
+  // (0 = the first sample).
+  State<double> propagate(const State<double>& x0, Eigen::Index steps,
+                          Eigen::Index from = 0) const {
+    State<double> x = x0;
     const long k0 = first_index();
-    for (Eigen::Index j = 0; j < steps; ++j)
+    for (Eigen::Index j = from; j < from + steps; ++j) {
       x = model_.f(x, Input(input(j)), k0 + static_cast<long>(j));
+    }
     return x;
   }
 

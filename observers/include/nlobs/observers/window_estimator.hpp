@@ -89,11 +89,6 @@ class WindowEstimator final : public Observer {
   const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
     const OutputWindow<Model>& window = state_->window;
     const Eigen::Index length = window.length();
-    // x̂[k] by the model from x̂[k−1]: the fallback whenever no window is solved.
-    if (k > 0) {
-      coast_ = window.model().f(coast_, typename OutputWindow<Model>::Input(last_u_), k - 1);
-    }
-    last_u_ = u;
     step_.summary.reset();
     step_.measurement_missing = !y.allFinite();
     if (step_.measurement_missing) {
@@ -103,20 +98,27 @@ class WindowEstimator final : public Observer {
       state_->window.push(k, y, u);
     }
     step_.ready = window.full();
+    bool solved = false;
     if (step_.ready) {
       // Guess for w = x̂[k−N+1]: warm start, or the estimate kept for that sample.
       State w = have_solution_ ? next_guess_ : history_[static_cast<size_t>((k + 1) % length)];
       Engine<N>& engine = (first_engine_ && !solved_once_) ? *first_engine_ : *engine_;
       solved_once_ = true;
-      const Summary s =
+      step_.summary =
           square_ ? engine.solve(*fixed_point_, w) : engine.solve_least_squares(*root_, w);
-      step_.summary = s;
-      if (usable(s.status) && w.allFinite()) {
-        have_solution_ = true;
-        next_guess_ = options_.warm_start == WarmStart::kPrevious ? w : window.propagate(w, 1);
-        coast_ = window.propagate(w, length - 1);  // x̂[k] = f^{N−1}(w*)
+      if (usable(step_.summary->status) && w.allFinite()) {
+        solved = have_solution_ = true;
+        const State w1 = window.propagate(w, 1);  // x̂[k−N+2]
+        next_guess_ = options_.warm_start == WarmStart::kPrevious ? w : w1;
+        // x̂[k] = f^{N−1}(w*): w* itself for a one-sample window.
+        coast_ = length == 1 ? w : window.propagate(w1, length - 2, 1);
       }
     }
+    // Otherwise x̂[k] comes from the model, f(x̂[k−1], u[k−1], k−1), from the guess at k = 0.
+    if (!solved && k > 0) {
+      coast_ = window.model().f(coast_, typename OutputWindow<Model>::Input(last_u_), k - 1);
+    }
+    last_u_ = u;
     history_[static_cast<size_t>(k % length)] = coast_;
     step_.estimate = coast_;
     return step_;
