@@ -5,6 +5,7 @@
 
 #include "model_catalog.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
+#include "pi_banks.hpp"
 #include "reference/mgh_suite.hpp"
 #include "scenario.hpp"
 #include "solve_chua_window.hpp"
@@ -35,7 +36,19 @@ void print_list(const std::string& what, std::ostream& out) {
         << "  luenberger — constant gain: gain (n x p)\n"
         << "  sliding_mode — Q, R (n x p), gamma (saturation boundary layer)\n"
         << "  ekf — extended Kalman filter, AD Jacobians: process_covariance, "
-           "measurement_covariance, initial_covariance\n";
+           "measurement_covariance, initial_covariance\n"
+        << "  (luenberger, sliding_mode, ekf also take 'model': their own design model)\n"
+        << "  pi_bank — model-free PI observers of seed 002: bank, gains ([k_p, k_i] per "
+           "channel), omega_bounds ({channel: N}), start (paper|zero), substeps, parameters\n";
+    for (const auto& b : pi_bank_catalog()) {
+      out << "      bank " << b.name << ": " << b.description << "; channels";
+      for (const auto& c : b.channels) out << ' ' << c;
+      if (!b.parameters.empty()) {
+        out << "; parameters";
+        for (const auto& p : b.parameters) out << ' ' << p;
+      }
+      out << '\n';
+    }
   }
   if (all || what == "scenarios") {
     out << "scenarios (nlobs run NAME, or a JSON file):\n";

@@ -52,6 +52,12 @@ const std::vector<ModelInfo>& model_catalog() {
       {"lander",
        "lunar lander, 1 input, y = x1, domain x3 > 0 (METHODS 3)",
        {"g=1.63", "sigma=50", "alpha=200"}},
+      {"lander-f",
+       "lunar lander with f = exp(c sin t) as state x4, y = x1, domain x3 > 0 (METHODS 3)",
+       {"g=1.63", "sigma=50", "alpha=200", "c=6"}},
+      {"unknown-input",
+       "x' = u + f, f = A sin(omega t) as state x2, y = x1 (METHODS 3, example 3)",
+       {"amplitude=3", "omega=pi"}},
       {"pendulum",
        "pendulum with time-varying friction, y = angle (METHODS 4)",
        {"g=9.81", "length=1", "c0=0.5", "c1=0.2", "omega_c=1", "a_max=0", "omega_a=2"}},
@@ -117,6 +123,18 @@ AnyModel make_model(JsonReader& spec) {
       LunarLander m;
       set(p, "g", m.p.g), set(p, "sigma", m.p.sigma), set(p, "alpha", m.p.alpha);
       p.finish({"g", "sigma", "alpha"});
+      return discretize(name, m, spec, 0.001, Scheme::kRk4);
+    }
+    if (name == "lander-f") {
+      LunarLanderImmersed m;
+      set(p, "g", m.p.g), set(p, "sigma", m.p.sigma), set(p, "alpha", m.p.alpha), set(p, "c", m.c);
+      p.finish({"g", "sigma", "alpha", "c"});
+      return discretize(name, m, spec, 0.001, Scheme::kRk4);
+    }
+    if (name == "unknown-input") {
+      UnknownInputIntegrator m;
+      set(p, "amplitude", m.amplitude), set(p, "omega", m.omega);
+      p.finish({"amplitude", "omega"});
       return discretize(name, m, spec, 0.001, Scheme::kRk4);
     }
     if (name == "pendulum") {

@@ -155,10 +155,45 @@ void print_table(const Scenario& s, const Measurements& data, const RunResult& r
   }
   out << "MSE: mean over states of (1/K) sum_k (x_i[k] - xhat_i[k])^2 (paper eq. 92); per-state "
          "values in summary.json.\n";
+  if (s.settle_time >= 0.0 && data.has_truth()) {
+    out << "largest |x_i - xhat_i| for t >= " << s.settle_time
+        << " s (the observed ultimate bound):\n";
+    for (const ObserverMetrics& m : r.metrics) {
+      std::snprintf(line, sizeof line, "  %-24s", m.name.c_str());
+      out << line;
+      for (Eigen::Index i = 0; i < m.max_error_after.size(); ++i) {
+        out << " x" << i + 1 << " " << fmt(m.max_error_after[i]);
+      }
+      out << '\n';
+    }
+  }
+  for (const ObserverMetrics& m : r.metrics) {
+    if (!m.first_failure.empty())
+      out << "first failure of " << m.name << ": " << m.first_failure << '\n';
+  }
+}
+
+void print_bounds(const nlohmann::json& bounds, std::ostream& out) {
+  if (bounds.empty()) return;
+  out << "PI ultimate bounds for |d eta/dt| <= N: paper delta (eq. 15, bounds ||E||) and ours "
+         "(bound |eta - eta_hat| and ||E||; docs/observers.md):\n";
+  for (const auto& b : bounds) {
+    out << "  " << b["observer"].get<std::string>() << " " << b["channel"].get<std::string>()
+        << " (k_p " << b["kp"].get<double>() << ", k_i " << b["ki"].get<double>() << "): ";
+    if (!b.contains("omega_bound")) {
+      out << "no N given\n";
+      continue;
+    }
+    const auto num = [](const nlohmann::json& v) { return v.is_null() ? NAN : v.get<double>(); };
+    out << "N " << fmt(num(b["omega_bound"])) << ", paper delta " << fmt(num(b["paper_delta"]))
+        << ", |e| <= " << fmt(num(b["eta_error_bound"]))
+        << ", ||E|| <= " << fmt(num(b["error_norm_bound"])) << '\n';
+  }
 }
 
 nlohmann::json summary_json(const Scenario& s, const Measurements& data, const RunResult& r,
-                            const std::string& source) {
+                            const std::string& source, const nlohmann::json& bounds,
+                            const std::vector<std::string>& warnings) {
   nlohmann::json observers = nlohmann::json::array();
   for (const ObserverMetrics& m : r.metrics) {
     nlohmann::json o{{"name", m.name},
@@ -172,13 +207,18 @@ nlohmann::json summary_json(const Scenario& s, const Measurements& data, const R
     if (data.has_truth()) {
       o["mse"] = vector_or_null(m.mse);
       o["mse_after_window"] = vector_or_null(m.mse_after_window);
+      o["max_error_after"] = vector_or_null(m.max_error_after);
     }
+    if (!m.first_failure.empty()) o["first_failure"] = m.first_failure;
     observers.push_back(o);
   }
   nlohmann::json j{{"scenario", s.name}, {"steps", data.steps()},  {"noise_std", s.noise},
                    {"seed", s.seed},     {"observers", observers}, {"settle_index", r.settle_index},
                    {"source", source}};
   if (!data.stop_message.empty()) j["stop_message"] = data.stop_message;
+  if (s.settle_time >= 0.0) j["settle_time"] = s.settle_time;
+  if (!bounds.empty()) j["pi_bounds"] = bounds;
+  if (!warnings.empty()) j["warnings"] = warnings;
   return j;
 }
 
@@ -193,6 +233,9 @@ std::string trajectories_csv(const Measurements& data, const RunResult& r) {
   for (const auto& m : r.metrics) {
     for (Eigen::Index i = 0; i < n; ++i) os << "," << m.name << ".x" << i + 1;
   }
+  for (size_t o = 0; o < r.extra_names.size(); ++o) {
+    for (const auto& e : r.extra_names[o]) os << "," << r.metrics[o].name << ".signal." << e;
+  }
   os << '\n';
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
     os << data.t[k];
@@ -201,6 +244,9 @@ std::string trajectories_csv(const Measurements& data, const RunResult& r) {
     }
     for (const auto& e : r.estimates) {
       for (Eigen::Index i = 0; i < n; ++i) os << ',' << e(i, k);
+    }
+    for (const auto& e : r.extras) {
+      for (Eigen::Index i = 0; i < e.rows(); ++i) os << ',' << e(i, k);
     }
     os << '\n';
   }
@@ -261,6 +307,22 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
     }
     g << "unset multiplot\nunset logscale y\n";
     written.push_back("errors.png");
+  }
+  // Further signals of observers that publish them (PI banks: η̂, η̂₁ per channel, ...).
+  long column = 2 + offset + observers * n;
+  for (size_t o = 0; o < r.extra_names.size(); ++o) {
+    const auto& names = r.extra_names[o];
+    if (names.empty()) continue;
+    const std::string file = "signals_" + std::to_string(o + 1) + ".png";
+    g << "set terminal pngcairo size 1200," << 250 * names.size() << "\nset output '"
+      << (dir / file).string() << "'\nset multiplot layout " << names.size() << ",1 title '"
+      << r.metrics[o].name << "'\n";
+    for (const auto& name : names) {
+      g << "set ylabel '" << name << "'\nplot 'trajectories.csv' using 1:" << column++
+        << " with lines notitle\n";
+    }
+    g << "unset multiplot\n";
+    written.push_back(file);
   }
   if (!traced.empty()) {
     g << "set datafile separator whitespace\nset terminal pngcairo size 1000,600\n"
@@ -323,10 +385,19 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
     throw std::invalid_argument(os.str());
   }
 
+  long settle_index = -1;
+  if (s.settle_time >= 0.0) {
+    const double T = model.sample_time() > 0 ? model.sample_time() : 1.0;
+    settle_index = static_cast<long>(std::ceil(s.settle_time / T - 1e-9));
+  }
+  std::vector<std::string> warnings;
+  const nlohmann::json bounds = pi_bounds_json(s, &warnings);
+  for (const auto& w : warnings) err << "nlobs: warning: " << w << '\n';
+
   const auto start = std::chrono::steady_clock::now();
   auto last = start;
   bool printed = false;
-  const RunResult r = run_observers(data, observers, -1, [&](long done, long total) {
+  const RunResult r = run_observers(data, observers, settle_index, [&](long done, long total) {
     const auto now = std::chrono::steady_clock::now();
     if (now - start < std::chrono::seconds(1) ||
         (now - last < std::chrono::milliseconds(250) && done < total)) {
@@ -340,6 +411,7 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
   if (printed) err << '\n';
 
   print_table(s, data, r, out);
+  print_bounds(bounds, out);
 
   if (!options.out_dir.empty()) {
     const fs::path dir(options.out_dir);
@@ -357,7 +429,8 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
       err << "nlobs: gnuplot not found: no PNG plots (apt-get install gnuplot-nox)\n";
     }
     // Last: summary.json marks a complete output directory.
-    write_atomically(dir / "summary.json", summary_json(s, data, r, source).dump(2) + "\n");
+    write_atomically(dir / "summary.json",
+                     summary_json(s, data, r, source, bounds, warnings).dump(2) + "\n");
     out << "wrote " << (dir / "summary.json").string() << ", trajectories.csv, scenario.json";
     for (const auto& p : plots) out << ", " << p;
     out << '\n';

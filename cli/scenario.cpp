@@ -7,6 +7,7 @@
 #include "json_reader.hpp"
 #include "model_catalog.hpp"
 #include "nlobs/observers/baselines.hpp"
+#include "nlobs/observers/pi_bound.hpp"
 #include "nlobs/observers/window_estimator.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 
@@ -60,15 +61,86 @@ const char* kChuaFp = R"({
   }
 })";
 
+// Seed 002, example 3 (METHODS §3): f = 3 sin(πt) immersed as state x2, u = 2 sin(πt),
+// gains (8, 15), γ(0) = 0. N = max|f'| = 3π. 10 s at the model's step 1 ms; after t = 2 s.
+// The EKF's own model assumes f constant (amplitude 0): it must track f through Q.
+const char* kPiLinear = R"({
+  "name": "pi-linear",
+  "model": {"name": "unknown-input", "scheme": "rk4", "step": 0.001},
+  "x0": [0.0, 0.0],
+  "initial_guess": [0.0, 0.0],
+  "steps": 10001,
+  "settle_time": 2.0,
+  "input": {"kind": "sin", "amplitude": 2.0, "frequency": 3.141592653589793},
+  "observers": [
+    {"type": "pi_bank", "bank": "unknown-input", "gains": [[8, 15]],
+     "omega_bounds": {"f": 9.42477796076938}},
+    {"type": "ekf", "model": {"name": "unknown-input", "parameters": {"amplitude": 0}, "step": 0.001},
+     "process_covariance": [[1e-10, 0], [0, 1e-4]], "measurement_covariance": [[1e-6]],
+     "initial_covariance": [[1, 0], [0, 100]]}
+  ]
+})";
+
+// Seed 002, example 4: the cubic Chua circuit, y = x2, x0 = (0.2, 0.2, 0.2), gains (25, 150),
+// γ(0) = 0, x̂1(0) = 0. N = 3.5 bounds |d(x1 + x3)/dt| on this run (measured max 3.20, see
+// docs/observers.md). 50 s at 1 ms; after t = 10 s. chua-x3 is our alternative reconstruction.
+const char* kPiChua = R"({
+  "name": "pi-chua",
+  "model": {"name": "cubic-chua", "scheme": "rk4", "step": 0.001},
+  "x0": [0.2, 0.2, 0.2],
+  "initial_guess": [0.0, 0.0, 0.0],
+  "steps": 50001,
+  "settle_time": 10.0,
+  "observers": [
+    {"type": "pi_bank", "bank": "chua", "gains": [[25, 150]], "omega_bounds": {"eta": 3.5}},
+    {"type": "pi_bank", "bank": "chua-x3", "gains": [[25, 150]], "omega_bounds": {"eta": 3.5}},
+    {"type": "ekf", "process_covariance": [[1e-8, 0, 0], [0, 1e-8, 0], [0, 0, 1e-8]],
+     "measurement_covariance": [[1e-6]], "initial_covariance": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}
+  ]
+})";
+
+// Seed 002, example 5: the lunar lander with f = exp(6 sin t) immersed as x4, u = 1,
+// x0 = (−700, 0, 1500), gains (6, 25) for x2 and (49, 700) for f, γ(0) = 0. Asked for 15 s at
+// 1 ms; the mass reaches zero near t = 13.05 s and the run stops there with the domain message.
+// N for f: max|d/dt exp(6 sin t)| = 588.2; x2' = g − σα/x3 is unbounded as x3 → 0, so no N.
+// The EKF's model assumes f constant (c = 0).
+const char* kPiLander = R"({
+  "name": "pi-lander",
+  "model": {"name": "lander-f", "scheme": "rk4", "step": 0.001},
+  "x0": [-700.0, 0.0, 1500.0, 1.0],
+  "initial_guess": [-700.0, 0.0, 1200.0, 0.0],
+  "steps": 15001,
+  "settle_time": 5.0,
+  "input": {"kind": "constant", "value": 1.0},
+  "observers": [
+    {"type": "pi_bank", "bank": "lander", "gains": [[6, 25], [49, 700]],
+     "omega_bounds": {"f": 588.2}},
+    {"type": "ekf", "model": {"name": "lander-f", "parameters": {"c": 0}, "step": 0.001},
+     "process_covariance": [[1e-10, 0, 0, 0], [0, 1e-8, 0, 0], [0, 0, 1e-4, 0], [0, 0, 0, 0.5]],
+     "measurement_covariance": [[1e-6]],
+     "initial_covariance": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1e5, 0], [0, 0, 0, 100]]}
+  ]
+})";
+
+const std::map<std::string, const char*>& builtin_texts() {
+  static const std::map<std::string, const char*> texts = {{"chua-fp", kChuaFp},
+                                                           {"pi-linear", kPiLinear},
+                                                           {"pi-chua", kPiChua},
+                                                           {"pi-lander", kPiLander}};
+  return texts;
+}
+
 }  // namespace
 
 std::vector<std::string> builtin_scenarios() {
-  return {"chua-fp"};
+  std::vector<std::string> names;
+  for (const auto& [name, text] : builtin_texts()) names.push_back(name);
+  return names;
 }
 
 Scenario load_scenario(const std::string& name_or_file) {
-  if (name_or_file == "chua-fp") {
-    return parse_scenario(nlohmann::json::parse(kChuaFp), "built-in scenario chua-fp");
+  if (auto it = builtin_texts().find(name_or_file); it != builtin_texts().end()) {
+    return parse_scenario(nlohmann::json::parse(it->second), "built-in scenario " + it->first);
   }
   std::ifstream in(name_or_file);
   if (!in) {
@@ -105,6 +177,10 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
     s.noise = *v;
   }
   if (auto v = r.integer("seed")) s.seed = static_cast<std::uint64_t>(*v);
+  if (auto v = r.number("settle_time")) {
+    if (!(*v >= 0.0)) r.fail("'settle_time' must be >= 0 (seconds)");
+    s.settle_time = *v;
+  }
   if (auto in = r.object("input")) {
     s.input.kind = in->text("kind").value_or("zero");
     if (s.input.kind != "zero" && s.input.kind != "constant" && s.input.kind != "sin") {
@@ -117,6 +193,17 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
   }
   for (JsonReader& o : r.objects("observers")) {
     ObserverSpec spec;
+    // An observer's own model: built now (errors name its keys), sizes checked against ours.
+    const auto read_design_model = [&](JsonReader& reader) {
+      auto design = reader.object("model");
+      if (!design) return;
+      const AnyModel own = make_model(*design);
+      if (own.states() != model.states() || own.outputs() != model.outputs() ||
+          own.inputs() != model.inputs() || own.sample_time() != model.sample_time()) {
+        reader.fail("'model' must have the scenario model's sizes and sample time");
+      }
+      spec.model = json.at("observers")[s.observers.size()].at("model");
+    };
     spec.type = o.required_text("type");
     if (spec.type == "window") {
       spec.engine = o.text("engine").value_or("newton");
@@ -128,28 +215,75 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
       }
       spec.initial = o.vector("initial");
       o.finish({"type", "engine", "tol", "window", "warm_start", "initial"});
+    } else if (spec.type == "pi_bank") {
+      spec.pi.bank = o.required_text("bank");
+      PiBankInfo info;
+      try {
+        info = pi_bank_info(spec.pi.bank);
+      } catch (const std::invalid_argument& e) {
+        o.fail(e.what());
+      }
+      const Eigen::MatrixXd gains = o.matrix("gains").value_or(Eigen::MatrixXd());
+      if (gains.cols() != 2 || gains.rows() != static_cast<Eigen::Index>(info.channels.size())) {
+        o.fail("'gains' must list [k_p, k_i] for each of the bank's " +
+               std::to_string(info.channels.size()) + " channel(s)");
+      }
+      for (Eigen::Index i = 0; i < gains.rows(); ++i) {
+        const PiGains g{gains(i, 0), gains(i, 1)};
+        try {
+          validate(g, "channel '" + info.channels[static_cast<size_t>(i)] + "'");
+        } catch (const InvalidInput& e) {
+          o.fail(std::string("gains: ") + e.what());
+        }
+        spec.pi.gains.push_back(g);
+      }
+      spec.pi.omega_bounds.assign(info.channels.size(), std::nullopt);
+      if (auto bounds = o.object("omega_bounds")) {
+        for (size_t i = 0; i < info.channels.size(); ++i) {
+          spec.pi.omega_bounds[i] = bounds->number(info.channels[i]);
+          if (spec.pi.omega_bounds[i] && !(*spec.pi.omega_bounds[i] >= 0.0)) {
+            bounds->fail("'" + info.channels[i] + "' must be >= 0");
+          }
+        }
+        bounds->finish(info.channels);
+      }
+      spec.pi.start = o.text("start").value_or("paper");
+      if (spec.pi.start != "paper" && spec.pi.start != "zero") {
+        o.fail("'start' must be paper (gamma(0) = 0) or zero (estimates start at 0)");
+      }
+      const long substeps = o.integer("substeps").value_or(1);
+      if (substeps < 1 || substeps > 1000) o.fail("'substeps' must be in 1..1000");
+      spec.pi.substeps = static_cast<int>(substeps);
+      if (o.has("parameters")) {
+        o.object("parameters");
+        spec.pi.parameters = json.at("observers")[s.observers.size()].at("parameters");
+      }
+      o.finish({"type", "bank", "gains", "omega_bounds", "start", "substeps", "parameters"});
     } else if (spec.type == "luenberger") {
       spec.gain = o.matrix("gain").value_or(Eigen::MatrixXd());
       if (spec.gain.size() == 0) o.fail("missing field 'gain'");
       spec.initial = o.vector("initial");
-      o.finish({"type", "gain", "initial"});
+      read_design_model(o);
+      o.finish({"type", "gain", "initial", "model"});
     } else if (spec.type == "sliding_mode") {
       spec.q = o.matrix("Q").value_or(Eigen::MatrixXd());
       spec.r = o.matrix("R").value_or(Eigen::MatrixXd());
       if (spec.q.size() == 0 || spec.r.size() == 0) o.fail("missing field 'Q' or 'R'");
       spec.gamma = o.required_number("gamma");
       spec.initial = o.vector("initial");
-      o.finish({"type", "Q", "R", "gamma", "initial"});
+      read_design_model(o);
+      o.finish({"type", "Q", "R", "gamma", "initial", "model"});
     } else if (spec.type == "ekf") {
       spec.process_covariance = o.matrix("process_covariance").value_or(Eigen::MatrixXd());
       spec.measurement_covariance = o.matrix("measurement_covariance").value_or(Eigen::MatrixXd());
       spec.initial_covariance = o.matrix("initial_covariance").value_or(Eigen::MatrixXd());
       spec.initial = o.vector("initial");
+      read_design_model(o);
       o.finish({"type", "process_covariance", "measurement_covariance", "initial_covariance",
-                "initial"});
+                "initial", "model"});
     } else {
       o.fail("unknown observer type '" + spec.type +
-             "'; valid: window, luenberger, sliding_mode, ekf");
+             "'; valid: window, luenberger, sliding_mode, ekf, pi_bank");
     }
     s.observers.push_back(std::move(spec));
   }
@@ -165,7 +299,7 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
     }
   }
   r.finish({"name", "model", "x0", "initial_guess", "steps", "noise", "seed", "input", "observers",
-            "reported"});
+            "reported", "settle_time"});
   // Sizes against the model, now that everything parsed.
   if (s.x0.size() != model.states() || s.initial_guess.size() != model.states()) {
     r.fail("'x0' and 'initial_guess' must have " + std::to_string(model.states()) +
@@ -201,6 +335,20 @@ nlohmann::json to_json(const Scenario& s) {
       jo["Q"] = matrix_json(o.q);
       jo["R"] = matrix_json(o.r);
       jo["gamma"] = o.gamma;
+    } else if (o.type == "pi_bank") {
+      jo["bank"] = o.pi.bank;
+      nlohmann::json gains = nlohmann::json::array();
+      for (const PiGains& g : o.pi.gains) gains.push_back({g.kp, g.ki});
+      jo["gains"] = gains;
+      const auto& channels = pi_bank_info(o.pi.bank).channels;
+      nlohmann::json bounds = nlohmann::json::object();
+      for (size_t c = 0; c < channels.size(); ++c) {
+        if (o.pi.omega_bounds[c]) bounds[channels[c]] = *o.pi.omega_bounds[c];
+      }
+      jo["omega_bounds"] = bounds;
+      jo["start"] = o.pi.start;
+      jo["substeps"] = o.pi.substeps;
+      jo["parameters"] = o.pi.parameters;
     } else if (o.type == "ekf") {
       if (o.process_covariance.size()) jo["process_covariance"] = matrix_json(o.process_covariance);
       if (o.measurement_covariance.size()) {
@@ -209,10 +357,12 @@ nlohmann::json to_json(const Scenario& s) {
       if (o.initial_covariance.size()) jo["initial_covariance"] = matrix_json(o.initial_covariance);
     }
     if (o.initial) jo["initial"] = vector_json(*o.initial);
+    if (o.model) jo["model"] = *o.model;
     observers.push_back(jo);
   }
   j["observers"] = observers;
   if (!s.reported.empty()) j["reported"] = s.reported;
+  if (s.settle_time >= 0.0) j["settle_time"] = s.settle_time;
   return j;
 }
 
@@ -238,8 +388,15 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& s, const A
     const ObserverSpec& o = s.observers[i];
     const std::string where = s.name + ".observers[" + std::to_string(i) + "]";
     const Eigen::VectorXd start = o.initial.value_or(s.initial_guess);
+    const AnyModel design = [&] {
+      if (!o.model) return model;
+      JsonReader reader(*o.model, where + ".model");
+      return make_model(reader);
+    }();
     try {
-      if (o.type == "window") {
+      if (o.type == "pi_bank") {
+        out.push_back(make_pi_bank(o.pi, model, where));
+      } else if (o.type == "window") {
         SolverOptions options;
         if (o.tol) {
           options.stop.step_tolerance = *o.tol;
@@ -256,17 +413,45 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& s, const A
         }
         out.push_back(std::move(estimator));
       } else if (o.type == "luenberger") {
-        out.push_back(std::make_unique<LuenbergerObserver<AnyModel>>(model, o.gain, start));
+        out.push_back(std::make_unique<LuenbergerObserver<AnyModel>>(design, o.gain, start));
       } else if (o.type == "sliding_mode") {
         out.push_back(
-            std::make_unique<SlidingModeObserver<AnyModel>>(model, o.q, o.r, o.gamma, start));
+            std::make_unique<SlidingModeObserver<AnyModel>>(design, o.q, o.r, o.gamma, start));
       } else {
         out.push_back(std::make_unique<ExtendedKalmanFilter<AnyModel>>(
-            model, start,
+            design, start,
             EkfOptions{o.process_covariance, o.measurement_covariance, o.initial_covariance}));
       }
     } catch (const InvalidInput& e) {
       throw std::invalid_argument(where + ": " + e.what());
+    }
+  }
+  return out;
+}
+
+nlohmann::json pi_bounds_json(const Scenario& s, std::vector<std::string>* warnings) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const ObserverSpec& o : s.observers) {
+    if (o.type != "pi_bank") continue;
+    const auto& channels = pi_bank_info(o.pi.bank).channels;
+    for (size_t c = 0; c < channels.size(); ++c) {
+      const std::optional<double> n = o.pi.omega_bounds[c];
+      const PiBound b = pi_ultimate_bound(o.pi.gains[c], n.value_or(0.0));
+      const std::string who = "pi:" + o.pi.bank + " channel '" + channels[c] + "'";
+      nlohmann::json j{{"observer", "pi:" + o.pi.bank},
+                       {"channel", channels[c]},
+                       {"kp", o.pi.gains[c].kp},
+                       {"ki", o.pi.gains[c].ki},
+                       {"warnings", b.warnings}};
+      if (n) {
+        j["omega_bound"] = *n;
+        j["paper_delta"] =
+            std::isfinite(b.paper_delta) ? nlohmann::json(b.paper_delta) : nlohmann::json(nullptr);
+        j["eta_error_bound"] = b.eta_error;
+        j["error_norm_bound"] = b.error_norm;
+      }
+      for (const auto& w : b.warnings) warnings->push_back(who + ": " + w);
+      out.push_back(j);
     }
   }
   return out;

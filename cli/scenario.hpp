@@ -13,11 +13,12 @@
 
 #include "nlobs/observers/any_model.hpp"
 #include "nlobs/observers/observer.hpp"
+#include "pi_banks.hpp"
 
 namespace nlobs::cli {
 
 struct ObserverSpec {
-  std::string type;  // "window", "luenberger", "sliding_mode", "ekf"
+  std::string type;  // "window", "luenberger", "sliding_mode", "ekf", "pi_bank"
   // window
   std::string engine = "newton";
   std::optional<double> tol{};  // step and residual tolerance of the engine
@@ -29,6 +30,10 @@ struct ObserverSpec {
   // ekf
   Eigen::MatrixXd process_covariance, measurement_covariance, initial_covariance;
   std::optional<Eigen::VectorXd> initial{};  // start estimate; default: the scenario's guess
+  // luenberger, sliding_mode, ekf: the observer's own design model (same sizes and sample
+  // time as the scenario's), e.g. one that assumes an unknown input constant
+  std::optional<nlohmann::json> model{};
+  PiBankSpec pi{};  // pi_bank
 };
 
 struct InputSpec {
@@ -51,6 +56,9 @@ struct Scenario {
   InputSpec input;
   std::vector<ObserverSpec> observers;
   ReportedFigures reported;
+  // Start of "after": metrics after the transient (MSE, max error) count t >= settle_time;
+  // negative: after the longest window has filled.
+  double settle_time = -1.0;
 };
 
 std::vector<std::string> builtin_scenarios();
@@ -66,5 +74,9 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& scenario,
                                                       const AnyModel& model,
                                                       bool trace_first_window);
 Eigen::VectorXd scenario_input(const Scenario& scenario, const AnyModel& model, long k);
+
+// Per PI channel of the scenario's pi_bank observers: the gains, N, the paper's δ (eq. 15) and
+// our ultimate bounds (pi_bound.hpp); warnings (complex eigenvalues of K) are appended.
+nlohmann::json pi_bounds_json(const Scenario& scenario, std::vector<std::string>* warnings);
 
 }  // namespace nlobs::cli

@@ -2,6 +2,7 @@
 // recorded data, and every bad input the issue lists.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -9,6 +10,10 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "nlobs/models/discretization.hpp"
+#include "nlobs/models/systems.hpp"
+#include "nlobs/observers/pi_bound.hpp"
+#include "nlobs/observers/simulation.hpp"
 #include "run_command.hpp"
 #include "scenario.hpp"
 
@@ -191,6 +196,138 @@ TEST(Run, LanderScenarioStopsAtTheDomainBoundary) {
   run_scenario(f.string(), {}, out, err);
   EXPECT_NE(err.str().find("mass x3"), std::string::npos) << err.str();
   EXPECT_NE(err.str().find("leaves its domain"), std::string::npos) << err.str();
+}
+
+// Runs a built-in scenario into a scratch directory and returns summary.json.
+nlohmann::json run_summary(const std::string& name, std::string* err_text = nullptr) {
+  const fs::path dir = scratch(name);
+  std::ostringstream out, err;
+  run_scenario(name, {.out_dir = dir.string()}, out, err);
+  if (err_text) *err_text = err.str();
+  std::ifstream in(dir / "summary.json");
+  return nlohmann::json::parse(in);
+}
+
+const nlohmann::json& observer_of(const nlohmann::json& summary, const std::string& name) {
+  for (const auto& o : summary["observers"]) {
+    if (o["name"] == name) return o;
+  }
+  throw std::runtime_error("no observer " + name);
+}
+
+TEST(RunPi, LinearErrorAfterTwoSecondsStaysWithinTheDerivedBound) {
+  const nlohmann::json s = run_summary("pi-linear");
+  const double observed = observer_of(s, "pi:unknown-input")["max_error_after"][1];
+  ASSERT_EQ(s["pi_bounds"].size(), 1u);
+  const auto& b = s["pi_bounds"][0];
+  const double n = 3 * 3.14159265358979323846;
+  EXPECT_DOUBLE_EQ(b["omega_bound"].get<double>(), n);
+  // UUB, not zero: Ω = f' = 3π cos(πt) is a sinusoid, so the error settles to exactly
+  // N |G(jπ)| = 1.155 — below our L1 bound (1.75) and the paper's δ (18.1).
+  const double sinusoid = n * pi_sinusoid_gain({8, 15}, 3.14159265358979323846);
+  EXPECT_NEAR(observed, sinusoid, 0.01 * sinusoid);
+  EXPECT_LE(observed, b["eta_error_bound"].get<double>());
+  EXPECT_LE(observed, b["paper_delta"].get<double>());
+  EXPECT_TRUE(observer_of(s, "ekf")["max_error_after"][1].get<double>() < 1.0);
+}
+
+TEST(RunPi, ChuaReconstructionErrorsMatchTheirDerivation) {
+  const nlohmann::json s = run_summary("pi-chua");
+  // The scenario's N must bound |d(x1 + x3)/dt| on the run it describes.
+  CubicChua chua;
+  const Discretized<CubicChua> model(chua, 0.001, Scheme::kRk4);
+  const Measurements data = simulate(model, Eigen::Vector3d(0.2, 0.2, 0.2), {.steps = 50001});
+  double omega = 0.0;
+  for (Eigen::Index k = 0; k < data.steps(); ++k) {
+    const Eigen::Vector3d dx =
+        chua.vector_field(Eigen::Vector3d(data.x.col(k)), CubicChua::Input(), 0.0);
+    omega = std::max(omega, std::abs(dx[0] + dx[2]));
+  }
+  const double n = s["pi_bounds"][0]["omega_bound"];
+  EXPECT_LE(omega, n);
+  EXPECT_GT(omega, 0.85 * n);
+  // x̂3 = −b∫y carries the unobservable constant x3(0) − x̂3(0) = 0.2 and nothing else.
+  const auto& alt = observer_of(s, "pi:chua-x3")["max_error_after"];
+  EXPECT_NEAR(alt[2].get<double>(), 0.2, 1e-6);
+  const double eta_bound = s["pi_bounds"][1]["eta_error_bound"];
+  EXPECT_LE(alt[0].get<double>(), 0.2 + eta_bound);
+  // The paper's x̂1' = η̂₁ + b y: error c − e1 − k_p e2 with c = x̂1(0) − x1(0) + η(0) = 0.2
+  // (γ(0) = 0), so |x1 − x̂1| ≤ 0.2 + N ‖(s + k_p)/(s² + k_p s + k_i)‖₁.
+  const auto& paper = observer_of(s, "pi:chua")["max_error_after"];
+  const double lag_bound = n * pi_l1_gain({25, 150}, 1.0, 25.0);
+  EXPECT_LE(paper[0].get<double>(), 0.2 + lag_bound);
+  EXPECT_GT(paper[0].get<double>(), alt[0].get<double>());  // the k_p e2 lag costs accuracy
+
+  // The channel itself: |η − η̂| after the transient within eta_error (trajectories.csv has
+  // the truth x1, x3 and the bank's signal "eta").
+  std::ifstream csv(scratch("pi-chua") / "trajectories.csv");
+  std::string line;
+  std::getline(csv, line);
+  std::vector<std::string> header;
+  std::stringstream hs(line);
+  for (std::string cell; std::getline(hs, cell, ',');) header.push_back(cell);
+  const auto column = [&](const std::string& name) {
+    const auto it = std::find(header.begin(), header.end(), name);
+    EXPECT_NE(it, header.end()) << name;
+    return static_cast<size_t>(it - header.begin());
+  };
+  const size_t t_col = column("t"), x1 = column("x1"), x3 = column("x3"),
+               eta = column("pi:chua.signal.eta");
+  double worst = 0.0;
+  while (std::getline(csv, line)) {
+    std::vector<double> v;
+    std::stringstream ls(line);
+    for (std::string cell; std::getline(ls, cell, ',');) v.push_back(std::stod(cell));
+    if (v[t_col] >= 10.0) worst = std::max(worst, std::abs(v[x1] + v[x3] - v[eta]));
+  }
+  EXPECT_LE(worst, s["pi_bounds"][0]["eta_error_bound"].get<double>());
+  EXPECT_GT(worst, 0.0);
+}
+
+TEST(RunPi, LanderTracksFUntilTheMassRunsOut) {
+  std::string err;
+  const nlohmann::json s = run_summary("pi-lander", &err);
+  EXPECT_NE(err.find("mass x3"), std::string::npos) << err;
+  EXPECT_NE(s["stop_message"].get<std::string>().find("leaves its domain"), std::string::npos);
+  EXPECT_GT(s["steps"].get<long>(), 13000);  // t ≈ 13.05 s
+  // Both channels run with complex eigenvalues of K: warned, δ undefined.
+  EXPECT_NE(err.find("channel 'x2': K of eq. (7) has complex eigenvalues"), std::string::npos);
+  EXPECT_EQ(s["warnings"].size(), 2u);
+  EXPECT_TRUE(s["pi_bounds"][1]["paper_delta"].is_null());
+  // Bounded error (docs/observers.md): f peaks at e^6 = 403; the bank lags it by up to 150.
+  const auto& pi = observer_of(s, "pi:lander");
+  EXPECT_LT(pi["max_error_after"][3].get<double>(), 150.0);
+  EXPECT_TRUE(pi["failures"].empty());
+}
+
+TEST(RunPi, PiScenariosRoundTrip) {
+  for (const char* name : {"pi-linear", "pi-chua", "pi-lander"}) {
+    const Scenario sc = load_scenario(name);
+    const nlohmann::json j = to_json(sc);
+    EXPECT_EQ(to_json(parse_scenario(j, "round trip")), j) << name;
+  }
+}
+
+TEST(RunPi, BadPiBankSpecsNameTheProblem) {
+  const fs::path f = scratch("bad_pi.json");
+  const auto scenario = [](const std::string& observer) {
+    return R"({"name": "x", "model": {"name": "unknown-input"}, "x0": [0, 0],
+               "initial_guess": [0, 0], "steps": 10, "observers": [)" +
+           observer + "]}";
+  };
+  write(f, scenario(R"({"type": "pi_bank", "bank": "unknown-input", "gains": [[-8, 15]]})"));
+  EXPECT_NE(error_of(f.string()).find("gain k_p = -8"), std::string::npos) << error_of(f.string());
+  write(f, scenario(R"({"type": "pi_bank", "bank": "unknown-input", "gains": [[8, 15], [1, 1]]})"));
+  EXPECT_NE(error_of(f.string()).find("1 channel(s)"), std::string::npos);
+  write(f, scenario(R"({"type": "pi_bank", "bank": "nope", "gains": [[8, 15]]})"));
+  EXPECT_NE(error_of(f.string()).find("valid: unknown-input, chua"), std::string::npos);
+  write(f, scenario(R"({"type": "pi_bank", "bank": "chua", "gains": [[8, 15]]})"));
+  EXPECT_NE(error_of(f.string()).find("estimates 3 states"), std::string::npos);
+  write(f, scenario(R"({"type": "pi_bank", "bank": "unknown-input", "gains": [[8, 15]],
+                        "omega_bounds": {"g": 1}})"));
+  EXPECT_NE(error_of(f.string()).find("'g'"), std::string::npos) << error_of(f.string());
+  write(f, scenario(R"({"type": "ekf", "model": {"name": "lorenz"}})"));
+  EXPECT_NE(error_of(f.string()).find("sizes and sample time"), std::string::npos);
 }
 
 }  // namespace

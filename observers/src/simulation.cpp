@@ -15,6 +15,21 @@ Eigen::VectorXd mean_squared_error(const Eigen::MatrixXd& truth, const Eigen::Ma
   return diff.array().square().rowwise().sum() / static_cast<double>(count);
 }
 
+Eigen::VectorXd max_abs_error(const Eigen::MatrixXd& truth, const Eigen::MatrixXd& estimate,
+                              long from) {
+  const long count = static_cast<long>(truth.cols()) - from;
+  if (truth.rows() != estimate.rows() || truth.cols() != estimate.cols()) {
+    throw InvalidInput("max_abs_error: truth and estimate differ in shape");
+  }
+  if (count <= 0) return Eigen::VectorXd::Constant(truth.rows(), std::nan(""));
+  const Eigen::MatrixXd diff = (truth.rightCols(count) - estimate.rightCols(count)).cwiseAbs();
+  Eigen::VectorXd out(truth.rows());
+  for (Eigen::Index i = 0; i < truth.rows(); ++i) {
+    out[i] = diff.row(i).allFinite() ? diff.row(i).maxCoeff() : std::nan("");
+  }
+  return out;
+}
+
 RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Observer>>& observers,
                         long settle_index,
                         const std::function<void(long done, long total)>& progress) {
@@ -35,6 +50,7 @@ RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Ob
     m.engine = observer->engine();
     m.first_window_iterations = -1;
     Eigen::MatrixXd estimate(data.x.rows() > 0 ? data.x.rows() : 0, steps);
+    Eigen::MatrixXd extras(static_cast<Eigen::Index>(observer->extra_names().size()), steps);
     long iterations_sum = 0, evaluations_sum = 0;
     double elapsed_ns = 0.0;
     for (long k = 0; k < steps; ++k) {
@@ -45,7 +61,12 @@ RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Ob
           std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count();
       if (estimate.rows() == 0) estimate.resize(s.estimate.size(), steps);
       estimate.col(k) = s.estimate;
+      if (extras.rows() > 0) extras.col(k) = s.extras;
       if (s.measurement_missing) ++m.failures["missing_measurement"];
+      if (!s.failure.empty()) {
+        ++m.failures[s.failure];
+        if (m.first_failure.empty()) m.first_failure = s.failure_message;
+      }
       if (s.summary) {
         ++m.solves;
         iterations_sum += s.summary->iterations;
@@ -67,9 +88,12 @@ RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Ob
     if (data.has_truth()) {
       m.mse = mean_squared_error(data.x, estimate, 0);
       m.mse_after_window = mean_squared_error(data.x, estimate, settle_index);
+      m.max_error_after = max_abs_error(data.x, estimate, settle_index);
     }
     result.metrics.push_back(std::move(m));
     result.estimates.push_back(std::move(estimate));
+    result.extras.push_back(std::move(extras));
+    result.extra_names.push_back(observer->extra_names());
   }
   return result;
 }

@@ -162,6 +162,45 @@ struct LunarLander : ModelSizes<3, 1, 1> {
   }
 };
 
+// The lander with its unknown mass-loss term f immersed as a fourth state, so that a run has
+// f's true values (seed 002, eq. 52): f = exp(c sin t) gives f' = c cos t · f, f(0) = 1.
+// c = 0 makes f constant: the design model of an observer that only knows f varies slowly.
+struct LunarLanderImmersed : ModelSizes<4, 1, 1> {
+  LunarLanderParameters p{};
+  double c = 6.0;
+  template <typename T>
+  State<T> vector_field(const State<T>& x, const Input& u, double t) const {
+    State<T> dx;
+    dx[0] = x[1];
+    dx[1] = p.g - p.sigma * p.alpha * u[0] / x[2];
+    dx[2] = -p.sigma * u[0] - x[3];
+    dx[3] = c * std::cos(t) * x[3];
+    return dx;
+  }
+  template <typename T>
+  Output<T> h(const State<T>& x) const {
+    return Output<T>(x[0]);
+  }
+  std::string domain_violation(const State<double>& x) const {
+    return LunarLander{}.domain_violation(x.head<3>());
+  }
+};
+
+// Example 3 of seed 002 without its x1 (x1' = u never reaches y = x2): x' = u + f, y = x,
+// with the unknown f = A sin(ωt) immersed as a second state (f' = Aω cos ωt, f(0) = 0).
+// A = 0 makes f constant: the design model of an observer that does not know f's shape.
+struct UnknownInputIntegrator : ModelSizes<2, 1, 1> {
+  double amplitude = 3.0, omega = 3.14159265358979323846;
+  template <typename T>
+  State<T> vector_field(const State<T>& x, const Input& u, double t) const {
+    return State<T>(u[0] + x[1], T(amplitude * omega * std::cos(omega * t)));
+  }
+  template <typename T>
+  Output<T> h(const State<T>& x) const {
+    return Output<T>(x[0]);
+  }
+};
+
 // Pendulum with time-varying friction and an unknown bounded horizontal acceleration
 // (METHODS §4; the paper's table was lost, these values are ours): θ = x1, y = θ,
 //   x1' = x2,  x2' = −(g/l) sin x1 − c(t) x2 − (a(t)/l) cos x1,

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "nlobs/solvers/summary.hpp"
 
@@ -15,6 +16,9 @@ struct ObserverStep {
   bool ready = true;                 // false while a window fills (the estimate coasts on f)
   bool measurement_missing = false;  // y_k had a non-finite entry: skipped, estimate coasts
   std::optional<Summary> summary;    // the engine's summary when this step solved a window
+  Eigen::VectorXd extras;  // further named signals (extra_names()), e.g. η̂₁ of a PI bank
+  std::string failure;     // empty, or why this step kept the last good state (e.g. "non_finite")
+  std::string failure_message;  // what and where, for the report
 };
 
 class Observer {
@@ -24,6 +28,8 @@ class Observer {
   virtual std::string engine() const { return {}; }  // engine spec, for window estimators
   // Window length N for window estimators (0 otherwise): the harness's "after the window".
   virtual Eigen::Index window() const { return 0; }
+  // Names of the signals in ObserverStep::extras (written beside x̂ by `nlobs run`).
+  virtual std::vector<std::string> extra_names() const { return {}; }
   virtual void reset() = 0;  // back to the initial guess, empty window
   // Sample k (consecutive from 0). A non-finite y means a missing measurement.
   virtual const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) = 0;

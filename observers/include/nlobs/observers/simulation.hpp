@@ -94,6 +94,7 @@ struct ObserverMetrics {
   std::string name, engine;
   Eigen::VectorXd mse;               // per state, all samples (empty without truth)
   Eigen::VectorXd mse_after_window;  // per state, samples k ≥ settle index
+  Eigen::VectorXd max_error_after;   // per state, max_k |x_i − x̂_i| over k ≥ settle index
   double iterations_mean = 0.0;
   int iterations_max = 0;
   int first_window_iterations = 0;  // -1 if no window was solved
@@ -103,12 +104,15 @@ struct ObserverMetrics {
   std::map<std::string, int>
       failures;  // status name → count (solves not converged, missing samples)
   std::optional<Summary> first_window;  // with its trace when the engine records one
+  std::string first_failure;            // the first ObserverStep::failure_message, if any
 };
 
 struct RunResult {
   std::vector<ObserverMetrics> metrics;
   std::vector<Eigen::MatrixXd> estimates;  // per observer: n × K
-  long settle_index = 0;                   // first sample of "after the window"
+  std::vector<Eigen::MatrixXd> extras;     // per observer: extra_names() × K (may be empty)
+  std::vector<std::vector<std::string>> extra_names;  // per observer
+  long settle_index = 0;                              // first sample of "after the window"
 };
 
 // Runs every observer over the same measurements (each reset first). `settle_index`: the
@@ -116,6 +120,11 @@ struct RunResult {
 RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Observer>>& observers,
                         long settle_index = -1,
                         const std::function<void(long done, long total)>& progress = {});
+
+// Largest |truth − estimate| per state over samples [from, K) (NaN when the range is empty
+// or an estimate there is not finite).
+Eigen::VectorXd max_abs_error(const Eigen::MatrixXd& truth, const Eigen::MatrixXd& estimate,
+                              long from = 0);
 
 // Mean squared error per state (eq. 92) over samples [from, K).
 Eigen::VectorXd mean_squared_error(const Eigen::MatrixXd& truth, const Eigen::MatrixXd& estimate,

@@ -1,0 +1,349 @@
+#include "nlobs/observers/pi_bank.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "nlobs/solvers/status.hpp"
+
+namespace nlobs {
+
+double PiBank::Values::operator[](Signal s) const {
+  if (s.id < 0 || s.id >= available_) bank_->check_readable(s, bank_->stages_[reader_].name);
+  return data_[s.id];
+}
+
+PiBank::PiBank(Eigen::Index outputs, Eigen::Index inputs) : outputs_(outputs), inputs_(inputs) {
+  if (outputs < 1 || inputs < 0) {
+    throw InvalidInput("PiBank: needs at least one output and a non-negative number of inputs");
+  }
+  // (Appending rather than "y" + to_string(): GCC 12 reports a false -Wrestrict on the latter.)
+  const auto numbered = [](char letter, Eigen::Index i) {
+    std::string name(1, letter);
+    name.append(std::to_string(i + 1));
+    return name;
+  };
+  for (Eigen::Index i = 0; i < outputs; ++i) names_.push_back(numbered('y', i));
+  for (Eigen::Index i = 0; i < inputs; ++i) names_.push_back(numbered('u', i));
+  names_.push_back("t");
+}
+
+PiBank::Signal PiBank::output(Eigen::Index i) const {
+  if (i < 0 || i >= outputs_) {
+    throw InvalidInput("PiBank::output: index " + std::to_string(i) + " outside 0.." +
+                       std::to_string(outputs_ - 1));
+  }
+  return Signal{static_cast<int>(i)};
+}
+
+PiBank::Signal PiBank::input(Eigen::Index i) const {
+  if (i < 0 || i >= inputs_) {
+    throw InvalidInput("PiBank::input: index " + std::to_string(i) + " outside the " +
+                       std::to_string(inputs_) + " inputs");
+  }
+  return Signal{static_cast<int>(outputs_ + i)};
+}
+
+const std::string& PiBank::signal_name(Signal s) const {
+  if (s.id < 0 || s.id >= signal_count()) {
+    throw InvalidInput("PiBank: signal " + std::to_string(s.id) + " does not exist");
+  }
+  return names_[static_cast<size_t>(s.id)];
+}
+
+void PiBank::check_readable(Signal s, const std::string& stage) const {
+  std::ostringstream os;
+  os << "PiBank: stage '" << stage << "' reads ";
+  if (s.id < 0 || s.id >= signal_count()) {
+    os << "signal " << s.id << ", which does not exist";
+  } else {
+    os << "'" << names_[static_cast<size_t>(s.id)]
+       << "', which is defined by a later stage (or the stage itself); a stage reads y, u, t "
+          "and the stages added before it";
+  }
+  throw InvalidInput(os.str());
+}
+
+PiBank::Signal PiBank::add_name(const std::string& name) {
+  if (name.empty()) throw InvalidInput("PiBank: a stage needs a name");
+  for (const auto& n : names_) {
+    if (n == name) throw InvalidInput("PiBank: a signal named '" + name + "' exists already");
+  }
+  names_.push_back(name);
+  return Signal{static_cast<int>(names_.size()) - 1};
+}
+
+PiBank::PiOutputs PiBank::add_pi(const std::string& name, Channel c) {
+  validate(c.gains, "PiBank channel '" + name + "'");
+  if (!std::isfinite(c.a) || c.a == 0.0) {
+    throw InvalidInput("PiBank channel '" + name +
+                       "': a must be finite and non-zero (eta = a ds/dt + b)");
+  }
+  if (!c.gamma0.allFinite() || (c.initial_estimates && !c.initial_estimates->allFinite())) {
+    throw InvalidInput("PiBank channel '" + name + "': initial values must be finite");
+  }
+  const int available = static_cast<int>(names_.size());
+  if (c.measured.id < 0 || c.measured.id >= available) check_readable(c.measured, name);
+  Stage s{Kind::kPi, name, std::move(c), {}, 0.0, static_cast<int>(state_size_), 0, available};
+  const Signal eta = add_name(name);
+  const Signal rate = add_name(name + ".rate");
+  s.signal = eta.id;
+  state_size_ += 2;
+  stages_.push_back(std::move(s));
+  return {eta, rate};
+}
+
+PiBank::Signal PiBank::add_signal(const std::string& name, Function value) {
+  if (!value) throw InvalidInput("PiBank signal '" + name + "': needs a function");
+  const int available = static_cast<int>(names_.size());
+  const Signal id = add_name(name);
+  stages_.push_back(Stage{Kind::kSignal, name, {}, std::move(value), 0.0, 0, id.id, available});
+  return id;
+}
+
+PiBank::Signal PiBank::add_integrator(const std::string& name, Function rate, double initial) {
+  if (!rate) throw InvalidInput("PiBank integrator '" + name + "': needs a rate function");
+  if (!std::isfinite(initial)) {
+    throw InvalidInput("PiBank integrator '" + name + "': initial value must be finite");
+  }
+  const int available = static_cast<int>(names_.size());
+  const Signal id = add_name(name);
+  stages_.push_back(Stage{Kind::kIntegrator,
+                          name,
+                          {},
+                          std::move(rate),
+                          initial,
+                          static_cast<int>(state_size_),
+                          id.id,
+                          available});
+  state_size_ += 1;
+  return id;
+}
+
+std::vector<PiBank::Signal> PiBank::stage_signals() const {
+  std::vector<Signal> out;
+  for (int i = static_cast<int>(outputs_ + inputs_) + 1; i < signal_count(); ++i) {
+    out.push_back(Signal{i});
+  }
+  return out;
+}
+
+std::vector<PiBank::ChannelInfo> PiBank::channels() const {
+  std::vector<ChannelInfo> out;
+  for (const Stage& s : stages_) {
+    if (s.kind == Kind::kPi) out.push_back({s.name, s.channel.gains, s.channel.a});
+  }
+  return out;
+}
+
+PiBank::Values PiBank::view(const double* data, int available, int reader) const {
+  Values v;
+  v.bank_ = this;
+  v.data_ = data;
+  v.available_ = available;
+  v.reader_ = reader;
+  v.time_id_ = static_cast<int>(outputs_ + inputs_);
+  return v;
+}
+
+Eigen::VectorXd PiBank::initial_state(double t, const Eigen::VectorXd& y,
+                                      const Eigen::VectorXd& u) const {
+  Eigen::VectorXd state = Eigen::VectorXd::Zero(state_size_);
+  for (const Stage& s : stages_) {
+    if (s.kind == Kind::kPi) state.segment<2>(s.state) = s.channel.gamma0;
+    if (s.kind == Kind::kIntegrator) state[s.state] = s.initial;
+  }
+  // Channels started from estimates need their measured signal at t0, which may depend on
+  // earlier stages: evaluate in order, fixing each channel's γ(0) before later stages read it.
+  Eigen::VectorXd signals(signal_count());
+  for (size_t i = 0; i < stages_.size(); ++i) {
+    const Stage& s = stages_[i];
+    if (s.kind != Kind::kPi || !s.channel.initial_estimates) continue;
+    evaluate(t, y, u, state, signals, nullptr);
+    const PiChannelConstants c{s.channel.gains, s.channel.a};
+    state.segment<2>(s.state) =
+        pi_gamma_for(c, *s.channel.initial_estimates, signals[s.channel.measured.id]);
+  }
+  return state;
+}
+
+PiBank::Signal PiBank::evaluate(double t, const Eigen::VectorXd& y, const Eigen::VectorXd& u,
+                                const Eigen::VectorXd& state, Eigen::VectorXd& signals,
+                                Eigen::VectorXd* rate) const {
+  if (y.size() != outputs_ || u.size() != inputs_ || state.size() != state_size_) {
+    std::ostringstream os;
+    os << "PiBank::evaluate: expected " << outputs_ << " outputs, " << inputs_ << " inputs and "
+       << state_size_ << " states, got " << y.size() << ", " << u.size() << ", " << state.size();
+    throw InvalidInput(os.str());
+  }
+  signals.resize(signal_count());
+  if (rate) rate->resize(state_size_);
+  signals.head(outputs_) = y;
+  signals.segment(outputs_, inputs_) = u;
+  signals[outputs_ + inputs_] = t;
+  Signal bad{-1};
+  for (size_t i = 0; i < stages_.size(); ++i) {
+    const Stage& s = stages_[i];
+    const Values v = view(signals.data(), s.available, static_cast<int>(i));
+    switch (s.kind) {
+      case Kind::kPi: {
+        const PiChannelConstants c{s.channel.gains, s.channel.a};
+        const double measured = signals[s.channel.measured.id];
+        const double b = s.channel.b ? s.channel.b(v) : 0.0;
+        const Eigen::Vector2d gamma = state.segment<2>(s.state);
+        signals.segment<2>(s.signal) = pi_estimates(c, gamma, measured);
+        if (rate) rate->segment<2>(s.state) = pi_gamma_rate(c, gamma, measured, b);
+        if (bad.id < 0 && !std::isfinite(b)) bad = Signal{s.signal};
+        break;
+      }
+      case Kind::kSignal:
+        signals[s.signal] = s.fn(v);
+        break;
+      case Kind::kIntegrator:
+        signals[s.signal] = state[s.state];
+        if (rate) (*rate)[s.state] = s.fn(v);
+        if (rate && bad.id < 0 && !std::isfinite((*rate)[s.state])) bad = Signal{s.signal};
+        break;
+    }
+    if (bad.id < 0) {
+      const int count = s.kind == Kind::kPi ? 2 : 1;
+      for (int j = 0; j < count; ++j) {
+        if (!std::isfinite(signals[s.signal + j])) {
+          bad = Signal{s.signal + j};
+          break;
+        }
+      }
+    }
+  }
+  return bad;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+PiBankObserver::PiBankObserver(std::string name, PiBank bank, std::vector<PiBank::Signal> estimate,
+                               PiBankOptions options)
+    : name_(std::move(name)),
+      bank_(std::move(bank)),
+      estimate_ids_(std::move(estimate)),
+      options_(options) {
+  if (!(options_.sample_time > 0.0) || !std::isfinite(options_.sample_time)) {
+    throw InvalidInput(name_ + ": sample_time must be finite and > 0, got " +
+                       std::to_string(options_.sample_time));
+  }
+  if (options_.substeps < 1) {
+    throw InvalidInput(name_ + ": substeps must be >= 1, got " + std::to_string(options_.substeps));
+  }
+  if (estimate_ids_.empty()) throw InvalidInput(name_ + ": the estimate lists no signal");
+  for (const auto& s : estimate_ids_) bank_.signal_name(s);  // throws for unknown ids
+  extra_ids_ = bank_.stage_signals();
+  const Eigen::Index n = bank_.state_size();
+  for (Eigen::VectorXd* v : {&state_, &k1_, &k2_, &k3_, &k4_, &trial_, &scratch_}) v->resize(n);
+  signals_.resize(bank_.signal_count());
+  y_.resize(bank_.outputs());
+  step_.estimate.resize(static_cast<Eigen::Index>(estimate_ids_.size()));
+  step_.extras.resize(static_cast<Eigen::Index>(extra_ids_.size()));
+  // A dry evaluation: a stage reading a later signal fails here, at construction.
+  bank_.evaluate(0.0, Eigen::VectorXd::Zero(bank_.outputs()), Eigen::VectorXd::Zero(bank_.inputs()),
+                 Eigen::VectorXd::Zero(n), signals_, &k1_);
+  reset();
+}
+
+std::vector<std::string> PiBankObserver::extra_names() const {
+  std::vector<std::string> names;
+  for (const auto& s : extra_ids_) names.push_back(bank_.signal_name(s));
+  return names;
+}
+
+void PiBankObserver::reset() {
+  started_ = false;
+  step_.estimate.setConstant(std::nan(""));
+  step_.extras.setConstant(std::nan(""));
+}
+
+void PiBankObserver::publish() {
+  for (size_t i = 0; i < estimate_ids_.size(); ++i) {
+    step_.estimate[static_cast<Eigen::Index>(i)] = signals_[estimate_ids_[i].id];
+  }
+  for (size_t i = 0; i < extra_ids_.size(); ++i) {
+    step_.extras[static_cast<Eigen::Index>(i)] = signals_[extra_ids_[i].id];
+  }
+}
+
+// Classic RK4 over [t0, t1] in `substeps` steps; y moves linearly from last_y_ to y1, u is
+// held at last_u_. On a non-finite signal, returns false with state_ untouched.
+bool PiBankObserver::integrate(double t0, double t1, const Eigen::VectorXd& y1) {
+  trial_ = state_;
+  const double h = (t1 - t0) / options_.substeps;
+  const auto rhs = [&](double t, const Eigen::VectorXd& x, Eigen::VectorXd& out) {
+    const double w = (t - t0) / (t1 - t0);
+    y_ = (1.0 - w) * last_y_ + w * y1;
+    const PiBank::Signal bad = bank_.evaluate(t, y_, last_u_, x, signals_, &out);
+    if (bad.id >= 0) {
+      bad_ = bad;
+      bad_t_ = t;
+      return false;
+    }
+    return true;
+  };
+  for (int i = 0; i < options_.substeps; ++i) {
+    const double t = t0 + h * i;
+    if (!rhs(t, trial_, k1_)) return false;
+    scratch_ = trial_ + 0.5 * h * k1_;
+    if (!rhs(t + 0.5 * h, scratch_, k2_)) return false;
+    scratch_ = trial_ + 0.5 * h * k2_;
+    if (!rhs(t + 0.5 * h, scratch_, k3_)) return false;
+    scratch_ = trial_ + h * k3_;
+    if (!rhs(t + h, scratch_, k4_)) return false;
+    trial_ += (h / 6.0) * (k1_ + 2.0 * k2_ + 2.0 * k3_ + k4_);
+  }
+  if (!trial_.allFinite()) {
+    bad_ = PiBank::Signal{-1};
+    bad_t_ = t1;
+    return false;
+  }
+  state_ = trial_;
+  return true;
+}
+
+const ObserverStep& PiBankObserver::step(long k, const Eigen::VectorXd& y,
+                                         const Eigen::VectorXd& u) {
+  if (y.size() != bank_.outputs() || u.size() != bank_.inputs()) {
+    std::ostringstream os;
+    os << name_ << ": sample " << k << " has " << y.size() << " outputs and " << u.size()
+       << " inputs; the bank expects " << bank_.outputs() << " and " << bank_.inputs();
+    throw InvalidInput(os.str());
+  }
+  const double t = static_cast<double>(k) * options_.sample_time;
+  step_.failure.clear();
+  step_.failure_message.clear();
+  step_.measurement_missing = !y.allFinite();
+  step_.ready = started_;
+  if (step_.measurement_missing) return step_;  // hold: the integral states keep their value
+  if (!started_) {
+    state_ = bank_.initial_state(t, y, u);
+    started_ = true;
+    step_.ready = true;
+  } else if (!integrate(last_t_, t, y)) {
+    std::ostringstream os;
+    os << name_ << ": ";
+    if (bad_.id >= 0) {
+      os << "signal '" << bank_.signal_name(bad_) << "' is not finite at t = " << bad_t_;
+    } else {
+      os << "the state became non-finite by t = " << bad_t_;
+    }
+    os << "; kept the estimate of t = " << last_t_;
+    step_.failure = "non_finite";
+    step_.failure_message = os.str();
+    last_t_ = t;  // resume from the next interval, with the last good state
+    last_y_ = y;
+    last_u_ = u;
+    return step_;
+  }
+  last_t_ = t;
+  last_y_ = y;
+  last_u_ = u;
+  bank_.evaluate(t, y, u, state_, signals_, nullptr);
+  publish();
+  return step_;
+}
+
+}  // namespace nlobs
