@@ -284,7 +284,15 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
     << "set terminal pngcairo size 1200," << 300 * std::max<Eigen::Index>(n, 1) << "\n";
   g << "set output '" << (dir / "states.png").string() << "'\nset multiplot layout " << n << ",1\n";
   for (Eigen::Index i = 0; i < n; ++i) {
-    g << "set ylabel 'x" << i + 1 << "'\nplot ";
+    g << "set ylabel 'x" << i + 1 << "'\n";
+    // The truth's range plus half of it on each side: an estimate's transient spikes (a PI
+    // bank's pole crossing) must not flatten the comparison; errors.png shows them in full.
+    if (data.has_truth() && data.x.cols() > 0) {
+      const double lo = data.x.row(i).minCoeff(), hi = data.x.row(i).maxCoeff();
+      const double margin = std::max(0.5 * (hi - lo), 1e-3 * std::max(1.0, std::abs(hi)));
+      g << "set yrange [" << lo - margin << ":" << hi + margin << "]\n";
+    }
+    g << "plot ";
     if (data.has_truth())
       g << "'trajectories.csv' using 1:" << i + 2 << " with lines lw 2 title 'true', ";
     for (long o = 0; o < observers; ++o) {
@@ -292,7 +300,7 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
         << r.metrics[static_cast<size_t>(o)].name << "'" << (o + 1 < observers ? ", " : "\n");
     }
   }
-  g << "unset multiplot\n";
+  g << "unset multiplot\nset autoscale y\n";
   written.push_back("states.png");
   if (data.has_truth()) {
     g << "set output '" << (dir / "errors.png").string() << "'\nset logscale y\n"
