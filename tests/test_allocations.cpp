@@ -7,6 +7,7 @@
 #include <new>
 #include <vector>
 
+#include "nlobs/observers/pi_bank.hpp"
 #include "nlobs/solvers/ceres_engine.hpp"
 #include "nlobs/solvers/solvers.hpp"
 #include "reference/chua_window.hpp"
@@ -94,6 +95,30 @@ TEST(Allocations, FiniteDifferenceAndMatrixPreconditionerAllocateNothing) {
   SteffensenEngine<3> steffensen(o);
   EXPECT_EQ(allocations_during_solve(newton, by_fd), 0);
   EXPECT_EQ(allocations_during_solve(steffensen, by_matrix), 0);
+}
+
+// A PI bank's step (RK4 over the interval, every stage evaluated 4 × substeps times) works in
+// buffers sized at construction.
+TEST(Allocations, PiBankStepAllocatesNothing) {
+  PiBank bank(1, 1);
+  const auto y = bank.output(0), u = bank.input(0);
+  const auto x2 = bank.add_pi("x2", {.measured = y, .gains = {6, 25}});
+  const auto x3 = bank.add_signal(
+      "x3", [=](const PiBank::Values& v) { return 1e4 * v[u] / (1.63 - v[x2.rate]); });
+  const auto f = bank.add_pi("f", {.measured = x3,
+                                   .a = -1.0,
+                                   .b = [=](const PiBank::Values& v) { return -50 * v[u]; },
+                                   .gains = {49, 700}});
+  PiBankObserver observer("pi", bank, {y, x2.eta, x3, f.eta}, {.sample_time = 1e-3, .substeps = 2});
+  Eigen::VectorXd yk(1), uk = Eigen::VectorXd::Ones(1);
+  yk[0] = -700.0;
+  observer.step(0, yk, uk);
+  const long before = g_allocations.load();
+  for (long k = 1; k < 100; ++k) {
+    yk[0] = -700.0 - 1e-3 * static_cast<double>(k);
+    observer.step(k, yk, uk);
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
 }
 
 }  // namespace
