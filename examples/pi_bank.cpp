@@ -36,7 +36,8 @@ int main() {
   double worst = 0.0;
   for (long k = 0; k < data.steps(); ++k) {
     const ObserverStep& s = observer.step(k, data.y.col(k), data.u.col(k));
-    if (static_cast<double>(k) * h >= 5.0) worst = std::max(worst, std::abs(s.estimate[3] - data.x(3, k)));
+    if (static_cast<double>(k) * h >= 5.0)
+      worst = std::max(worst, std::abs(s.estimate[3] - data.x(3, k)));
   }
   const PiBound bound = pi_ultimate_bound({49, 700}, 588.2);  // N = max |d/dt exp(6 sin t)|
   std::printf("max |f - f_hat| for 5 s <= t < 12 s: %.1f (f peaks at %.0f)\n", worst,

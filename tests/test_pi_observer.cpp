@@ -175,6 +175,26 @@ TEST(PiBank, TwoStageCascadeEstimatesVelocityThenAcceleration) {
   EXPECT_LT(worst_acc, 2 * first.eta_error + pi_ultimate_bound({20, 200}, 1.0).eta_error);
 }
 
+TEST(PiBank, VectorEtaOnSeveralOutputs) {
+  // y = (sin t, cos 2t): one channel per output, η_i = ẏ_i; each within its own bound.
+  PiBank bank(2, 0);
+  const auto a = bank.add_pi("a", {.measured = bank.output(0), .gains = {30, 300}});
+  const auto b = bank.add_pi("b", {.measured = bank.output(1), .gains = {30, 300}});
+  const double h = 1e-3;
+  PiBankObserver observer("two", bank, {a.eta, b.eta}, {h, 1});
+  double worst_a = 0, worst_b = 0;
+  for (long k = 0; k <= 10000; ++k) {
+    const double t = h * static_cast<double>(k);
+    const auto& s = observer.step(k, Eigen::Vector2d(std::sin(t), std::cos(2 * t)), {});
+    if (t < 3.0) continue;
+    worst_a = std::max(worst_a, std::abs(s.estimate[0] - std::cos(t)));
+    worst_b = std::max(worst_b, std::abs(s.estimate[1] + 2 * std::sin(2 * t)));
+  }
+  EXPECT_LE(worst_a, pi_ultimate_bound({30, 300}, 1.0).eta_error);  // |d cos t/dt| ≤ 1
+  EXPECT_LE(worst_b, pi_ultimate_bound({30, 300}, 4.0).eta_error);  // |d(−2 sin 2t)/dt| ≤ 4
+  EXPECT_GT(worst_b, worst_a);
+}
+
 TEST(PiBank, StagesMayOnlyReadEarlierSignals) {
   PiBank bank(1, 0);
   PiBank::Signal later{};
