@@ -3,13 +3,22 @@
 #include <algorithm>
 
 namespace nlobs {
+namespace {
+
+// Samples counted from `from` on; throws when the two differ in shape.
+long samples_from(const char* who, const Eigen::MatrixXd& truth, const Eigen::MatrixXd& estimate,
+                  long from) {
+  if (truth.rows() != estimate.rows() || truth.cols() != estimate.cols()) {
+    throw InvalidInput(std::string(who) + ": truth and estimate differ in shape");
+  }
+  return static_cast<long>(truth.cols()) - from;
+}
+
+}  // namespace
 
 Eigen::VectorXd mean_squared_error(const Eigen::MatrixXd& truth, const Eigen::MatrixXd& estimate,
                                    long from) {
-  const long count = static_cast<long>(truth.cols()) - from;
-  if (truth.rows() != estimate.rows() || truth.cols() != estimate.cols()) {
-    throw InvalidInput("mean_squared_error: truth and estimate differ in shape");
-  }
+  const long count = samples_from("mean_squared_error", truth, estimate, from);
   if (count <= 0) return Eigen::VectorXd::Constant(truth.rows(), std::nan(""));
   const auto diff = truth.rightCols(count) - estimate.rightCols(count);
   return diff.array().square().rowwise().sum() / static_cast<double>(count);
@@ -17,10 +26,7 @@ Eigen::VectorXd mean_squared_error(const Eigen::MatrixXd& truth, const Eigen::Ma
 
 Eigen::VectorXd max_abs_error(const Eigen::MatrixXd& truth, const Eigen::MatrixXd& estimate,
                               long from) {
-  const long count = static_cast<long>(truth.cols()) - from;
-  if (truth.rows() != estimate.rows() || truth.cols() != estimate.cols()) {
-    throw InvalidInput("max_abs_error: truth and estimate differ in shape");
-  }
+  const long count = samples_from("max_abs_error", truth, estimate, from);
   if (count <= 0) return Eigen::VectorXd::Constant(truth.rows(), std::nan(""));
   const Eigen::MatrixXd diff = (truth.rightCols(count) - estimate.rightCols(count)).cwiseAbs();
   Eigen::VectorXd out(truth.rows());
