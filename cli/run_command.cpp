@@ -396,7 +396,8 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
   long settle_index = -1;
   if (s.settle_time >= 0.0) {
     const double T = model.sample_time() > 0 ? model.sample_time() : 1.0;
-    settle_index = static_cast<long>(std::ceil(s.settle_time / T - 1e-9));
+    settle_index = static_cast<long>(
+        std::min(std::ceil(s.settle_time / T - 1e-9), static_cast<double>(data.steps())));
   }
   std::vector<std::string> warnings;
   const nlohmann::json bounds = pi_bounds_json(s, &warnings);

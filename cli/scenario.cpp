@@ -178,7 +178,7 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
   }
   if (auto v = r.integer("seed")) s.seed = static_cast<std::uint64_t>(*v);
   if (auto v = r.number("settle_time")) {
-    if (!(*v >= 0.0)) r.fail("'settle_time' must be >= 0 (seconds)");
+    if (!(*v >= 0.0) || !std::isfinite(*v)) r.fail("'settle_time' must be finite and >= 0 (s)");
     s.settle_time = *v;
   }
   if (auto in = r.object("input")) {

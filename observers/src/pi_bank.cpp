@@ -1,5 +1,6 @@
 #include "nlobs/observers/pi_bank.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -83,6 +84,10 @@ PiBank::PiOutputs PiBank::add_pi(const std::string& name, Channel c) {
   }
   const int available = static_cast<int>(names_.size());
   if (c.measured.id < 0 || c.measured.id >= available) check_readable(c.measured, name);
+  for (const auto& n : names_) {  // both names free before either is taken
+    if (n == name + ".rate")
+      throw InvalidInput("PiBank: a signal named '" + n + "' exists already");
+  }
   Stage s{Kind::kPi, name, std::move(c), {}, 0.0, static_cast<int>(state_size_), 0, available};
   const Signal eta = add_name(name);
   const Signal rate = add_name(name + ".rate");
@@ -272,7 +277,10 @@ void PiBankObserver::publish() {
 // held at last_u_. On a non-finite signal, returns false with state_ untouched.
 bool PiBankObserver::integrate(double t0, double t1, const Eigen::VectorXd& y1) {
   trial_ = state_;
-  const double h = (t1 - t0) / options_.substeps;
+  // After missing samples the interval spans several sample times: keep the step length.
+  const long intervals = std::max(1L, std::lround((t1 - t0) / options_.sample_time));
+  const long steps = intervals * options_.substeps;
+  const double h = (t1 - t0) / static_cast<double>(steps);
   const auto rhs = [&](double t, const Eigen::VectorXd& x, Eigen::VectorXd& out) {
     const double w = (t - t0) / (t1 - t0);
     y_ = (1.0 - w) * last_y_ + w * y1;
@@ -284,8 +292,8 @@ bool PiBankObserver::integrate(double t0, double t1, const Eigen::VectorXd& y1) 
     }
     return true;
   };
-  for (int i = 0; i < options_.substeps; ++i) {
-    const double t = t0 + h * i;
+  for (long i = 0; i < steps; ++i) {
+    const double t = t0 + h * static_cast<double>(i);
     if (!rhs(t, trial_, k1_)) return false;
     scratch_ = trial_ + 0.5 * h * k1_;
     if (!rhs(t + 0.5 * h, scratch_, k2_)) return false;
@@ -320,6 +328,15 @@ const ObserverStep& PiBankObserver::step(long k, const Eigen::VectorXd& y,
   if (step_.measurement_missing) return step_;  // hold: the integral states keep their value
   if (!started_) {
     state_ = bank_.initial_state(t, y, u);
+    const PiBank::Signal bad = bank_.evaluate(t, y, u, state_, signals_, nullptr);
+    if (bad.id >= 0 || !state_.allFinite()) {  // not started: try again at the next sample
+      std::ostringstream os;
+      os << name_ << ": cannot start at t = " << t << ": signal '"
+         << (bad.id >= 0 ? bank_.signal_name(bad) : std::string("state")) << "' is not finite";
+      step_.failure = "non_finite";
+      step_.failure_message = os.str();
+      return step_;
+    }
     started_ = true;
     step_.ready = true;
   } else if (!integrate(last_t_, t, y)) {

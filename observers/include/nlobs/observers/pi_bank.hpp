@@ -125,9 +125,10 @@ struct PiBankOptions {
 
 // Runs a bank on samples y_k, u_k at t_k = k·T. Between samples, y is interpolated linearly
 // (the interval [t_{k−1}, t_k] is integrated when y_k arrives, so x̂_k uses data up to t_k) and
-// u is held (the plant's sampled input). A non-finite y_k is skipped with the state held; a
+// u is held (the plant's sampled input). A non-finite y_k is skipped with the state held; the
+// next good sample integrates across the gap (y interpolated, u held, the same step length); a
 // step whose signals turn non-finite (a stage left its domain) keeps the last good state and
-// reports the signal and time.
+// reports the signal and time; a first sample whose signals are not finite does not start it.
 class PiBankObserver final : public Observer {
  public:
   // `estimate`: the signals that form x̂, in the model's state order.
