@@ -128,6 +128,10 @@ TEST(PiBound, PaperDeltaIsEq15WithRealEigenvaluesAndUndefinedOtherwise) {
   ASSERT_EQ(complex.warnings.size(), 1u);
   EXPECT_NE(complex.warnings[0].find("complex eigenvalues"), std::string::npos);
   EXPECT_TRUE(std::isfinite(complex.eta_error));
+  const PiBound none = pi_ultimate_bound({6, 25}, 0.0);  // N = 0: warnings, zero bounds
+  EXPECT_EQ(none.eta_error, 0.0);
+  EXPECT_EQ(none.error_norm, 0.0);
+  EXPECT_EQ(none.warnings.size(), 1u);
   // Larger gains shrink the ball: the trade-off the helper is for.
   EXPECT_LT(pi_ultimate_bound({40, 400}, n).eta_error, real.eta_error);
 }

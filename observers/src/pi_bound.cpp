@@ -95,6 +95,7 @@ PiBound pi_ultimate_bound(const PiGains& gains, double omega_bound) {
           "is stable) whose size eta_error and error_norm give";
     b.warnings.push_back(os.str());
   }
+  if (omega_bound == 0.0) return b;  // both bounds are 0: no quadrature (callers after warnings)
   const SecondOrder sys(gains);
   b.eta_error = omega_bound * pi_l1_gain(gains, 1.0, 0.0);
   b.error_norm = omega_bound * integrate_to_decay(sys, [&](double t) {
