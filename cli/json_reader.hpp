@@ -18,6 +18,8 @@ class JsonReader {
   [[noreturn]] void fail(const std::string& what) const;
   const std::string& where() const { return where_; }
   bool has(const std::string& key) const { return object_.contains(key); }
+  // The object this reader reads (to keep a sub-object as JSON, e.g. a model spec).
+  const nlohmann::json& json() const { return object_; }
 
   std::optional<double> number(const std::string& key);
   std::optional<long> integer(const std::string& key);

@@ -164,7 +164,7 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
   s.name = r.required_text("name");
   if (!r.has("model")) r.fail("missing field 'model'");
   auto model_spec = r.object("model");
-  s.model = json.at("model");
+  s.model = model_spec->json();
   const AnyModel model = make_model(*model_spec);  // validates now, naming the key
   s.x0 = r.required_vector("x0");
   s.initial_guess = r.required_vector("initial_guess");
@@ -202,7 +202,7 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
           own.inputs() != model.inputs() || own.sample_time() != model.sample_time()) {
         reader.fail("'model' must have the scenario model's sizes and sample time");
       }
-      spec.model = json.at("observers")[s.observers.size()].at("model");
+      spec.model = design->json();
     };
     spec.type = o.required_text("type");
     if (spec.type == "window") {
@@ -254,10 +254,7 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
       const long substeps = o.integer("substeps").value_or(1);
       if (substeps < 1 || substeps > 1000) o.fail("'substeps' must be in 1..1000");
       spec.pi.substeps = static_cast<int>(substeps);
-      if (o.has("parameters")) {
-        o.object("parameters");
-        spec.pi.parameters = json.at("observers")[s.observers.size()].at("parameters");
-      }
+      if (auto parameters = o.object("parameters")) spec.pi.parameters = parameters->json();
       o.finish({"type", "bank", "gains", "omega_bounds", "start", "substeps", "parameters"});
     } else if (spec.type == "luenberger") {
       spec.gain = o.matrix("gain").value_or(Eigen::MatrixXd());
@@ -289,7 +286,7 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
   }
   if (s.observers.empty()) r.fail("'observers' must list at least one observer");
   if (auto rep = r.object("reported")) {
-    const nlohmann::json& raw = json.at("reported");
+    const nlohmann::json& raw = rep->json();
     for (auto it = raw.begin(); it != raw.end(); ++it) {
       auto entry = rep->object(it.key());
       for (const char* key : {"mse", "first_window_iterations"}) {
