@@ -30,6 +30,9 @@ class Observer {
   virtual Eigen::Index window() const { return 0; }
   // Names of the signals in ObserverStep::extras (written beside x̂ by `nlobs run`).
   virtual std::vector<std::string> extra_names() const { return {}; }
+  // What a user should know about this observer's set-up (e.g. derivatives by finite
+  // differences because the model does not support AD); printed and kept in summary.json.
+  virtual std::vector<std::string> warnings() const { return {}; }
   virtual void reset() = 0;  // back to the initial guess, empty window
   // Sample k (consecutive from 0). A non-finite y means a missing measurement.
   virtual const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) = 0;

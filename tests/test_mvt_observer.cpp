@@ -1,0 +1,401 @@
+// The MVT observer of seed 001: the β problem (identity, row decoupling, degenerate pairs), the
+// paper's two cases on the chaotic example (published structure and our output injection), the
+// robot, the integrators, and bad input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "nlobs/models/discretization.hpp"
+#include "nlobs/models/systems.hpp"
+#include "nlobs/observers/mvt_observer.hpp"
+#include "nlobs/observers/simulation.hpp"
+#include "test_support.hpp"
+
+namespace nlobs {
+namespace {
+
+constexpr double kStep = 1e-3;  // sample time and RK4 step of plant and observer
+
+const Eigen::Vector3d kChaoticX0(-2.0, -1.0, -1.0), kChaoticXhat0(-1.0, -0.5, -1.5);
+const Eigen::Vector3d kCase2Error(-1.0, -0.5, 0.2);  // the paper's case 2: 0.2 instead of 0.5
+const Eigen::Vector4d kRobotX0(3, 3, 3, 3), kRobotXhat0(-1, -2, -0.5, -1);
+
+template <typename Model>
+Measurements simulate_continuous(const Model& model, const Eigen::VectorXd& x0, double t_end,
+                                 std::function<Eigen::VectorXd(long)> input = {}) {
+  SimulationOptions o;
+  o.steps = std::lround(t_end / kStep) + 1;
+  o.sample_time = kStep;
+  o.input = std::move(input);
+  return simulate(Discretized<Model>(model, kStep, Scheme::kRk4), x0, o);
+}
+
+Eigen::VectorXd robot_input(long k) {
+  return Eigen::VectorXd::Constant(1, std::sin(static_cast<double>(k) * kStep));
+}
+
+// Per sample: ‖x − x̂‖₂ and ‖(x − x̂) − ê‖₂, and the largest ‖X(β)‖ seen.
+struct Trace {
+  std::vector<double> error, tracking;
+  double max_residual = 0.0;
+  int failures = 0;
+  double max_error_from(double t) const {
+    double worst = 0.0;
+    for (size_t k = static_cast<size_t>(std::lround(t / kStep)); k < error.size(); ++k) {
+      worst = std::max(worst, error[k]);
+    }
+    return worst;
+  }
+};
+
+template <typename Model>
+Trace run(MvtObserver<Model>& observer, const Measurements& data) {
+  constexpr int n = Model::kStates;
+  Trace trace;
+  observer.reset();
+  for (long k = 0; k < data.steps(); ++k) {
+    const ObserverStep& s = observer.step(k, data.y.col(k), data.u.col(k));
+    if (!s.failure.empty()) ++trace.failures;
+    const Eigen::VectorXd e = data.x.col(k) - s.estimate;
+    trace.error.push_back(e.norm());
+    trace.tracking.push_back((e - s.extras.segment(1 + n, n)).norm());
+    trace.max_residual = std::max(trace.max_residual, s.extras[0]);
+  }
+  return trace;
+}
+
+MvtOptions options(MvtVariant variant, MvtBetaMethod method = MvtBetaMethod::kPerRow) {
+  MvtOptions o;
+  o.sample_time = kStep;
+  o.variant = variant;
+  o.beta.method = method;
+  return o;
+}
+
+// ---- the β problem -------------------------------------------------------------------------
+
+template <typename Model>
+void expect_mvt_identity(const Model& model, MvtBetaMethod method, unsigned seed) {
+  constexpr int n = Model::kStates;
+  using State = ModelVector<double, n>;
+  MvtBetaOptions o;
+  o.method = method;
+  MvtBetaSolver<Model> solver(model, o);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> box(-2.0, 2.0);
+  const typename MvtBetaSolver<Model>::Input u =
+      MvtBetaSolver<Model>::Input::Constant(model.inputs(), 0.3);
+  for (int trial = 0; trial < 50; ++trial) {
+    State xhat, ehat;
+    for (int i = 0; i < n; ++i) xhat[i] = box(rng), ehat[i] = box(rng);
+    ASSERT_TRUE(solver.set_pair(xhat, ehat, u, 0.0));
+    State beta = State::Constant(0.5);
+    const MvtBetaResult r = solver.solve(beta);
+    EXPECT_TRUE(r.converged) << "trial " << trial;
+    EXPECT_LE(r.residual_norm, 1e-8) << "trial " << trial;
+    EXPECT_GE(beta.minCoeff(), 0.0);
+    EXPECT_LE(beta.maxCoeff(), 1.0);
+    typename MvtBetaSolver<Model>::Jacobian d;
+    solver.mvt_jacobian(beta, d);
+    const State lhs = d * ehat, rhs = solver.f_w() - solver.f_xhat();  // D ê = F(x̂+ê) − F(x̂)
+    EXPECT_LE((lhs - rhs).norm(), 1e-8 * (1.0 + rhs.norm())) << "trial " << trial;
+  }
+}
+
+TEST(MvtBeta, IdentityHoldsAtTheSolvedBetaOnRandomPairs) {
+  for (MvtBetaMethod m : {MvtBetaMethod::kPerRow, MvtBetaMethod::kNlopt, MvtBetaMethod::kCeres}) {
+    SCOPED_TRACE(std::string(to_string(m)));
+    expect_mvt_identity(ChaoticNoLinear{}, m, 1);
+    expect_mvt_identity(FlexibleJointRobot{}, m, 2);
+  }
+}
+
+// Row decoupling: the joint engines, with no per-row help, land on the per-row roots.
+TEST(MvtBeta, RowDecouplingGivesTheJointSolution) {
+  const ChaoticNoLinear model;
+  MvtBetaOptions row_options, joint_options;
+  joint_options.polish_rows = false;
+  MvtBetaSolver<ChaoticNoLinear> rows(model, row_options);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> box(-1.5, 1.5), small(-0.4, 0.4);
+  for (MvtBetaMethod m : {MvtBetaMethod::kNlopt, MvtBetaMethod::kCeres}) {
+    joint_options.method = m;
+    MvtBetaSolver<ChaoticNoLinear> joint(model, joint_options);
+    int compared = 0;
+    for (int trial = 0; trial < 30; ++trial) {
+      Eigen::Vector3d xhat, ehat;
+      for (int i = 0; i < 3; ++i) xhat[i] = box(rng), ehat[i] = small(rng);
+      rows.set_pair(xhat, ehat, {}, 0.0);
+      joint.set_pair(xhat, ehat, {}, 0.0);
+      Eigen::Vector3d b_rows = Eigen::Vector3d::Constant(0.5), b_joint = b_rows;
+      rows.solve(b_rows);
+      const MvtBetaResult r = joint.solve(b_joint);
+      EXPECT_LE(r.residual_norm, 1e-8) << to_string(m) << " trial " << trial;
+      for (int i = 0; i < 3; ++i) {
+        // Rows 2 and 3 are bilinear: X_i is affine in β_i with slope −ê ∇²F_i ê; compare where
+        // that slope is clear of zero (elsewhere every β is a root).
+        const double slope = std::abs(rows.residual_row(i, 1.0) - rows.residual_row(i, 0.0));
+        if (slope < 1e-3) continue;
+        EXPECT_NEAR(b_rows[i], b_joint[i], 1e-6) << to_string(m) << " trial " << trial;
+        ++compared;
+      }
+    }
+    EXPECT_GE(compared, 60);
+  }
+}
+
+TEST(MvtBeta, DegeneratePairKeepsBeta) {
+  const ChaoticNoLinear model;
+  MvtBetaSolver<ChaoticNoLinear> solver(model, {});
+  const Eigen::Vector3d xhat(0.3, -0.2, 1.0);
+  ASSERT_TRUE(solver.set_pair(xhat, Eigen::Vector3d::Zero(), {}, 0.0));
+  Eigen::Vector3d beta(0.1, 0.7, 0.9);
+  const MvtBetaResult r = solver.solve(beta);
+  EXPECT_TRUE(r.degenerate);
+  EXPECT_EQ(r.residual_norm, 0.0);
+  EXPECT_EQ(beta, Eigen::Vector3d(0.1, 0.7, 0.9));
+  // Numerically zero: x̂ + ê rounds to x̂.
+  ASSERT_TRUE(solver.set_pair(xhat, Eigen::Vector3d::Constant(1e-30), {}, 0.0));
+  EXPECT_TRUE(solver.solve(beta).degenerate);
+  EXPECT_TRUE(beta.allFinite());
+}
+
+TEST(MvtBeta, BadOptions) {
+  const ChaoticNoLinear model;
+  MvtBetaOptions o;
+  o.tolerance = 0.0;
+  EXPECT_NE(test::message_of([&] { MvtBetaSolver<ChaoticNoLinear> s(model, o); })
+                .find("tolerance"),
+            std::string::npos);
+  o = {};
+  o.method = MvtBetaMethod::kNlopt;
+  o.nlopt_algorithm = "LN_BOBYQA";
+  EXPECT_NE(test::message_of([&] { MvtBetaSolver<ChaoticNoLinear> s(model, o); })
+                .find("gradient-based"),
+            std::string::npos);
+  EXPECT_NE(test::message_of([] { mvt_beta_method_from_string("bisection"); }).find("per-row"),
+            std::string::npos);
+}
+
+// ---- the paper's chaotic example -----------------------------------------------------------
+
+TEST(MvtObserver, Case1ErrorEstimateTracksTheTrueError) {
+  const Measurements data = simulate_continuous(ChaoticNoLinear{}, kChaoticX0, 15.0);
+  for (MvtVariant v : {MvtVariant::kPublished, MvtVariant::kOutputInjection}) {
+    MvtObserver<ChaoticNoLinear> observer(ChaoticNoLinear{}, kChaoticXhat0,
+                                          kChaoticX0 - kChaoticXhat0, options(v));
+    const Trace trace = run(observer, data);
+    EXPECT_EQ(trace.failures, 0);
+    EXPECT_LE(*std::max_element(trace.tracking.begin(), trace.tracking.end()), 1e-6);
+    EXPECT_LE(trace.error.back(), 1e-6);  // ‖x − x̂‖ at t = 15 (measured 2.4e-8)
+    EXPECT_LE(trace.max_residual, 1e-8);
+  }
+}
+
+// The published structure from ê(0) ≠ x(0) − x̂(0): ê decays to zero by itself while x3's
+// error stays at 0.06–0.18 (measured 0.0584 at t = 25) — x̂3 never learns it.
+TEST(MvtObserver, Case2PublishedLeavesTheUnmeasuredErrorUncorrected) {
+  const Measurements data = simulate_continuous(ChaoticNoLinear{}, kChaoticX0, 25.0);
+  MvtObserver<ChaoticNoLinear> observer(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error,
+                                        options(MvtVariant::kPublished));
+  const Trace trace = run(observer, data);
+  EXPECT_LE(trace.max_residual, 1e-8);
+  EXPECT_LE(observer.ehat().norm(), 1e-9);  // ê has (nearly) vanished
+  for (double t = 5.0; t <= 25.0; t += 2.5) {  // after ê's transient; x3's error dominates
+    const double e = trace.error[static_cast<size_t>(std::lround(t / kStep))];
+    EXPECT_GE(e, 0.05) << "t = " << t;
+    EXPECT_LE(e, 0.2) << "t = " << t;
+  }
+}
+
+TEST(MvtObserver, Case2WithOutputInjectionConverges) {
+  const Measurements data = simulate_continuous(ChaoticNoLinear{}, kChaoticX0, 30.0);
+  MvtObserver<ChaoticNoLinear> observer(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error,
+                                        options(MvtVariant::kOutputInjection));
+  const Trace trace = run(observer, data);
+  EXPECT_LE(trace.max_residual, 1e-8);
+  EXPECT_LE(trace.max_error_from(17.5), 1e-6);  // measured 6e-8 over [17.5, 30]
+}
+
+TEST(MvtObserver, JointBetaSolversGiveTheSameRun) {
+  const Measurements data = simulate_continuous(ChaoticNoLinear{}, kChaoticX0, 3.0);
+  MvtObserver<ChaoticNoLinear> rows(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error,
+                                    options(MvtVariant::kOutputInjection));
+  const Trace reference = run(rows, data);
+  for (MvtBetaMethod m : {MvtBetaMethod::kNlopt, MvtBetaMethod::kCeres}) {
+    MvtObserver<ChaoticNoLinear> joint(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error,
+                                       options(MvtVariant::kOutputInjection, m));
+    const Trace trace = run(joint, data);
+    EXPECT_LE(trace.max_residual, 1e-8) << to_string(m);
+    EXPECT_LE((joint.xhat() - rows.xhat()).norm(), 1e-9) << to_string(m);
+    EXPECT_EQ(joint.engine(), to_string(m));
+  }
+}
+
+TEST(MvtObserver, AdaptiveIntegratorMatchesRk4) {
+  const Measurements data = simulate_continuous(ChaoticNoLinear{}, kChaoticX0, 5.0);
+  MvtOptions o = options(MvtVariant::kOutputInjection);
+  o.integrator = MvtIntegrator::kDopri5;
+  MvtObserver<ChaoticNoLinear> observer(ChaoticNoLinear{}, kChaoticXhat0,
+                                        kChaoticX0 - kChaoticXhat0, o);
+  const Trace trace = run(observer, data);
+  EXPECT_LE(*std::max_element(trace.tracking.begin(), trace.tracking.end()), 1e-6);
+}
+
+TEST(MvtObserver, ExactStartStaysExactWithBetaKept) {
+  const Measurements data = simulate_continuous(ChaoticNoLinear{}, kChaoticX0, 2.0);
+  MvtObserver<ChaoticNoLinear> observer(ChaoticNoLinear{}, kChaoticX0, Eigen::Vector3d::Zero(),
+                                        options(MvtVariant::kOutputInjection));
+  const Trace trace = run(observer, data);
+  EXPECT_EQ(trace.failures, 0);
+  // The first samples interpolate y by lower-degree polynomials: measured 4.7e-9.
+  EXPECT_LE(*std::max_element(trace.error.begin(), trace.error.end()), 1e-8);
+  EXPECT_TRUE(observer.beta().allFinite());
+  EXPECT_TRUE(observer.gains().allFinite());
+}
+
+TEST(MvtObserver, MissingSamplesAreBridged) {
+  Measurements data = simulate_continuous(ChaoticNoLinear{}, kChaoticX0, 4.0);
+  MvtObserver<ChaoticNoLinear> reference(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error,
+                                         options(MvtVariant::kOutputInjection));
+  run(reference, data);
+  for (long k = 1000; k < 1005; ++k) data.y.col(k).setConstant(std::nan(""));
+  MvtObserver<ChaoticNoLinear> gapped(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error,
+                                      options(MvtVariant::kOutputInjection));
+  const Trace trace = run(gapped, data);
+  EXPECT_EQ(trace.failures, 0);
+  EXPECT_TRUE(gapped.step(4001, data.y.col(0).setConstant(std::nan("")), data.u.col(0))
+                  .measurement_missing);
+  EXPECT_LE((gapped.xhat() - reference.xhat()).norm(), 1e-4);
+}
+
+// ---- the flexible-joint robot --------------------------------------------------------------
+
+TEST(MvtObserver, RobotConvergesAndTheInjectionCorrectsTheUnmeasuredState) {
+  const Measurements data = simulate_continuous(FlexibleJointRobot{}, kRobotX0, 10.0, robot_input);
+  const Eigen::Vector4d other(4, 5, 3.5, 3);  // ê(0) ≠ x(0) − x̂(0) by 1 in x4
+  MvtObserver<FlexibleJointRobot> published(FlexibleJointRobot{}, kRobotXhat0, other,
+                                            options(MvtVariant::kPublished));
+  MvtObserver<FlexibleJointRobot> injected(FlexibleJointRobot{}, kRobotXhat0, other,
+                                           options(MvtVariant::kOutputInjection));
+  const Trace p = run(published, data), i = run(injected, data);
+  EXPECT_LE(p.max_residual, 1e-8);
+  EXPECT_LE(i.max_residual, 1e-8);
+  EXPECT_GE(p.error.back(), 1e-2);  // x4's error decays only through the plant (0.058 at 10 s)
+  // The floor: y's kinks from the held input, interpolated by a cubic (measured 1.3e-6).
+  EXPECT_LE(i.max_error_from(3.0), 5e-6);
+}
+
+// ---- bad input -----------------------------------------------------------------------------
+
+// F(x) leaves its domain for x1 > 1 (NaN).
+struct BrokenAbove : ModelSizes<2, 0, 1> {
+  template <typename T>
+  State<T> vector_field(const State<T>& x, const Input&, double) const {
+    using std::sqrt;
+    return State<T>(x[1], sqrt(1.0 - x[0]));
+  }
+  template <typename T>
+  Output<T> h(const State<T>& x) const {
+    return Output<T>(x[0]);
+  }
+};
+
+// Double-only vector field: no AD, finite differences with a warning.
+struct DoubleOnly : ModelSizes<2, 0, 1> {
+  State<double> vector_field(const State<double>& x, const Input&, double) const {
+    return State<double>(x[1], -std::sin(x[0]));
+  }
+  template <typename T>
+  Output<T> h(const State<T>& x) const {
+    return Output<T>(x[0]);
+  }
+};
+
+TEST(MvtObserverBadInput, OptionsAndOutputMap) {
+  const auto make = [](MvtOptions o) {
+    return test::message_of([&] {
+      MvtObserver<ChaoticNoLinear> m(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error, o);
+    });
+  };
+  MvtOptions o = options(MvtVariant::kPublished);
+  o.eta = 0.5;
+  EXPECT_NE(make(o).find("eta must be finite and >= 1"), std::string::npos);
+  o = options(MvtVariant::kPublished);
+  o.sample_time = 0.0;
+  EXPECT_NE(make(o).find("sample_time"), std::string::npos);
+  o = options(MvtVariant::kPublished);
+  o.injection_gain = -1.0;
+  EXPECT_NE(make(o).find("injection_gain"), std::string::npos);
+  o = options(MvtVariant::kPublished);
+  o.substeps = 0;
+  EXPECT_NE(make(o).find("substeps"), std::string::npos);
+  EXPECT_NE(test::message_of([] {
+              MvtObserver<ChaoticNoLinear> m(ChaoticNoLinear{},
+                                             Eigen::Vector3d(0, std::nan(""), 0),
+                                             kCase2Error, options(MvtVariant::kPublished));
+            }).find("x̂(0)"),
+            std::string::npos);
+  // Duffing measures x2: C = [0 1] is not [I_m 0].
+  const std::string c = test::message_of([] {
+    MvtObserver<Duffing> m(Duffing{}, Eigen::Vector2d(1, 0), Eigen::Vector2d(0.1, 0.1),
+                           options(MvtVariant::kPublished));
+  });
+  EXPECT_NE(c.find("C = [I_m 0]"), std::string::npos) << c;
+}
+
+TEST(MvtObserverBadInput, NonFiniteFKeepsTheLastGoodState) {
+  // x1 grows as x2 = 1 pushes it past 1, where F turns NaN.
+  Measurements data;
+  const long steps = 1500;
+  data.t = Eigen::VectorXd::LinSpaced(steps, 0.0, kStep * (steps - 1));
+  data.y = (0.5 + data.t.array()).matrix().transpose();
+  data.u.resize(0, steps);
+  MvtObserver<BrokenAbove> observer(BrokenAbove{}, Eigen::Vector2d(0.5, 1.0),
+                                    Eigen::Vector2d(0.0, 0.0), options(MvtVariant::kPublished));
+  long first_failure = -1;
+  Eigen::VectorXd last_good;
+  for (long k = 0; k < steps; ++k) {
+    const ObserverStep& s = observer.step(k, data.y.col(k), data.u.col(k));
+    if (!s.failure.empty()) {
+      first_failure = k;
+      EXPECT_EQ(s.failure, "non_finite");
+      EXPECT_NE(s.failure_message.find("not finite"), std::string::npos);
+      EXPECT_EQ(s.estimate, last_good);
+      break;
+    }
+    last_good = s.estimate;
+  }
+  EXPECT_GT(first_failure, 400);
+  EXPECT_TRUE(observer.xhat().allFinite());
+}
+
+TEST(MvtObserverBadInput, ModelWithoutJetSupportFallsBackToFiniteDifferences) {
+  MvtObserver<DoubleOnly> observer(DoubleOnly{}, Eigen::Vector2d(0.5, 0.0),
+                                   Eigen::Vector2d(0.2, -0.1), options(MvtVariant::kPublished));
+  ASSERT_EQ(observer.warnings().size(), 1u);
+  EXPECT_NE(observer.warnings()[0].find("central differences"), std::string::npos);
+  const DoubleOnly model;
+  MvtBetaSolver<DoubleOnly> solver(model, {});
+  const Eigen::Vector2d xhat(0.5, 0.0), ehat(0.8, -0.3);
+  ASSERT_TRUE(solver.set_pair(xhat, ehat, {}, 0.0));
+  Eigen::Vector2d beta = Eigen::Vector2d::Constant(0.5);
+  solver.solve(beta);
+  Eigen::Matrix2d d;
+  solver.mvt_jacobian(beta, d);
+  EXPECT_LE((d * ehat - (solver.f_w() - solver.f_xhat())).norm(), 1e-6);
+  EXPECT_NEAR(d(1, 0), -std::cos(0.5 + beta[1] * 0.8), 1e-7);
+}
+
+TEST(MvtObserverBadInput, WrongSampleSizeIsAnError) {
+  MvtObserver<ChaoticNoLinear> observer(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error,
+                                        options(MvtVariant::kPublished));
+  EXPECT_NE(test::message_of([&] {
+              observer.step(0, Eigen::VectorXd::Zero(3), Eigen::VectorXd());
+            }).find("2 outputs"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace nlobs
