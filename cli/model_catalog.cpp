@@ -1,7 +1,6 @@
 #include "model_catalog.hpp"
 
-#include "nlobs/models/modified_chua.hpp"
-#include "nlobs/models/systems.hpp"
+#include "model_visit.hpp"
 
 namespace nlobs::cli {
 namespace {
@@ -25,10 +24,6 @@ AnyModel discretize(const std::string& name, Model model, JsonReader& spec, doub
   } catch (const std::invalid_argument& e) {
     spec.fail(e.what());
   }
-}
-
-void set(JsonReader& r, const char* key, double& value) {
-  if (auto v = r.number(key)) value = *v;
 }
 
 }  // namespace
@@ -70,85 +65,10 @@ AnyModel make_model(JsonReader& spec) {
   std::optional<JsonReader> params = spec.object("parameters");
   static const nlohmann::json empty = nlohmann::json::object();
   JsonReader p = params ? *params : JsonReader(empty, spec.where() + ".parameters");
-  AnyModel model = [&]() -> AnyModel {
-    if (name == "modified-chua") {
-      ModifiedChuaParameters c;
-      set(p, "alpha", c.alpha), set(p, "beta", c.beta), set(p, "a", c.a), set(p, "b", c.b),
-          set(p, "d", c.d);
-      p.finish({"alpha", "beta", "a", "b", "d"});
-      try {
-        return discretize(name, ModifiedChua(c), spec, 0.05, Scheme::kEuler);
-      } catch (const std::invalid_argument& e) {
-        spec.fail(e.what());
-      }
-    }
-    if (name == "cubic-chua") {
-      CubicChua m;
-      set(p, "a", m.p.a), set(p, "b", m.p.b), set(p, "m0", m.p.m0), set(p, "m1", m.p.m1);
-      p.finish({"a", "b", "m0", "m1"});
-      return discretize(name, m, spec, 0.01, Scheme::kRk4);
-    }
-    if (name == "lorenz") {
-      Lorenz m;
-      set(p, "sigma", m.p.sigma), set(p, "rho", m.p.rho), set(p, "beta", m.p.beta);
-      p.finish({"sigma", "rho", "beta"});
-      return discretize(name, m, spec, 0.01, Scheme::kRk4);
-    }
-    if (name == "duffing") {
-      p.finish({});
-      return discretize(name, Duffing{}, spec, 0.01, Scheme::kRk4);
-    }
-    if (name == "van-der-pol") {
-      VanDerPol m;
-      set(p, "mu", m.mu);
-      p.finish({"mu"});
-      return discretize(name, m, spec, 0.01, Scheme::kRk4);
-    }
-    if (name == "oscillator") {
-      p.finish({});
-      return discretize(name, OscillatorNonlinearOutput{}, spec, 0.01, Scheme::kRk4);
-    }
-    if (name == "chaotic") {
-      p.finish({});
-      return discretize(name, ChaoticNoLinear{}, spec, 0.01, Scheme::kRk4);
-    }
-    if (name == "robot") {
-      FlexibleJointRobot m;
-      set(p, "k1", m.p.k1), set(p, "damping", m.p.damping), set(p, "k2", m.p.k2),
-          set(p, "gain", m.p.gain), set(p, "gravity", m.p.gravity);
-      p.finish({"k1", "damping", "k2", "gain", "gravity"});
-      return discretize(name, m, spec, 0.01, Scheme::kRk4);
-    }
-    if (name == "lander") {
-      LunarLander m;
-      set(p, "g", m.p.g), set(p, "sigma", m.p.sigma), set(p, "alpha", m.p.alpha);
-      p.finish({"g", "sigma", "alpha"});
-      return discretize(name, m, spec, 0.001, Scheme::kRk4);
-    }
-    if (name == "lander-f") {
-      LunarLanderImmersed m;
-      set(p, "g", m.p.g), set(p, "sigma", m.p.sigma), set(p, "alpha", m.p.alpha), set(p, "c", m.c);
-      p.finish({"g", "sigma", "alpha", "c"});
-      return discretize(name, m, spec, 0.001, Scheme::kRk4);
-    }
-    if (name == "unknown-input") {
-      UnknownInputIntegrator m;
-      set(p, "amplitude", m.amplitude), set(p, "omega", m.omega);
-      p.finish({"amplitude", "omega"});
-      return discretize(name, m, spec, 0.001, Scheme::kRk4);
-    }
-    if (name == "pendulum") {
-      PendulumTimeVaryingFriction m;
-      set(p, "g", m.p.g), set(p, "length", m.p.length), set(p, "c0", m.p.c0), set(p, "c1", m.p.c1),
-          set(p, "omega_c", m.p.omega_c), set(p, "a_max", m.p.a_max),
-          set(p, "omega_a", m.p.omega_a);
-      p.finish({"g", "length", "c0", "c1", "omega_c", "a_max", "omega_a"});
-      return discretize(name, m, spec, 0.01, Scheme::kRk4);
-    }
-    std::string list;
-    for (const auto& m : model_catalog()) list += (list.empty() ? "" : ", ") + m.name;
-    spec.fail("unknown model '" + name + "'; valid models: " + list);
-  }();
+  AnyModel model = visit_model(
+      name, p, spec, [&](auto m, double default_step, Scheme default_scheme) -> AnyModel {
+        return discretize(name, std::move(m), spec, default_step, default_scheme);
+      });
   spec.finish({"name", "parameters", "scheme", "step"});
   return model;
 }

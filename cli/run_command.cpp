@@ -1,5 +1,6 @@
 #include "run_command.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -8,6 +9,7 @@
 #include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <ostream>
 #include <sstream>
 #include <stdexcept>
@@ -120,6 +122,23 @@ std::string fmt(double v, const char* f = "%.3e") {
   return buf;
 }
 
+// MVT observers publish ‖X(β)‖ per step as the extra signal "residual" (beside β): its largest
+// value over the run, or nothing for other observers.
+std::optional<double> max_beta_residual(const RunResult& r, size_t i) {
+  const auto& names = r.extra_names[i];
+  const auto at = std::find(names.begin(), names.end(), "residual");
+  if (at == names.end() || std::find(names.begin(), names.end(), "beta1") == names.end()) {
+    return std::nullopt;
+  }
+  const Eigen::Index row = at - names.begin();
+  double worst = 0.0;
+  for (Eigen::Index k = 0; k < r.extras[i].cols(); ++k) {
+    const double v = r.extras[i](row, k);
+    if (std::isfinite(v)) worst = std::max(worst, v);
+  }
+  return worst;
+}
+
 void print_table(const Scenario& s, const Measurements& data, const RunResult& r,
                  std::ostream& out) {
   char line[512];
@@ -167,6 +186,21 @@ void print_table(const Scenario& s, const Measurements& data, const RunResult& r
       out << '\n';
     }
   }
+  if (data.has_truth()) {
+    out << "time from which ||x - xhat||_2 < 1e-3 to the end";
+    bool any_residual = false;
+    for (size_t i = 0; i < r.metrics.size(); ++i)
+      any_residual |= max_beta_residual(r, i).has_value();
+    out << (any_residual ? "; MVT: largest ||X(beta)||_2 over the run" : "") << ":\n";
+    for (size_t i = 0; i < r.metrics.size(); ++i) {
+      const long k = first_index_staying_below(data.x, r.estimates[i], 1e-3);
+      std::snprintf(line, sizeof line, "  %-24s %s", r.metrics[i].name.c_str(),
+                    k >= 0 ? ("t = " + fmt(data.t[k], "%.3f") + " s").c_str() : "never");
+      out << line;
+      if (const auto residual = max_beta_residual(r, i)) out << "   ||X|| " << fmt(*residual);
+      out << '\n';
+    }
+  }
   for (const ObserverMetrics& m : r.metrics) {
     if (!m.first_failure.empty())
       out << "first failure of " << m.name << ": " << m.first_failure << '\n';
@@ -210,6 +244,12 @@ nlohmann::json summary_json(const Scenario& s, const Measurements& data, const R
       o["max_error_after"] = vector_or_null(m.max_error_after);
     }
     if (!m.first_failure.empty()) o["first_failure"] = m.first_failure;
+    const size_t i = observers.size();
+    if (data.has_truth()) {
+      const long k = first_index_staying_below(data.x, r.estimates[i], 1e-3);
+      o["time_to_1e-3"] = k >= 0 ? nlohmann::json(data.t[k]) : nlohmann::json(nullptr);
+    }
+    if (const auto residual = max_beta_residual(r, i)) o["max_beta_residual"] = *residual;
     observers.push_back(o);
   }
   nlohmann::json j{{"scenario", s.name}, {"steps", data.steps()},  {"noise_std", s.noise},
@@ -401,6 +441,9 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
   }
   std::vector<std::string> warnings;
   const nlohmann::json bounds = pi_bounds_json(s, &warnings);
+  for (const auto& o : observers) {
+    for (const auto& w : o->warnings()) warnings.push_back(w);
+  }
   for (const auto& w : warnings) err << "nlobs: warning: " << w << '\n';
 
   const auto start = std::chrono::steady_clock::now();

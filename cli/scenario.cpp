@@ -122,11 +122,59 @@ const char* kPiLander = R"({
   ]
 })";
 
+// Seed 001, example 1 (METHODS §2): the chaotic system without linear term, y = (x1, x2),
+// x0 = (−2, −1, −1), x̂0 = (−1, −0.5, −1.5), η = 1, 30 s at 1 ms (plant RK4, observer RK4 at the
+// sample step, y between samples by the cubic through the last four samples). Case 1:
+// ê0 = x0 − x̂0; case 2: ê0's third entry 0.2 instead of 0.5. The published structure and our
+// output-injection correction (γ = 10) side by side, and an EKF on the same data.
+const char* kMvtChaotic = R"({
+  "name": "mvt-chaotic",
+  "model": {"name": "chaotic", "scheme": "rk4", "step": 0.001},
+  "x0": [-2.0, -1.0, -1.0],
+  "initial_guess": [-1.0, -0.5, -1.5],
+  "steps": 30001,
+  "settle_time": 20.0,
+  "observers": [
+    {"type": "mvt", "name": "mvt-case1", "variant": "published", "error_guess": [-1.0, -0.5, 0.5]},
+    {"type": "mvt", "name": "mvt-case1-injection", "variant": "injection",
+     "error_guess": [-1.0, -0.5, 0.5]},
+    {"type": "mvt", "name": "mvt-case2", "variant": "published", "error_guess": [-1.0, -0.5, 0.2]},
+    {"type": "mvt", "name": "mvt-case2-injection", "variant": "injection",
+     "error_guess": [-1.0, -0.5, 0.2]},
+    {"type": "ekf", "process_covariance": [[1e-10, 0, 0], [0, 1e-10, 0], [0, 0, 1e-10]],
+     "measurement_covariance": [[1e-6, 0], [0, 1e-6]],
+     "initial_covariance": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}
+  ]
+})";
+
+// Seed 001, example 2: the flexible-joint robot, u = sin t, y = (x1, x2, x3), x0 = (3, 3, 3, 3),
+// x̂0 = (−1, −2, −0.5, −1), η = 1, 15 s at 1 ms. The paper's ê0 = x0 − x̂0, and one that misses
+// x4 by 1 (published and corrected).
+const char* kMvtRobot = R"({
+  "name": "mvt-robot",
+  "model": {"name": "robot", "scheme": "rk4", "step": 0.001},
+  "x0": [3.0, 3.0, 3.0, 3.0],
+  "initial_guess": [-1.0, -2.0, -0.5, -1.0],
+  "steps": 15001,
+  "settle_time": 5.0,
+  "input": {"kind": "sin", "amplitude": 1.0, "frequency": 1.0},
+  "observers": [
+    {"type": "mvt", "name": "mvt", "variant": "published", "error_guess": [4.0, 5.0, 3.5, 4.0]},
+    {"type": "mvt", "name": "mvt-other-e0", "variant": "published",
+     "error_guess": [4.0, 5.0, 3.5, 3.0]},
+    {"type": "mvt", "name": "mvt-other-e0-injection", "variant": "injection",
+     "error_guess": [4.0, 5.0, 3.5, 3.0]},
+    {"type": "ekf", "process_covariance": [[1e-10, 0, 0, 0], [0, 1e-10, 0, 0], [0, 0, 1e-10, 0],
+                                           [0, 0, 0, 1e-10]],
+     "measurement_covariance": [[1e-6, 0, 0], [0, 1e-6, 0], [0, 0, 1e-6]],
+     "initial_covariance": [[10, 0, 0, 0], [0, 10, 0, 0], [0, 0, 10, 0], [0, 0, 0, 10]]}
+  ]
+})";
+
 const std::map<std::string, const char*>& builtin_texts() {
-  static const std::map<std::string, const char*> texts = {{"chua-fp", kChuaFp},
-                                                           {"pi-linear", kPiLinear},
-                                                           {"pi-chua", kPiChua},
-                                                           {"pi-lander", kPiLander}};
+  static const std::map<std::string, const char*> texts = {
+      {"chua-fp", kChuaFp},     {"pi-linear", kPiLinear},     {"pi-chua", kPiChua},
+      {"pi-lander", kPiLander}, {"mvt-chaotic", kMvtChaotic}, {"mvt-robot", kMvtRobot}};
   return texts;
 }
 
@@ -256,6 +304,15 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
       spec.pi.substeps = static_cast<int>(substeps);
       if (auto parameters = o.object("parameters")) spec.pi.parameters = parameters->json();
       o.finish({"type", "bank", "gains", "omega_bounds", "start", "substeps", "parameters"});
+    } else if (spec.type == "mvt") {
+      spec.mvt = parse_mvt_spec(o);
+      if (spec.mvt.error_guess.size() != model.states()) {
+        o.fail("'error_guess' must have " + std::to_string(model.states()) +
+               " entries (the model's states)");
+      }
+      spec.initial = o.vector("initial");
+      o.finish({"type", "name", "error_guess", "eta", "variant", "injection_gain", "beta_solver",
+                "integrator", "substeps", "initial"});
     } else if (spec.type == "luenberger") {
       spec.gain = o.matrix("gain").value_or(Eigen::MatrixXd());
       if (spec.gain.size() == 0) o.fail("missing field 'gain'");
@@ -280,7 +337,7 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
                 "initial", "model"});
     } else {
       o.fail("unknown observer type '" + spec.type +
-             "'; valid: window, luenberger, sliding_mode, ekf, pi_bank");
+             "'; valid: window, luenberger, sliding_mode, ekf, pi_bank, mvt");
     }
     s.observers.push_back(std::move(spec));
   }
@@ -346,6 +403,8 @@ nlohmann::json to_json(const Scenario& s) {
       jo["start"] = o.pi.start;
       jo["substeps"] = o.pi.substeps;
       jo["parameters"] = o.pi.parameters;
+    } else if (o.type == "mvt") {
+      write_mvt_spec(o.mvt, jo);
     } else if (o.type == "ekf") {
       if (o.process_covariance.size()) jo["process_covariance"] = matrix_json(o.process_covariance);
       if (o.measurement_covariance.size()) {
@@ -393,6 +452,8 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& s, const A
     try {
       if (o.type == "pi_bank") {
         out.push_back(make_pi_bank(o.pi, model, where));
+      } else if (o.type == "mvt") {
+        out.push_back(make_mvt_observer(o.mvt, s.model, start, model.sample_time(), where));
       } else if (o.type == "window") {
         SolverOptions options;
         if (o.tol) {

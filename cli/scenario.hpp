@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "mvt_observers.hpp"
 #include "nlobs/observers/any_model.hpp"
 #include "nlobs/observers/observer.hpp"
 #include "pi_banks.hpp"
@@ -18,7 +19,7 @@
 namespace nlobs::cli {
 
 struct ObserverSpec {
-  std::string type;  // "window", "luenberger", "sliding_mode", "ekf", "pi_bank"
+  std::string type;  // "window", "luenberger", "sliding_mode", "ekf", "pi_bank", "mvt"
   // window
   std::string engine = "newton";
   std::optional<double> tol{};  // step and residual tolerance of the engine
@@ -34,6 +35,7 @@ struct ObserverSpec {
   // time as the scenario's), e.g. one that assumes an unknown input constant
   std::optional<nlohmann::json> model{};
   PiBankSpec pi{};  // pi_bank
+  MvtSpec mvt{};    // mvt
 };
 
 struct InputSpec {

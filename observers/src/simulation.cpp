@@ -36,6 +36,18 @@ Eigen::VectorXd max_abs_error(const Eigen::MatrixXd& truth, const Eigen::MatrixX
   return out;
 }
 
+long first_index_staying_below(const Eigen::MatrixXd& truth, const Eigen::MatrixXd& estimate,
+                               double threshold) {
+  samples_from("first_index_staying_below", truth, estimate, 0);
+  long first = -1;
+  for (long k = static_cast<long>(truth.cols()) - 1; k >= 0; --k) {
+    const double e = (truth.col(k) - estimate.col(k)).norm();
+    if (!(e < threshold)) break;  // NaN is not below
+    first = k;
+  }
+  return first;
+}
+
 RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Observer>>& observers,
                         long settle_index,
                         const std::function<void(long done, long total)>& progress) {

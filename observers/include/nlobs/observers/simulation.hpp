@@ -130,4 +130,9 @@ Eigen::VectorXd max_abs_error(const Eigen::MatrixXd& truth, const Eigen::MatrixX
 Eigen::VectorXd mean_squared_error(const Eigen::MatrixXd& truth, const Eigen::MatrixXd& estimate,
                                    long from = 0);
 
+// The first sample index from which ‖x_k − x̂_k‖₂ < threshold for every later sample (a
+// non-finite estimate counts as above); -1 when the last sample is not below it.
+long first_index_staying_below(const Eigen::MatrixXd& truth, const Eigen::MatrixXd& estimate,
+                               double threshold);
+
 }  // namespace nlobs
