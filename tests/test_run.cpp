@@ -330,5 +330,64 @@ TEST(RunPi, BadPiBankSpecsNameTheProblem) {
   EXPECT_NE(error_of(f.string()).find("sizes and sample time"), std::string::npos);
 }
 
+TEST(RunMvt, ChaoticCasesAsDocumented) {
+  std::string err;
+  const nlohmann::json s = run_summary("mvt-chaotic", &err);
+  for (const char* name :
+       {"mvt-case1", "mvt-case1-injection", "mvt-case2", "mvt-case2-injection"}) {
+    const auto& o = observer_of(s, name);
+    EXPECT_LE(o["max_beta_residual"].get<double>(), 1e-8) << name;
+    EXPECT_TRUE(o["failures"].empty()) << name;
+  }
+  // Case 1: below 1e-3 from t = 2.73 s, both variants (the correction sees ν ≡ 0).
+  EXPECT_NEAR(observer_of(s, "mvt-case1")["time_to_1e-3"].get<double>(), 2.727, 0.01);
+  EXPECT_NEAR(observer_of(s, "mvt-case1-injection")["time_to_1e-3"].get<double>(), 2.727, 0.01);
+  // Case 2 as published never gets there; corrected, it does (t = 4.02 s measured).
+  EXPECT_TRUE(observer_of(s, "mvt-case2")["time_to_1e-3"].is_null());
+  EXPECT_LT(observer_of(s, "mvt-case2-injection")["time_to_1e-3"].get<double>(), 6.0);
+  EXPECT_GT(observer_of(s, "mvt-case2")["max_error_after"][2].get<double>(), 0.05);
+  EXPECT_LT(observer_of(s, "mvt-case2-injection")["max_error_after"][2].get<double>(), 1e-6);
+  EXPECT_FALSE(observer_of(s, "ekf").contains("max_beta_residual"));
+  EXPECT_TRUE(observer_of(s, "ekf").contains("time_to_1e-3"));
+  // β and ‖X(β)‖ per sample, the paper's Figs. 2 and 3.
+  std::ifstream csv(scratch("mvt-chaotic") / "trajectories.csv");
+  std::string header;
+  std::getline(csv, header);
+  for (const char* column : {"mvt-case1.signal.residual", "mvt-case1.signal.beta3",
+                             "mvt-case2-injection.signal.ehat3"}) {
+    EXPECT_NE(header.find(column), std::string::npos) << column;
+  }
+}
+
+TEST(RunMvt, RobotScenarioRunsBesideTheEkf) {
+  const nlohmann::json s = run_summary("mvt-robot");
+  EXPECT_LT(observer_of(s, "mvt")["time_to_1e-3"].get<double>(), 1.0);
+  EXPECT_TRUE(observer_of(s, "mvt-other-e0")["time_to_1e-3"].is_null());
+  EXPECT_LT(observer_of(s, "mvt-other-e0-injection")["max_error_after"][3].get<double>(), 1e-6);
+  EXPECT_LE(observer_of(s, "mvt-other-e0-injection")["max_beta_residual"].get<double>(), 1e-8);
+}
+
+TEST(RunMvt, ScenariosRoundTripAndBadSpecsNameTheProblem) {
+  for (const char* name : {"mvt-chaotic", "mvt-robot"}) {
+    const nlohmann::json j = to_json(load_scenario(name));
+    EXPECT_EQ(to_json(parse_scenario(j, "round trip")), j) << name;
+  }
+  const fs::path f = scratch("bad_mvt.json");
+  const auto scenario = [](const std::string& model, const std::string& observer) {
+    return R"({"name": "x", "model": {"name": ")" + model +
+           R"("}, "x0": [0, 0, 0], "initial_guess": [0, 0, 0], "steps": 10, "observers": [)" +
+           observer + "]}";
+  };
+  write(f, scenario("chaotic", R"({"type": "mvt", "error_guess": [1, 1]})"));
+  EXPECT_NE(error_of(f.string()).find("'error_guess' must have 3 entries"), std::string::npos);
+  write(f, scenario("chaotic", R"({"type": "mvt", "error_guess": [1, 1, 1], "eta": 0.5})"));
+  EXPECT_NE(error_of(f.string()).find("'eta' must be >= 1"), std::string::npos);
+  write(f, scenario("chaotic", R"({"type": "mvt", "error_guess": [1, 1, 1], "beta_solver": "x"})"));
+  EXPECT_NE(error_of(f.string()).find("per-row, nlopt or ceres"), std::string::npos);
+  // The cubic Chua circuit measures x2: not y = [I_m 0] x.
+  write(f, scenario("cubic-chua", R"({"type": "mvt", "error_guess": [1, 1, 1]})"));
+  EXPECT_NE(error_of(f.string()).find("C = [I_m 0]"), std::string::npos) << error_of(f.string());
+}
+
 }  // namespace
 }  // namespace nlobs::cli
