@@ -7,6 +7,8 @@
 #include <new>
 #include <vector>
 
+#include "nlobs/models/systems.hpp"
+#include "nlobs/observers/mvt_observer.hpp"
 #include "nlobs/observers/pi_bank.hpp"
 #include "nlobs/solvers/ceres_engine.hpp"
 #include "nlobs/solvers/solvers.hpp"
@@ -119,6 +121,25 @@ TEST(Allocations, PiBankStepAllocatesNothing) {
     observer.step(k, yk, uk);
   }
   EXPECT_EQ(g_allocations.load() - before, 0);
+}
+
+// An MVT step with the per-row β search (secant, grid, TOMS 748, Brent) and RK4 on std::array
+// states: fixed-size work only, with ê far from zero so every β problem is solved.
+TEST(Allocations, MvtStepWithPerRowBetaAllocatesNothing) {
+  MvtOptions o;
+  o.sample_time = 1e-3;
+  MvtObserver<FlexibleJointRobot> observer(FlexibleJointRobot{}, Eigen::Vector4d(-1, -2, -0.5, -1),
+                                           Eigen::Vector4d(4, 5, 3.5, 3), o);
+  Eigen::VectorXd yk = Eigen::Vector3d(3, 3, 3), uk = Eigen::VectorXd::Zero(1);
+  observer.step(0, yk, uk);
+  const long before = g_allocations.load();
+  for (long k = 1; k < 100; ++k) {
+    yk += Eigen::Vector3d::Constant(1e-3);
+    uk[0] = std::sin(1e-3 * static_cast<double>(k));
+    observer.step(k, yk, uk);
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_GT(observer.ehat().norm(), 1e-3);  // the β problems were real ones
 }
 
 }  // namespace

@@ -165,15 +165,14 @@ TEST(MvtBeta, BadOptions) {
   const ChaoticNoLinear model;
   MvtBetaOptions o;
   o.tolerance = 0.0;
-  EXPECT_NE(test::message_of([&] { MvtBetaSolver<ChaoticNoLinear> s(model, o); })
-                .find("tolerance"),
+  EXPECT_NE(test::message_of([&] { MvtBetaSolver<ChaoticNoLinear> s(model, o); }).find("tolerance"),
             std::string::npos);
   o = {};
   o.method = MvtBetaMethod::kNlopt;
   o.nlopt_algorithm = "LN_BOBYQA";
-  EXPECT_NE(test::message_of([&] { MvtBetaSolver<ChaoticNoLinear> s(model, o); })
-                .find("gradient-based"),
-            std::string::npos);
+  EXPECT_NE(
+      test::message_of([&] { MvtBetaSolver<ChaoticNoLinear> s(model, o); }).find("gradient-based"),
+      std::string::npos);
   EXPECT_NE(test::message_of([] { mvt_beta_method_from_string("bisection"); }).find("per-row"),
             std::string::npos);
 }
@@ -201,7 +200,7 @@ TEST(MvtObserver, Case2PublishedLeavesTheUnmeasuredErrorUncorrected) {
                                         options(MvtVariant::kPublished));
   const Trace trace = run(observer, data);
   EXPECT_LE(trace.max_residual, 1e-8);
-  EXPECT_LE(observer.ehat().norm(), 1e-9);  // ê has (nearly) vanished
+  EXPECT_LE(observer.ehat().norm(), 1e-9);     // ê has (nearly) vanished
   for (double t = 5.0; t <= 25.0; t += 2.5) {  // after ê's transient; x3's error dominates
     const double e = trace.error[static_cast<size_t>(std::lround(t / kStep))];
     EXPECT_GE(e, 0.05) << "t = " << t;
@@ -315,9 +314,8 @@ struct DoubleOnly : ModelSizes<2, 0, 1> {
 
 TEST(MvtObserverBadInput, OptionsAndOutputMap) {
   const auto make = [](MvtOptions o) {
-    return test::message_of([&] {
-      MvtObserver<ChaoticNoLinear> m(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error, o);
-    });
+    return test::message_of(
+        [&] { MvtObserver<ChaoticNoLinear> m(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error, o); });
   };
   MvtOptions o = options(MvtVariant::kPublished);
   o.eta = 0.5;
@@ -332,8 +330,7 @@ TEST(MvtObserverBadInput, OptionsAndOutputMap) {
   o.substeps = 0;
   EXPECT_NE(make(o).find("substeps"), std::string::npos);
   EXPECT_NE(test::message_of([] {
-              MvtObserver<ChaoticNoLinear> m(ChaoticNoLinear{},
-                                             Eigen::Vector3d(0, std::nan(""), 0),
+              MvtObserver<ChaoticNoLinear> m(ChaoticNoLinear{}, Eigen::Vector3d(0, std::nan(""), 0),
                                              kCase2Error, options(MvtVariant::kPublished));
             }).find("x̂(0)"),
             std::string::npos);

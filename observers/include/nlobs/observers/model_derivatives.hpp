@@ -17,9 +17,9 @@ namespace nlobs {
 
 // True when `vector_field` accepts ceres::Jet states (the model can be differentiated by AD).
 template <typename Model>
-concept JetDifferentiable =
-    requires(const Model m, const ModelVector<ceres::Jet<double, Model::kStates>, Model::kStates>& x,
-             const ModelVector<double, Model::kInputs>& u) {
+concept JetDifferentiable = requires(
+    const Model m, const ModelVector<ceres::Jet<double, Model::kStates>, Model::kStates>& x,
+    const ModelVector<double, Model::kInputs>& u) {
   // The result must be Jet-valued: a double-only vector field would accept the Jets through
   // Eigen's converting constructor and fail only when instantiated.
   {

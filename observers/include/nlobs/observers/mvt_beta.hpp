@@ -60,7 +60,7 @@ struct MvtBetaOptions {
   // Target |X_i(β_i)| (absolute). A row whose residual cannot get below the rounding floor
   // 8ε(|F_i(x̂)| + |F_i(x̂ + ê)|) stops there.
   double tolerance = 1e-12;
-  int max_iterations = 60;                  // per row (per-row) or per solve (nlopt, ceres)
+  int max_iterations = 60;                   // per row (per-row) or per solve (nlopt, ceres)
   std::string nlopt_algorithm = "LD_SLSQP";  // a gradient-based NLopt algorithm with bounds
   // nlopt, ceres: rows the joint solve left above their tolerance get the per-row search. A
   // minimiser of ½‖X‖² can stop at a bound where X_i ≠ 0 but ∂(X_i²)/∂β_i points outward (the
@@ -90,7 +90,8 @@ class MvtBetaSolver {
     if (!(options_.tolerance > 0.0) || !std::isfinite(options_.tolerance)) {
       throw InvalidInput("MvtBetaOptions::tolerance must be finite and > 0");
     }
-    if (options_.max_iterations < 1) throw InvalidInput("MvtBetaOptions::max_iterations must be >= 1");
+    if (options_.max_iterations < 1)
+      throw InvalidInput("MvtBetaOptions::max_iterations must be >= 1");
     if (options_.method != MvtBetaMethod::kPerRow) make_engine();
   }
   MvtBetaSolver(const MvtBetaSolver&) = delete;
@@ -289,8 +290,8 @@ class MvtBetaSolver {
 
   ModelDerivatives<Model> derivatives_;
   MvtBetaOptions options_;
-  State xhat_ = State::Zero(), ehat_ = State::Zero(), f_xhat_ = State::Zero(),
-        f_w_ = State::Zero(), delta_ = State::Zero();
+  State xhat_ = State::Zero(), ehat_ = State::Zero(), f_xhat_ = State::Zero(), f_w_ = State::Zero(),
+        delta_ = State::Zero();
   Input u_ = Input::Zero();
   double t_ = 0.0;
   bool degenerate_ = true;

@@ -58,7 +58,7 @@ struct MvtOptions {
   double injection_gain = 10.0;
   MvtBetaOptions beta{};
   MvtIntegrator integrator = MvtIntegrator::kRk4;
-  int substeps = 1;                                           // RK4 steps per sample interval
+  int substeps = 1;                                               // RK4 steps per sample interval
   double absolute_tolerance = 1e-10, relative_tolerance = 1e-10;  // kDopri5
 };
 
@@ -148,8 +148,8 @@ class MvtObserver final : public Observer {
   // (warm-started from the last β, which it updates) and returns false, with zero
   // derivatives and a message, when F is not finite at x̂ or x̂ + ê. For continuous-time use
   // without samples (an ODE solver of the caller's choice).
-  bool derivatives(double t, const State& xhat, const State& ehat, const Output& y,
-                   const Input& u, State& dxhat, State& dehat) {
+  bool derivatives(double t, const State& xhat, const State& ehat, const Output& y, const Input& u,
+                   State& dxhat, State& dehat) {
     if (!beta_solver_->set_pair(xhat, ehat, u, t) || !y.allFinite()) {
       dxhat.setZero();
       dehat.setZero();
@@ -187,9 +187,9 @@ class MvtObserver final : public Observer {
       beta_solver_->derivatives().jacobian(State(xhat + ehat), u, t, j_w_);
       // K_b ν = J_ba ν + γ J_abᵀ Ḡ_a ν
       dehat.tail(N - P).noalias() +=
-          j_w_.bottomLeftCorner(N - P, P) * nu +
-          options_.injection_gain * j_w_.topRightCorner(P, N - P).transpose() *
-              gains_.template head<P>().cwiseProduct(nu);
+          j_w_.bottomLeftCorner(N - P, P) * nu + options_.injection_gain *
+                                                     j_w_.topRightCorner(P, N - P).transpose() *
+                                                     gains_.template head<P>().cwiseProduct(nu);
     }
     return true;
   }
@@ -283,8 +283,7 @@ class MvtObserver final : public Observer {
     const auto rhs = [this, &finite](const Augmented& z, Augmented& dz, double t) {
       State dx, de;
       finite = derivatives(t, Eigen::Map<const State>(z.data()),
-                           Eigen::Map<const State>(z.data() + N), output_at(t), last_u_, dx,
-                           de) &&
+                           Eigen::Map<const State>(z.data() + N), output_at(t), last_u_, dx, de) &&
                finite;
       Eigen::Map<State>(dz.data()) = dx;
       Eigen::Map<State>(dz.data() + N) = de;
@@ -332,8 +331,7 @@ class MvtObserver final : public Observer {
   State xhat0_ = State::Zero(), ehat0_ = State::Zero();
   std::unique_ptr<MvtBetaSolver<Model>> beta_solver_;
   std::vector<std::string> warnings_, extra_names_;
-  State xhat_ = State::Zero(), ehat_ = State::Zero(), beta_ = State::Zero(),
-        gains_ = State::Zero();
+  State xhat_ = State::Zero(), ehat_ = State::Zero(), beta_ = State::Zero(), gains_ = State::Zero();
   Jacobian d_ = Jacobian::Zero(), j_w_ = Jacobian::Zero();
   bool started_ = false;
   int samples_ = 0;
