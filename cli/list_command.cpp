@@ -39,7 +39,10 @@ void print_list(const std::string& what, std::ostream& out) {
            "measurement_covariance, initial_covariance\n"
         << "  (luenberger, sliding_mode, ekf also take 'model': their own design model)\n"
         << "  pi_bank — model-free PI observers of seed 002: bank, gains ([k_p, k_i] per "
-           "channel), omega_bounds ({channel: N}), start (paper|zero), substeps, parameters\n";
+           "channel), omega_bounds ({channel: N}), start (paper|zero), substeps, parameters\n"
+        << "  mvt — mean-value-theorem observer of seed 001, models with y = [I_m 0] x: "
+           "error_guess (required), name, variant (injection|published), injection_gain, eta, "
+           "beta_solver (per-row|nlopt|ceres), integrator (rk4|dopri5), substeps, initial\n";
     for (const auto& b : pi_bank_catalog()) {
       out << "      bank " << b.name << ": " << b.description << "; channels";
       for (const auto& c : b.channels) out << ' ' << c;

@@ -4,6 +4,7 @@
 //     f(model, default_step, default_scheme)
 // with the continuous model. make_model discretises it; observers that need the continuous,
 // AD-capable model (the MVT observer) build themselves from it.
+#include <optional>
 #include <string>
 
 #include "json_reader.hpp"
@@ -28,11 +29,13 @@ decltype(auto) visit_model(const std::string& name, JsonReader& p, JsonReader& w
     set_parameter(p, "alpha", c.alpha), set_parameter(p, "beta", c.beta),
         set_parameter(p, "a", c.a), set_parameter(p, "b", c.b), set_parameter(p, "d", c.d);
     p.finish({"alpha", "beta", "a", "b", "d"});
-    try {
-      return f(ModifiedChua(c), 0.05, Scheme::kEuler);
+    std::optional<ModifiedChua> model;
+    try {  // only the parameter check: f's own errors keep their own location
+      model.emplace(c);
     } catch (const std::invalid_argument& e) {
       p.fail(e.what());
     }
+    return f(std::move(*model), 0.05, Scheme::kEuler);
   }
   if (name == "cubic-chua") {
     CubicChua m;

@@ -33,7 +33,8 @@
 // On samples: the interval [t_{k−1}, t_k] is integrated when y_k arrives (Boost.Odeint, RK4
 // with `substeps` steps per sample, or adaptive Dormand–Prince); y between samples is the cubic
 // through the last four good samples, u is held (the plant's sampled input). β is solved inside
-// the right-hand side at every evaluation, warm-started from the last β.
+// the right-hand side at every evaluation, warm-started from the last β. The β and Ḡ published
+// with x̂_k are those of the step's last right-hand side (RK4's last stage, at t_k).
 #include <array>
 #include <boost/numeric/odeint.hpp>
 #include <cmath>
@@ -137,6 +138,8 @@ class MvtObserver final : public Observer {
     max_residual_ = 0.0;
   }
 
+  // Why the last failed derivatives() call failed (empty if none since the last step()).
+  const std::string& last_failure() const { return failure_; }
   const State& xhat() const { return xhat_; }
   const State& ehat() const { return ehat_; }
   const State& beta() const { return beta_; }
@@ -145,24 +148,31 @@ class MvtObserver final : public Observer {
   MvtBetaSolver<Model>& beta_solver() { return *beta_solver_; }
 
   // The right-hand side (METHODS §2) at t for the state (x̂, ê), with y and u given: solves β
-  // (warm-started from the last β, which it updates) and returns false, with zero
-  // derivatives and a message, when F is not finite at x̂ or x̂ + ê. For continuous-time use
-  // without samples (an ODE solver of the caller's choice).
+  // (warm-started from the last β; β, Ḡ and D are updated) and returns false, with zero
+  // derivatives, when y, u, F or ∂F is not finite — the first such reason since the last
+  // step() is last_failure(). For continuous-time use without samples (an ODE solver of the
+  // caller's choice).
   bool derivatives(double t, const State& xhat, const State& ehat, const Output& y, const Input& u,
                    State& dxhat, State& dehat) {
-    if (!beta_solver_->set_pair(xhat, ehat, u, t) || !y.allFinite()) {
+    const bool data_ok = y.allFinite() && u.allFinite();
+    if (!data_ok || !beta_solver_->set_pair(xhat, ehat, u, t)) {
       dxhat.setZero();
       dehat.setZero();
       if (failure_.empty()) {
         std::ostringstream os;
-        os << name_ << ": F is not finite at t = " << t << " (x̂ = " << xhat.transpose()
-           << ", x̂ + ê = " << (xhat + ehat).transpose() << ")";
+        if (data_ok) {
+          os << name_ << ": F is not finite at t = " << t << " (x̂ = " << xhat.transpose()
+             << ", x̂ + ê = " << (xhat + ehat).transpose() << ")";
+        } else {
+          os << name_ << ": y or u is not finite at t = " << t;
+        }
         failure_ = os.str();
       }
       return false;
     }
     const MvtBetaResult r = beta_solver_->solve(beta_);
-    max_residual_ = std::max(max_residual_, r.residual_norm);
+    // NaN-propagating maximum: an unsolvable β problem must show in the report.
+    if (!(r.residual_norm <= max_residual_)) max_residual_ = r.residual_norm;
     beta_solver_->mvt_jacobian(beta_, d_);
     if (!d_.allFinite()) {
       dxhat.setZero();
@@ -205,6 +215,11 @@ class MvtObserver final : public Observer {
     step_.measurement_missing = !y.allFinite();
     step_.ready = true;
     max_residual_ = 0.0;
+    if (!u.allFinite()) {  // the plant's input is known by assumption: an error, state kept
+      step_.failure = "non_finite";
+      step_.failure_message = name_ + ": u_k is not finite at t = " + std::to_string(t);
+      return publish();
+    }
     if (step_.measurement_missing) return publish();  // hold; the next sample bridges the gap
     push_sample(t, y);
     if (!started_) {
@@ -276,6 +291,8 @@ class MvtObserver final : public Observer {
   bool integrate(double t0, double t1) {
     namespace odeint = boost::numeric::odeint;
     failure_.clear();
+    const State beta0 = beta_, gains0 = gains_;
+    const Jacobian d0 = d_;
     Augmented s;
     Eigen::Map<State>(s.data()) = xhat_;
     Eigen::Map<State>(s.data() + N) = ehat_;
@@ -309,6 +326,7 @@ class MvtObserver final : public Observer {
     const State x = Eigen::Map<const State>(s.data()), e = Eigen::Map<const State>(s.data() + N);
     if (!finite || !x.allFinite() || !e.allFinite()) {
       if (failure_.empty()) failure_ = name_ + ": the state is not finite after the step";
+      beta_ = beta0, gains_ = gains0, d_ = d0;  // all that is published stays the last good step's
       return false;
     }
     xhat_ = x;
