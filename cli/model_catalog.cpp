@@ -62,11 +62,8 @@ const std::vector<ModelInfo>& model_catalog() {
 
 AnyModel make_model(JsonReader& spec) {
   const std::string name = spec.required_text("name");
-  std::optional<JsonReader> params = spec.object("parameters");
-  static const nlohmann::json empty = nlohmann::json::object();
-  JsonReader p = params ? *params : JsonReader(empty, spec.where() + ".parameters");
-  AnyModel model = visit_model(
-      name, p, spec, [&](auto m, double default_step, Scheme default_scheme) -> AnyModel {
+  AnyModel model =
+      visit_model(spec, [&](auto m, double default_step, Scheme default_scheme) -> AnyModel {
         return discretize(name, std::move(m), spec, default_step, default_scheme);
       });
   spec.finish({"name", "parameters", "scheme", "step"});

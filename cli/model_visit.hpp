@@ -1,6 +1,6 @@
 #pragma once
-// The catalogue's models as their own C++ types: visit_model reads the parameters of the model
-// `name` from `p` (strictly: an unknown key is an error naming it) and calls
+// The catalogue's models as their own C++ types: visit_model reads the model's name and
+// parameters from its spec (strictly: an unknown key is an error naming it) and calls
 //     f(model, default_step, default_scheme)
 // with the continuous model. make_model discretises it; observers that need the continuous,
 // AD-capable model (the MVT observer) build themselves from it.
@@ -20,10 +20,14 @@ inline void set_parameter(JsonReader& r, const char* key, double& value) {
 }
 }  // namespace detail
 
-// `where` names the model object in errors about the name itself.
+// `spec` is the model object {"name", "parameters", ...}; its other keys are the caller's.
 template <typename F>
-decltype(auto) visit_model(const std::string& name, JsonReader& p, JsonReader& where, F&& f) {
+decltype(auto) visit_model(JsonReader& spec, F&& f) {
   using detail::set_parameter;
+  const std::string name = spec.required_text("name");
+  std::optional<JsonReader> params = spec.object("parameters");
+  static const nlohmann::json empty = nlohmann::json::object();
+  JsonReader p = params ? *params : JsonReader(empty, spec.where() + ".parameters");
   if (name == "modified-chua") {
     ModifiedChuaParameters c;
     set_parameter(p, "alpha", c.alpha), set_parameter(p, "beta", c.beta),
@@ -108,7 +112,7 @@ decltype(auto) visit_model(const std::string& name, JsonReader& p, JsonReader& w
   }
   std::string list;
   for (const auto& m : model_catalog()) list += (list.empty() ? "" : ", ") + m.name;
-  where.fail("unknown model '" + name + "'; valid models: " + list);
+  spec.fail("unknown model '" + name + "'; valid models: " + list);
 }
 
 }  // namespace nlobs::cli

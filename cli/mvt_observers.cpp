@@ -57,11 +57,7 @@ std::unique_ptr<Observer> make_mvt_observer(const MvtSpec& spec, const nlohmann:
   options.integrator = spec.integrator == "dopri5" ? MvtIntegrator::kDopri5 : MvtIntegrator::kRk4;
   options.substeps = spec.substeps;
   JsonReader reader(model, where + ".model");
-  const std::string name = reader.required_text("name");
-  std::optional<JsonReader> params = reader.object("parameters");
-  static const nlohmann::json empty = nlohmann::json::object();
-  JsonReader p = params ? *params : JsonReader(empty, reader.where() + ".parameters");
-  return visit_model(name, p, reader, [&](auto m, double, Scheme) -> std::unique_ptr<Observer> {
+  return visit_model(reader, [&](auto m, double, Scheme) -> std::unique_ptr<Observer> {
     using Model = decltype(m);
     return std::make_unique<MvtObserver<Model>>(std::move(m), start, spec.error_guess, options,
                                                 spec.name);
