@@ -139,6 +139,70 @@ std::optional<double> max_beta_residual(const RunResult& r, size_t i) {
   return worst;
 }
 
+// Observers in other coordinates (high gain: z = q_N(x)) publish ẑ as extras zhat1…; with the
+// truth known, ‖q_N(x_k) − ẑ_k‖ becomes one more extra, "z_error".
+void add_coordinate_errors(const Measurements& data,
+                           const std::vector<std::unique_ptr<Observer>>& observers, RunResult& r) {
+  if (!data.has_truth()) return;
+  for (size_t i = 0; i < observers.size(); ++i) {
+    const Eigen::VectorXd z0 = observers[i]->coordinates_of(data.x.col(0));
+    if (z0.size() == 0) continue;
+    const auto& names = r.extra_names[i];
+    const auto first = std::find(names.begin(), names.end(), "zhat1");
+    if (first == names.end()) continue;
+    const Eigen::Index row = first - names.begin(), K = data.steps();
+    Eigen::MatrixXd& extras = r.extras[i];
+    extras.conservativeResize(extras.rows() + 1, Eigen::NoChange);
+    for (Eigen::Index k = 0; k < K; ++k) {
+      const Eigen::VectorXd z = observers[i]->coordinates_of(data.x.col(k));
+      extras(extras.rows() - 1, k) = (z - extras.col(k).segment(row, z.size())).norm();
+    }
+    r.extra_names[i].push_back("z_error");
+  }
+}
+
+// Per observer with a "z_error" extra: what seed 004's figures show.
+struct EmbeddedMetrics {
+  double max_zhat_norm = 0.0;  // the peaking
+  double final_z_error = NAN;
+  double z_rms_after = NAN, max_residual_after = NAN;
+  long time_index_below = -1;  // ‖z − ẑ‖ < 1e-6 from here to the end
+  double jumps = 0.0;
+};
+
+std::optional<EmbeddedMetrics> embedded_metrics(const RunResult& r, size_t i) {
+  const auto& names = r.extra_names[i];
+  const auto error_at = std::find(names.begin(), names.end(), "z_error");
+  const auto z1 = std::find(names.begin(), names.end(), "zhat1");
+  const auto residual_at = std::find(names.begin(), names.end(), "projection_residual");
+  const auto jumps_at = std::find(names.begin(), names.end(), "jumps");
+  if (error_at == names.end() || z1 == names.end() || residual_at == names.end()) {
+    return std::nullopt;
+  }
+  const Eigen::MatrixXd& e = r.extras[i];
+  const Eigen::Index K = e.cols(), row = error_at - names.begin(), zrow = z1 - names.begin();
+  const Eigen::Index N = residual_at - z1;
+  EmbeddedMetrics m;
+  if (K == 0) return m;
+  for (Eigen::Index k = 0; k < K; ++k) {
+    const double norm = e.col(k).segment(zrow, N).norm();
+    if (!(norm <= m.max_zhat_norm)) m.max_zhat_norm = norm;  // NaN propagates
+  }
+  m.final_z_error = e(row, K - 1);
+  for (Eigen::Index k = K - 1; k >= 0 && e(row, k) < 1e-6; --k) m.time_index_below = k;
+  const Eigen::Index from = std::clamp<Eigen::Index>(r.settle_index, 0, K - 1);
+  double sum = 0.0, worst = 0.0;
+  for (Eigen::Index k = from; k < K; ++k) {
+    sum += e(row, k) * e(row, k);
+    const double res = e(residual_at - names.begin(), k);
+    if (!(res <= worst)) worst = res;
+  }
+  m.z_rms_after = std::sqrt(sum / static_cast<double>(K - from));
+  m.max_residual_after = worst;
+  if (jumps_at != names.end()) m.jumps = e(jumps_at - names.begin(), K - 1);
+  return m;
+}
+
 void print_table(const Scenario& s, const Measurements& data, const RunResult& r,
                  std::ostream& out) {
   char line[512];
@@ -201,6 +265,24 @@ void print_table(const Scenario& s, const Measurements& data, const RunResult& r
       out << '\n';
     }
   }
+  bool header = false;
+  for (size_t i = 0; i < r.metrics.size(); ++i) {
+    const auto em = embedded_metrics(r, i);
+    if (!em) continue;
+    if (!header) {
+      out << "embedded coordinates (||z - zhat||_2, z = q_N(x)): max ||zhat|| (peaking), below "
+             "1e-6 from, final, RMS after, max projection residual after, jumps:\n";
+      header = true;
+    }
+    std::snprintf(line, sizeof line, "  %-24s %10s  %-14s %10s %10s %10s %6.0f\n",
+                  r.metrics[i].name.c_str(), fmt(em->max_zhat_norm).c_str(),
+                  em->time_index_below >= 0
+                      ? ("t = " + fmt(data.t[em->time_index_below], "%.3f") + " s").c_str()
+                      : "never",
+                  fmt(em->final_z_error).c_str(), fmt(em->z_rms_after).c_str(),
+                  fmt(em->max_residual_after).c_str(), em->jumps);
+    out << line;
+  }
   for (const ObserverMetrics& m : r.metrics) {
     if (!m.first_failure.empty())
       out << "first failure of " << m.name << ": " << m.first_failure << '\n';
@@ -250,6 +332,15 @@ nlohmann::json summary_json(const Scenario& s, const Measurements& data, const R
       o["time_to_1e-3"] = k >= 0 ? nlohmann::json(data.t[k]) : nlohmann::json(nullptr);
     }
     if (const auto residual = max_beta_residual(r, i)) o["max_beta_residual"] = *residual;
+    if (const auto em = embedded_metrics(r, i)) {
+      o["max_zhat_norm"] = number_or_null(em->max_zhat_norm);
+      o["time_to_z_1e-6"] = em->time_index_below >= 0 ? nlohmann::json(data.t[em->time_index_below])
+                                                      : nlohmann::json(nullptr);
+      o["final_z_error"] = number_or_null(em->final_z_error);
+      o["z_rms_after"] = number_or_null(em->z_rms_after);
+      o["max_projection_residual_after"] = number_or_null(em->max_residual_after);
+      o["projection_jumps"] = em->jumps;
+    }
     observers.push_back(o);
   }
   nlohmann::json j{{"scenario", s.name}, {"steps", data.steps()},  {"noise_std", s.noise},
@@ -372,6 +463,26 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
     g << "unset multiplot\n";
     written.push_back(file);
   }
+  // Seed 004's Figs. 3 and 6: ‖z − ẑ‖ on a log scale.
+  std::vector<std::pair<long, std::string>> z_columns;
+  for (size_t o = 0, c = static_cast<size_t>(2 + offset + observers * n); o < r.extra_names.size();
+       c += r.extra_names[o].size(), ++o) {
+    const auto& names = r.extra_names[o];
+    const auto at = std::find(names.begin(), names.end(), "z_error");
+    if (at != names.end()) {
+      z_columns.emplace_back(static_cast<long>(c) + (at - names.begin()), r.metrics[o].name);
+    }
+  }
+  if (!z_columns.empty()) {
+    g << "set terminal pngcairo size 1000,600\nset output '" << (dir / "z_error.png").string()
+      << "'\nset logscale y\nset xlabel 't'\nset ylabel '||z - zhat||_2'\nplot ";
+    for (size_t i = 0; i < z_columns.size(); ++i) {
+      g << "'trajectories.csv' using 1:($" << z_columns[i].first << "+1e-16) with lines title '"
+        << z_columns[i].second << "'" << (i + 1 < z_columns.size() ? ", " : "\n");
+    }
+    g << "unset logscale y\nunset xlabel\n";
+    written.push_back("z_error.png");
+  }
   if (!traced.empty()) {
     g << "set datafile separator whitespace\nset terminal pngcairo size 1000,600\n"
       << "set output '" << (dir / "first_window.png").string() << "'\nset logscale y\n"
@@ -388,6 +499,99 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
     throw std::runtime_error("gnuplot failed; see " + (dir / "gnuplot.log").string());
   }
   return written;
+}
+
+// --sweep theta=v1,v2,…: the high_gain observers once per θ on the same data (seed 004's
+// peaking/noise trade-off: peaking grows as θ shrinks, noise amplification too).
+void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& data,
+               long settle_index, const RunOptions& options, std::ostream& out) {
+  const std::string& spec = options.sweep;
+  const auto eq = spec.find('=');
+  if (eq == std::string::npos || spec.substr(0, eq) != "theta") {
+    throw std::invalid_argument("--sweep: expected theta=v1,v2,... (got '" + spec + "')");
+  }
+  std::vector<double> values;
+  std::stringstream list(spec.substr(eq + 1));
+  for (std::string item; std::getline(list, item, ',');) {
+    try {
+      size_t used = 0;
+      values.push_back(std::stod(item, &used));
+      if (used != item.size() || !(values.back() > 0.0)) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw std::invalid_argument("--sweep theta: '" + item + "' is not a number > 0");
+    }
+  }
+  if (values.empty()) throw std::invalid_argument("--sweep theta: no values");
+  Scenario only = s;
+  only.observers.clear();
+  for (const ObserverSpec& o : s.observers) {
+    if (o.type == "high_gain") only.observers.push_back(o);
+  }
+  if (only.observers.empty()) {
+    throw std::invalid_argument("--sweep theta needs a high_gain observer in the scenario");
+  }
+  if (!data.has_truth()) throw std::invalid_argument("--sweep needs simulated data (the truth)");
+  std::ostringstream csv;
+  csv << std::setprecision(10)
+      << "theta,observer,max_zhat_norm,z_rms_after,x_rms_after,time_to_z_1e-6,jumps,"
+         "failures,us_per_step\n";
+  char line[256];
+  out << "sweep over theta on scenario " << s.name << " (noise sigma " << s.noise
+      << "); 'after' counts samples k >= " << settle_index << "\n";
+  std::snprintf(line, sizeof line, "%-8s %-20s %12s %12s %12s %14s %6s %9s\n", "theta", "observer",
+                "max||zhat||", "z RMS after", "x RMS after", "z<1e-6 from", "jumps", "us/step");
+  out << line;
+  for (double theta : values) {
+    Scenario run = only;
+    for (ObserverSpec& o : run.observers) o.high_gain.theta = theta;
+    auto observers = make_observers(run, model, false);
+    RunResult r = run_observers(data, observers, settle_index);
+    add_coordinate_errors(data, observers, r);
+    for (size_t i = 0; i < observers.size(); ++i) {
+      const auto em = embedded_metrics(r, i);
+      const ObserverMetrics& m = r.metrics[i];
+      const double x_rms =
+          m.mse_after_window.size() ? std::sqrt(m.mse_after_window.mean()) : std::nan("");
+      long failures = 0;
+      for (const auto& [status, count] : m.failures) failures += count;
+      const double t_below = em && em->time_index_below >= 0 ? data.t[em->time_index_below] : NAN;
+      std::snprintf(line, sizeof line, "%-8.4g %-20s %12s %12s %12s %14s %6.0f %9.2f\n", theta,
+                    m.name.c_str(), fmt(em ? em->max_zhat_norm : NAN).c_str(),
+                    fmt(em ? em->z_rms_after : NAN).c_str(), fmt(x_rms).c_str(),
+                    std::isfinite(t_below) ? ("t = " + fmt(t_below, "%.3f")).c_str() : "never",
+                    em ? em->jumps : 0.0, m.ns_per_step / 1e3);
+      out << line;
+      csv << theta << ',' << m.name << ',' << (em ? em->max_zhat_norm : NAN) << ','
+          << (em ? em->z_rms_after : NAN) << ',' << x_rms << ',' << t_below << ','
+          << (em ? em->jumps : 0.0) << ',' << failures << ',' << m.ns_per_step / 1e3 << '\n';
+    }
+  }
+  if (options.out_dir.empty()) return;
+  const fs::path dir(options.out_dir);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw std::runtime_error("cannot create " + dir.string() + ": " + ec.message());
+  write_atomically(dir / "sweep.csv", csv.str());
+  out << "wrote " << (dir / "sweep.csv").string();
+  if (have_gnuplot()) {
+    std::ostringstream g;
+    g << "set datafile separator ','\nset terminal pngcairo size 1000,800\nset output '"
+      << (dir / "sweep.png").string()
+      << "'\nset multiplot layout 2,1 title 'theta sweep: " << s.name << " (noise " << s.noise
+      << ")'\nset logscale xy\nset grid\nset key outside right\n"
+      << "set xlabel 'theta'\nset ylabel 'max ||zhat|| (peaking)'\n"
+      << "plot 'sweep.csv' skip 1 using 1:3 with linespoints title 'max ||zhat||'\n"
+      << "set ylabel 'RMS error after settling'\n"
+      << "plot 'sweep.csv' skip 1 using 1:4 with linespoints title 'z', "
+         "'sweep.csv' skip 1 using 1:5 with linespoints title 'x'\nunset multiplot\n";
+    write_atomically(dir / "sweep.gp", g.str());
+    const std::string cmd = "cd '" + dir.string() + "' && gnuplot sweep.gp 2>gnuplot.log";
+    if (std::system(cmd.c_str()) != 0) {
+      throw std::runtime_error("gnuplot failed; see " + (dir / "gnuplot.log").string());
+    }
+    out << ", sweep.png";
+  }
+  out << '\n';
 }
 
 }  // namespace
@@ -423,6 +627,16 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
     source = options.data_file;
   }
 
+  if (!options.sweep.empty()) {
+    long settle = -1;
+    if (s.settle_time >= 0.0) {
+      const double T = model.sample_time() > 0 ? model.sample_time() : 1.0;
+      settle = static_cast<long>(
+          std::min(std::ceil(s.settle_time / T - 1e-9), static_cast<double>(data.steps())));
+    }
+    run_sweep(s, model, data, settle < 0 ? 0 : settle, options, out);
+    return;
+  }
   Eigen::Index longest = 1;
   auto observers = make_observers(s, model, !options.out_dir.empty());
   for (const auto& o : observers) longest = std::max(longest, o->window());
@@ -449,7 +663,7 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
   const auto start = std::chrono::steady_clock::now();
   auto last = start;
   bool printed = false;
-  const RunResult r = run_observers(data, observers, settle_index, [&](long done, long total) {
+  RunResult r = run_observers(data, observers, settle_index, [&](long done, long total) {
     const auto now = std::chrono::steady_clock::now();
     if (now - start < std::chrono::seconds(1) ||
         (now - last < std::chrono::milliseconds(250) && done < total)) {
@@ -461,6 +675,7 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
         << " observer steps" << std::flush;
   });
   if (printed) err << '\n';
+  add_coordinate_errors(data, observers, r);
 
   print_table(s, data, r, out);
   print_bounds(bounds, out);

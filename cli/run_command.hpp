@@ -1,5 +1,6 @@
 #pragma once
-// `nlobs run SCENARIO [--steps N] [--noise SIGMA] [--seed S] [--out DIR] [--data FILE.csv]`.
+// `nlobs run SCENARIO [--steps N] [--noise SIGMA] [--seed S] [--out DIR] [--data FILE.csv]
+//  [--sweep theta=v1,v2,...]`.
 #include <cstdint>
 #include <iosfwd>
 #include <optional>
@@ -13,6 +14,9 @@ struct RunOptions {
   std::optional<std::uint64_t> seed{};
   std::string out_dir{};    // empty: no files
   std::string data_file{};  // empty: simulate
+  // "theta=0.05,0.1,0.2": run the scenario's high_gain observers once per value on the same
+  // data; prints and writes (with --out) sweep.csv and sweep.png instead of the usual outputs.
+  std::string sweep{};
 };
 
 // Prints the table to `out` (progress and notices to `err`); writes the files when asked.

@@ -171,10 +171,86 @@ const char* kMvtRobot = R"({
   ]
 })";
 
+// METHODS §5 / seed 004: the Duffing oscillator's hard start ẑ(0) = q6(0, 0) while x(0) is on an
+// orbit around the equilibrium (1, 0); P, R, ρ and θ are the paper's.
+constexpr const char* kHgDuffing = R"({
+  "name": "hg-duffing",
+  "model": {"name": "duffing", "scheme": "rk4", "step": 0.001},
+  "x0": [1.2, 0.0],
+  "initial_guess": [0.0, 0.0],
+  "steps": 20001,
+  "settle_time": 15.0,
+  "observers": [
+    {"type": "high_gain", "name": "hg-duffing", "N": 6, "theta": 0.1, "alpha": "explicit",
+     "saturation": {"P_diagonal": [0.8, 0.145, 0.103, 0.0158, 4.07e-3, 5.26e-4], "R": 1.0,
+                    "rho": 2.0},
+     "initial_z_from": [0.0, 0.0]},
+    {"type": "ekf", "process_covariance": [[1e-10, 0], [0, 1e-10]],
+     "measurement_covariance": [[1e-6]], "initial_covariance": [[1, 0], [0, 1]]}
+  ]
+})";
+
+// The oscillator with y = x1² + x1: x(0) = (−1/2, 0), initial error (0.2, 0), θ = 0.3, the
+// paper's P; the explicit inverse (the paper) beside the least-squares projection.
+constexpr const char* kHgOscillator = R"({
+  "name": "hg-oscillator",
+  "model": {"name": "oscillator", "scheme": "rk4", "step": 0.001},
+  "x0": [-0.5, 0.0],
+  "initial_guess": [-0.3, 0.0],
+  "steps": 40001,
+  "settle_time": 30.0,
+  "observers": [
+    {"type": "high_gain", "name": "hg-inverse", "N": 4, "theta": 0.3, "alpha": "explicit",
+     "inverse": true,
+     "saturation": {"P_diagonal": [0.594, 0.421, 0.266, 0.153], "R": 1.0, "rho": 2.0}},
+    {"type": "high_gain", "name": "hg-projection", "N": 4, "theta": 0.3, "alpha": "explicit",
+     "saturation": {"P_diagonal": [0.594, 0.421, 0.266, 0.153], "R": 1.0, "rho": 2.0}},
+    {"type": "ekf", "process_covariance": [[1e-10, 0], [0, 1e-10]],
+     "measurement_covariance": [[1e-6]], "initial_covariance": [[1, 0], [0, 1]]}
+  ]
+})";
+
+// Lorenz, y = x1, N = 4: α = L_f^4 h along the prediction (α(z) is rational, singular on the
+// x3 axis); P from the box |x| ≤ (25, 30, 55) around the attractor (the paper's §6 recipe).
+constexpr const char* kHgLorenz = R"({
+  "name": "hg-lorenz",
+  "model": {"name": "lorenz", "scheme": "rk4", "step": 0.001},
+  "x0": [1.0, 1.0, 20.0],
+  "initial_guess": [2.0, 3.0, 25.0],
+  "steps": 10001,
+  "settle_time": 5.0,
+  "observers": [
+    {"type": "high_gain", "name": "hg-lorenz", "N": 4, "theta": 0.02, "alpha": "lie",
+     "saturation": {"box": [25.0, 30.0, 55.0], "R": 1.0, "rho": 2.0}},
+    {"type": "ekf", "process_covariance": [[1e-10, 0, 0], [0, 1e-10, 0], [0, 0, 1e-10]],
+     "measurement_covariance": [[1e-6]],
+     "initial_covariance": [[10, 0, 0], [0, 10, 0], [0, 0, 10]]}
+  ]
+})";
+
+// Van der Pol, y = x2, N = 5: α = L_f^5 h along the prediction; high gain (θ = 0.02), as the
+// paper found; P from the box |x| ≤ (2.5, 3) around the limit cycle.
+constexpr const char* kHgVdp = R"({
+  "name": "hg-vdp",
+  "model": {"name": "van-der-pol", "scheme": "rk4", "step": 0.001},
+  "x0": [2.0, 0.0],
+  "initial_guess": [1.0, 1.0],
+  "steps": 20001,
+  "settle_time": 15.0,
+  "observers": [
+    {"type": "high_gain", "name": "hg-vdp", "N": 5, "theta": 0.02, "alpha": "lie",
+     "saturation": {"box": [2.5, 3.0], "R": 1.0, "rho": 2.0}},
+    {"type": "ekf", "process_covariance": [[1e-10, 0], [0, 1e-10]],
+     "measurement_covariance": [[1e-6]], "initial_covariance": [[1, 0], [0, 1]]}
+  ]
+})";
+
 const std::map<std::string, const char*>& builtin_texts() {
   static const std::map<std::string, const char*> texts = {
-      {"chua-fp", kChuaFp},     {"pi-linear", kPiLinear},     {"pi-chua", kPiChua},
-      {"pi-lander", kPiLander}, {"mvt-chaotic", kMvtChaotic}, {"mvt-robot", kMvtRobot}};
+      {"chua-fp", kChuaFp},       {"pi-linear", kPiLinear},         {"pi-chua", kPiChua},
+      {"pi-lander", kPiLander},   {"mvt-chaotic", kMvtChaotic},     {"mvt-robot", kMvtRobot},
+      {"hg-duffing", kHgDuffing}, {"hg-oscillator", kHgOscillator}, {"hg-lorenz", kHgLorenz},
+      {"hg-vdp", kHgVdp}};
   return texts;
 }
 
@@ -313,6 +389,30 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
       spec.initial = o.vector("initial");
       o.finish({"type", "name", "error_guess", "eta", "variant", "injection_gain", "beta_solver",
                 "integrator", "substeps", "initial"});
+    } else if (spec.type == "high_gain") {
+      spec.high_gain = parse_high_gain_spec(o);
+      spec.initial = o.vector("initial");
+      o.finish({"type",
+                "name",
+                "N",
+                "theta",
+                "poles",
+                "coefficients",
+                "map",
+                "alpha",
+                "inverse",
+                "saturation",
+                "projection",
+                "start",
+                "integrator",
+                "substeps",
+                "jump_threshold",
+                "observability_floor",
+                "residual_scale",
+                "restart_residual",
+                "initial_z",
+                "initial_z_from",
+                "initial"});
     } else if (spec.type == "luenberger") {
       spec.gain = o.matrix("gain").value_or(Eigen::MatrixXd());
       if (spec.gain.size() == 0) o.fail("missing field 'gain'");
@@ -337,7 +437,7 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
                 "initial", "model"});
     } else {
       o.fail("unknown observer type '" + spec.type +
-             "'; valid: window, luenberger, sliding_mode, ekf, pi_bank, mvt");
+             "'; valid: window, luenberger, sliding_mode, ekf, pi_bank, mvt, high_gain");
     }
     s.observers.push_back(std::move(spec));
   }
@@ -405,6 +505,8 @@ nlohmann::json to_json(const Scenario& s) {
       jo["parameters"] = o.pi.parameters;
     } else if (o.type == "mvt") {
       write_mvt_spec(o.mvt, jo);
+    } else if (o.type == "high_gain") {
+      write_high_gain_spec(o.high_gain, jo);
     } else if (o.type == "ekf") {
       if (o.process_covariance.size()) jo["process_covariance"] = matrix_json(o.process_covariance);
       if (o.measurement_covariance.size()) {
@@ -454,6 +556,9 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& s, const A
         out.push_back(make_pi_bank(o.pi, model, where));
       } else if (o.type == "mvt") {
         out.push_back(make_mvt_observer(o.mvt, s.model, start, model.sample_time(), where));
+      } else if (o.type == "high_gain") {
+        out.push_back(
+            make_high_gain_observer(o.high_gain, s.model, start, model.sample_time(), where));
       } else if (o.type == "window") {
         SolverOptions options;
         if (o.tol) {

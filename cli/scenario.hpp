@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "high_gain_observers.hpp"
 #include "mvt_observers.hpp"
 #include "nlobs/observers/any_model.hpp"
 #include "nlobs/observers/observer.hpp"
@@ -19,7 +20,7 @@
 namespace nlobs::cli {
 
 struct ObserverSpec {
-  std::string type;  // "window", "luenberger", "sliding_mode", "ekf", "pi_bank", "mvt"
+  std::string type;  // "window", "luenberger", "sliding_mode", "ekf", "pi_bank", "mvt", "high_gain"
   // window
   std::string engine = "newton";
   std::optional<double> tol{};  // step and residual tolerance of the engine
@@ -34,8 +35,9 @@ struct ObserverSpec {
   // luenberger, sliding_mode, ekf: the observer's own design model (same sizes and sample
   // time as the scenario's), e.g. one that assumes an unknown input constant
   std::optional<nlohmann::json> model{};
-  PiBankSpec pi{};  // pi_bank
-  MvtSpec mvt{};    // mvt
+  PiBankSpec pi{};           // pi_bank
+  MvtSpec mvt{};             // mvt
+  HighGainSpec high_gain{};  // high_gain
 };
 
 struct InputSpec {

@@ -18,6 +18,6 @@ configure_package_config_file(cmake/nlobsConfig.cmake.in
                               INSTALL_DESTINATION ${NLOBS_CMAKE_DIR})
 write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/nlobsConfigVersion.cmake
                                  COMPATIBILITY SameMinorVersion)
-install(FILES ${CMAKE_CURRENT_BINARY_DIR}/nlobsConfig.cmake
+install(FILES ${CMAKE_CURRENT_BINARY_DIR}/nlobsConfig.cmake ${PROJECT_SOURCE_DIR}/cmake/FindADOLC.cmake
               ${CMAKE_CURRENT_BINARY_DIR}/nlobsConfigVersion.cmake
         DESTINATION ${NLOBS_CMAKE_DIR})

@@ -14,7 +14,8 @@ packages=(
   libsundials-dev      # KINSOL: reference solver compared in the same run
   libcminpack-dev      # MINPACK hybrj: reference solver of the MGH suite
   libgsl-dev           # GSL hybridsj / gnewton: reference solvers of the MGH suite
-  libboost-dev         # Boost.Odeint: adaptive integration of continuous models
+  libboost-dev         # Boost.Odeint (integration, Rosenbrock), Boost.Math, Boost.Interval
+  libadolc-dev         # ADOL-C Taylor-mode AD: observability maps q_N of any model
   gnuplot-nox          # PNG plots of nlobs run --out (optional at run time)
   libcli11-dev         # command-line parsing for the nlobs CLI
   nlohmann-json3-dev   # JSON output of the CLI

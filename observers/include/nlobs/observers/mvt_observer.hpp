@@ -45,6 +45,7 @@
 
 #include "nlobs/observers/mvt_beta.hpp"
 #include "nlobs/observers/observer.hpp"
+#include "nlobs/observers/sample_interpolator.hpp"
 
 namespace nlobs {
 
@@ -132,7 +133,7 @@ class MvtObserver final : public Observer {
     beta_.setConstant(0.5);
     gains_.setZero();
     started_ = false;
-    samples_ = 0;
+    samples_.clear();
     last_t_ = 0.0;
     last_u_.setZero();
     max_residual_ = 0.0;
@@ -221,7 +222,7 @@ class MvtObserver final : public Observer {
       return publish();
     }
     if (step_.measurement_missing) return publish();  // hold; the next sample bridges the gap
-    push_sample(t, y);
+    samples_.push(t, Output(y));
     if (!started_) {
       // The first sample: the state is the initial condition; evaluate once to report β.
       failure_.clear();
@@ -260,33 +261,6 @@ class MvtObserver final : public Observer {
     }
   }
 
-  // Keeps the last four good samples (oldest first) for the cubic interpolant of y.
-  void push_sample(double t, const Eigen::VectorXd& y) {
-    if (samples_ == 4) {
-      for (int j = 0; j < 3; ++j) {
-        times_[j] = times_[j + 1];
-        ys_.col(j) = ys_.col(j + 1);
-      }
-      samples_ = 3;
-    }
-    times_[samples_] = t;
-    ys_.col(samples_) = y;
-    ++samples_;
-  }
-
-  // Lagrange interpolation through the stored samples (cubic once four are in).
-  Output output_at(double t) const {
-    Output y = Output::Zero();
-    for (int j = 0; j < samples_; ++j) {
-      double l = 1.0;
-      for (int m = 0; m < samples_; ++m) {
-        if (m != j) l *= (t - times_[m]) / (times_[j] - times_[m]);
-      }
-      y += l * ys_.col(j);
-    }
-    return y;
-  }
-
   // [t0, t1] with Boost.Odeint; false (state untouched) when F turned non-finite.
   bool integrate(double t0, double t1) {
     namespace odeint = boost::numeric::odeint;
@@ -299,9 +273,10 @@ class MvtObserver final : public Observer {
     bool finite = true;
     const auto rhs = [this, &finite](const Augmented& z, Augmented& dz, double t) {
       State dx, de;
-      finite = derivatives(t, Eigen::Map<const State>(z.data()),
-                           Eigen::Map<const State>(z.data() + N), output_at(t), last_u_, dx, de) &&
-               finite;
+      finite =
+          derivatives(t, Eigen::Map<const State>(z.data()), Eigen::Map<const State>(z.data() + N),
+                      samples_.at(t), last_u_, dx, de) &&
+          finite;
       Eigen::Map<State>(dz.data()) = dx;
       Eigen::Map<State>(dz.data() + N) = de;
     };
@@ -352,9 +327,7 @@ class MvtObserver final : public Observer {
   State xhat_ = State::Zero(), ehat_ = State::Zero(), beta_ = State::Zero(), gains_ = State::Zero();
   Jacobian d_ = Jacobian::Zero(), j_w_ = Jacobian::Zero();
   bool started_ = false;
-  int samples_ = 0;
-  std::array<double, 4> times_{};
-  Eigen::Matrix<double, P, 4> ys_ = Eigen::Matrix<double, P, 4>::Zero();
+  SampleInterpolator<P> samples_;  // y between samples: the cubic through the last four
   double last_t_ = 0.0, max_residual_ = 0.0;
   Input last_u_ = Input::Zero();
   std::string failure_;

@@ -33,6 +33,10 @@ class Observer {
   // What a user should know about this observer's set-up (e.g. derivatives by finite
   // differences because the model does not support AD); printed and kept in summary.json.
   virtual std::vector<std::string> warnings() const { return {}; }
+  // Observers that estimate in other coordinates (the high-gain observer's z = q_N(x), published
+  // as the extras zhat1…): the image of a true state, so that a harness can measure the error
+  // there. Empty for observers that estimate x directly.
+  virtual Eigen::VectorXd coordinates_of(const Eigen::VectorXd& /*x*/) const { return {}; }
   virtual void reset() = 0;  // back to the initial guess, empty window
   // Sample k (consecutive from 0). A non-finite y means a missing measurement.
   virtual const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) = 0;
