@@ -42,7 +42,13 @@ void print_list(const std::string& what, std::ostream& out) {
            "channel), omega_bounds ({channel: N}), start (paper|zero), substeps, parameters\n"
         << "  mvt — mean-value-theorem observer of seed 001, models with y = [I_m 0] x: "
            "error_guess (required), name, variant (injection|published), injection_gain, eta, "
-           "beta_solver (per-row|nlopt|ceres), integrator (rk4|dopri5), substeps, initial\n";
+           "beta_solver (per-row|nlopt|ceres), integrator (rk4|dopri5), substeps, initial\n"
+        << "  high_gain — high-gain observer in embedded coordinates of seed 004, autonomous "
+           "one-output models: N, theta, poles | coefficients, map (ad|explicit), alpha "
+           "(auto|explicit|lie), inverse, saturation ({P | P_diagonal | box, R, rho}), "
+           "projection (engine spec), start (previous|predicted), integrator (auto|rk4|cvode), "
+           "substeps, jump_threshold, observability_floor, residual_scale, restart_residual, "
+           "initial_z | initial_z_from, initial, name\n";
     for (const auto& b : pi_bank_catalog()) {
       out << "      bank " << b.name << ": " << b.description << "; channels";
       for (const auto& c : b.channels) out << ' ' << c;

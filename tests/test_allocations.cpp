@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "nlobs/models/systems.hpp"
+#include "nlobs/observers/embedded_forms.hpp"
+#include "nlobs/observers/high_gain_observer.hpp"
 #include "nlobs/observers/mvt_observer.hpp"
 #include "nlobs/observers/pi_bank.hpp"
 #include "nlobs/solvers/ceres_engine.hpp"
@@ -140,6 +142,32 @@ TEST(Allocations, MvtStepWithPerRowBetaAllocatesNothing) {
   }
   EXPECT_EQ(g_allocations.load() - before, 0);
   EXPECT_GT(observer.ehat().norm(), 1e-3);  // the β problems were real ones
+}
+
+// A high-gain step with an explicit map, α and inverse (the oscillator of METHODS §5) on RK4:
+// the embedded state is dynamic-size but allocated once, so the step allocates nothing.
+TEST(Allocations, HighGainStepWithExplicitFormsAllocatesNothing) {
+  HighGainObserver<OscillatorNonlinearOutput>::Design d;
+  d.map = std::make_shared<ExplicitObservabilityMap<OscillatorEmbedding>>();
+  d.alpha = explicit_alpha<OscillatorEmbedding>();
+  d.inverse = explicit_inverse<OscillatorEmbedding>();
+  HighGainOptions o;
+  o.sample_time = 1e-2;
+  o.theta = 0.3;
+  o.saturation = SmoothSaturation{Eigen::MatrixXd::Identity(4, 4) * 0.2, 1.0, 2.0};
+  HighGainObserver<OscillatorNonlinearOutput> observer(OscillatorNonlinearOutput{}, d,
+                                                       Eigen::Vector2d(-0.3, 0.0), o);
+  const Eigen::VectorXd none(0);
+  Eigen::VectorXd yk = Eigen::VectorXd::Constant(1, -0.25);
+  observer.step(0, yk, none);
+  observer.step(1, yk, none);
+  const long before = g_allocations.load();
+  for (long k = 2; k < 100; ++k) {
+    yk[0] = -0.25 + 0.01 * std::sin(0.01 * static_cast<double>(k));
+    observer.step(k, yk, none);
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_GT(observer.zhat().norm(), 0.1);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -387,6 +388,115 @@ TEST(RunMvt, ScenariosRoundTripAndBadSpecsNameTheProblem) {
   // The cubic Chua circuit measures x2: not y = [I_m 0] x.
   write(f, scenario("cubic-chua", R"({"type": "mvt", "error_guess": [1, 1, 1]})"));
   EXPECT_NE(error_of(f.string()).find("C = [I_m 0]"), std::string::npos) << error_of(f.string());
+}
+
+// Seed 004's examples: ‖z − ẑ‖ below 1e-6 within the documented times, x̂ → x.
+TEST(RunHighGain, OscillatorAndDuffingReachOneMicro) {
+  const nlohmann::json osc = run_summary("hg-oscillator");
+  for (const char* name : {"hg-inverse", "hg-projection"}) {
+    const auto& o = observer_of(osc, name);
+    EXPECT_LT(o["time_to_z_1e-6"].get<double>(), 18.0) << name;  // measured 16.9 s
+    EXPECT_LT(o["z_rms_after"].get<double>(), 1e-6) << name;
+    EXPECT_LT(o["max_error_after"][0].get<double>(), 1e-6) << name;
+    EXPECT_TRUE(o["failures"].empty()) << name;
+  }
+  EXPECT_FALSE(observer_of(osc, "ekf").contains("time_to_z_1e-6"));
+  // The log-scale error plot of the paper's Fig. 6 and ẑ per sample.
+  EXPECT_TRUE(fs::exists(scratch("hg-oscillator") / "z_error.png") ||
+              !fs::exists("/usr/bin/gnuplot"));
+  std::ifstream csv(scratch("hg-oscillator") / "trajectories.csv");
+  std::string header;
+  std::getline(csv, header);
+  for (const char* column : {"hg-inverse.signal.zhat4", "hg-inverse.signal.z_error",
+                             "hg-projection.signal.projection_residual"}) {
+    EXPECT_NE(header.find(column), std::string::npos) << column;
+  }
+
+  const fs::path dir = scratch("hg-duffing");
+  std::ostringstream out, err;
+  run_scenario("hg-duffing", {.steps = 12001, .out_dir = dir.string()}, out, err);
+  std::ifstream in(dir / "summary.json");
+  const nlohmann::json duffing = nlohmann::json::parse(in);
+  const auto& hg = observer_of(duffing, "hg-duffing");
+  EXPECT_LT(hg["time_to_z_1e-6"].get<double>(), 10.0);  // measured 9.0 s
+  EXPECT_GT(hg["max_zhat_norm"].get<double>(), 10.0);   // the peaking of the hard start
+  EXPECT_LT(hg["final_z_error"].get<double>(), 1e-6);
+}
+
+// The θ sweep: smaller θ, more peaking; under noise, larger steady error (the oscillator at
+// h = 0.01, 40 s, σ = 1e-3; measured max ‖ẑ‖ 7.2 / 1.63 / 1.65 and z RMS 0.134 / 0.017 / 0.0076).
+TEST(RunHighGain, ThetaSweepShowsPeakingAndNoise) {
+  const fs::path dir = scratch("hg-sweep"), file = scratch("hg-sweep.json");
+  write(file, R"({"name": "osc-sweep", "model": {"name": "oscillator", "scheme": "rk4",
+    "step": 0.01}, "x0": [-0.5, 0.0], "initial_guess": [-0.3, 0.0], "steps": 4001,
+    "settle_time": 30.0, "observers": [{"type": "high_gain", "name": "hg", "N": 4,
+    "alpha": "explicit", "inverse": true,
+    "saturation": {"P_diagonal": [0.594, 0.421, 0.266, 0.153]}}, {"type": "ekf"}]})");
+  std::ostringstream out, err;
+  RunOptions o;
+  o.noise = 1e-3;
+  o.out_dir = dir.string();
+  o.sweep = "theta=0.1,0.2,0.3";
+  run_scenario(file.string(), o, out, err);
+  std::ifstream csv(dir / "sweep.csv");
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line.rfind("theta,observer,max_zhat_norm,z_rms_after,x_rms_after", 0), 0u) << line;
+  std::map<double, std::pair<double, double>> rows;  // θ → (max ‖ẑ‖, z RMS after)
+  while (std::getline(csv, line)) {
+    std::stringstream fields(line);
+    std::string theta, name, peak, z_rms;
+    std::getline(fields, theta, ',');
+    std::getline(fields, name, ',');
+    std::getline(fields, peak, ',');
+    std::getline(fields, z_rms, ',');
+    EXPECT_EQ(name, "hg");  // the EKF is not swept
+    rows[std::stod(theta)] = {std::stod(peak), std::stod(z_rms)};
+  }
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_GT(rows[0.1].first, 2.0 * rows[0.3].first);  // peaking
+  EXPECT_GT(rows[0.1].second, rows[0.2].second);      // noise amplification
+  EXPECT_GT(rows[0.2].second, rows[0.3].second);
+  EXPECT_NE(error_of("hg-oscillator", {.sweep = "theta=0.1,x"}).find("'x' is not a number"),
+            std::string::npos);
+  EXPECT_NE(error_of("mvt-robot", {.sweep = "theta=0.1"}).find("needs a high_gain observer"),
+            std::string::npos);
+}
+
+TEST(RunHighGain, ScenariosRoundTripAndBadSpecsNameTheProblem) {
+  for (const char* name : {"hg-duffing", "hg-oscillator", "hg-lorenz", "hg-vdp"}) {
+    const nlohmann::json j = to_json(load_scenario(name));
+    EXPECT_EQ(to_json(parse_scenario(j, "round trip")), j) << name;
+  }
+  const fs::path f = scratch("bad_hg.json");
+  const auto scenario = [](const std::string& model, int n, const std::string& observer) {
+    const std::string zeros = n == 2 ? "[0, 0]" : n == 3 ? "[0, 0, 0]" : "[0, 0, 0, 0]";
+    return R"({"name": "x", "model": {"name": ")" + model + R"("}, "x0": )" + zeros +
+           R"(, "initial_guess": )" + zeros + R"(, "steps": 10, "observers": [)" + observer + "]}";
+  };
+  write(f, scenario("duffing", 2, R"({"type": "high_gain", "theta": 0})"));
+  EXPECT_NE(error_of(f.string()).find("'theta' must be > 0"), std::string::npos);
+  write(f, scenario("duffing", 2, R"({"type": "high_gain", "poles": [-1, -1, -1, -1, -1, 1]})"));
+  EXPECT_NE(error_of(f.string()).find("poles"), std::string::npos) << error_of(f.string());
+  write(f,
+        scenario("duffing", 2,
+                 R"({"type": "high_gain", "saturation": {"P_diagonal": [1, 1], "box": [1, 1]}})"));
+  EXPECT_NE(error_of(f.string()).find("give one of"), std::string::npos);
+  write(f, scenario("duffing", 2,
+                    R"({"type": "high_gain", "saturation": {"P_diagonal": [1, 1, 1, 1, 1, -1]}})"));
+  EXPECT_NE(error_of(f.string()).find("not positive definite"), std::string::npos)
+      << error_of(f.string());
+  write(f, scenario("robot", 4, R"({"type": "high_gain", "N": 4})"));
+  EXPECT_NE(error_of(f.string()).find("autonomous model with one output"), std::string::npos)
+      << error_of(f.string());
+  write(f, scenario("cubic-chua", 3, R"({"type": "high_gain", "N": 4, "map": "explicit"})"));
+  EXPECT_NE(error_of(f.string()).find("hand-expanded"), std::string::npos) << error_of(f.string());
+  write(f, scenario("cubic-chua", 3, R"({"type": "high_gain"})"));
+  EXPECT_NE(error_of(f.string()).find("give 'N'"), std::string::npos) << error_of(f.string());
+  write(f, scenario("lorenz", 3, R"({"type": "high_gain", "N": 2})"));
+  EXPECT_NE(error_of(f.string()).find("N = 2"), std::string::npos) << error_of(f.string());
+  write(f, scenario("lorenz", 3, R"({"type": "high_gain", "N": 4, "alpha": "explicit"})"));
+  EXPECT_NE(error_of(f.string()).find("needs a hand α"), std::string::npos) << error_of(f.string());
 }
 
 }  // namespace

@@ -23,7 +23,8 @@
 // Between samples y is the cubic through the last four good samples (sample_interpolator.hpp).
 // Integration: RK4 (Boost.Odeint) with `substeps` per sample, or SUNDIALS CVODE (BDF, dense,
 // our Jacobian; stiff_integrator.hpp) for stiff gains; `auto` picks CVODE when h · max|p_j| / θ
-// exceeds 0.5 (docs/observers.md has the measurements behind it).
+// exceeds 0.2 (bench BM_HighGainIntegrator: RK4 is as accurate and ~200× cheaper up to 0.1, its
+// error reaches 1e-2 at 0.33 and it diverges beyond 2.8; docs/observers.md).
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
@@ -110,7 +111,7 @@ struct HighGainOptions {
   ProjectionStart start = ProjectionStart::kPrevious;
   double jump_threshold = 0.1;  // ‖x̂_k − x̂_{k−1}‖∞ above this is a discontinuity
   double observability_floor = 1e-2;  // ε of the weight of α = L_f^N h (see above)
-  double residual_scale = 1e-3;       // ρ_r of the same weight's residual factor
+  double residual_scale = 0.1;        // ρ_r of the same weight's residual factor
   // Restart the projection from x̂(0) and 0 when ‖ẑ − q_N(x̂)‖ > this · (1 + ‖ẑ‖); 0: never.
   double restart_residual = 1e-2;
 };
@@ -245,10 +246,9 @@ class HighGainObserver final : public Observer {
     }
     integrator_ = options_.integrator;
     if (integrator_ == HighGainIntegrator::kAuto) {
-      // Largest |root| of the scaled error dynamics times the step: RK4 is accurate and stable
-      // well below its stability limit 2.78; beyond 0.5 the implicit stepper is cheaper.
+      // Largest |root| of the scaled error dynamics times the step (see the header comment).
       const double h = options_.sample_time / options_.substeps;
-      integrator_ = h * spectral_radius_ / options_.theta > 0.5 ? HighGainIntegrator::kCvode
+      integrator_ = h * spectral_radius_ / options_.theta > 0.2 ? HighGainIntegrator::kCvode
                                                                 : HighGainIntegrator::kRk4;
     }
     if (integrator_ == HighGainIntegrator::kCvode && !ModelDerivatives<Model>::kAutoDiff &&
@@ -282,7 +282,7 @@ class HighGainObserver final : public Observer {
   const Eigen::VectorXd& coefficients() const { return coefficients_; }  // l_0 … l_{N−1}
   const Eigen::VectorXd& gains() const { return gains_; }  // l_{N−i} / θ^i, i = 1…N
   const Eigen::VectorXd& zhat() const { return zhat_; }
-  const Eigen::VectorXd& xhat() const { return xhat_; }
+  const State& xhat() const { return xhat_; }
   double projection_residual() const { return residual_; }
   long jumps() const { return jumps_; }
 

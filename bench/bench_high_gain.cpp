@@ -1,0 +1,138 @@
+// The high-gain observer (seed 004), whole runs over recorded data so that the cost per step
+// and the accuracy come from the same steps:
+//   BM_HighGainStep/<example>: µs per sample for each way of getting x̂ and α — the explicit
+//     inverse, the least-squares projection with a hand map (ceres::Jet Jacobian) and with the
+//     ADOL-C map, α explicit or L_f^N h;
+//   BM_HighGainIntegrator/<rk4|cvode>/<θ·1000>: the oscillator at h = 0.01 as θ shrinks —
+//     the measurement behind the `auto` choice (RK4 while h·max|p|/θ ≤ 0.5).
+// Counters: z_error = ‖q_N(x) − ẑ‖ at the last sample, failures.
+#include <benchmark/benchmark.h>
+
+#include "nlobs/models/discretization.hpp"
+#include "nlobs/models/systems.hpp"
+#include "nlobs/observers/embedded_forms.hpp"
+#include "nlobs/observers/high_gain_observer.hpp"
+#include "nlobs/observers/lie_observability_map.hpp"
+#include "nlobs/observers/simulation.hpp"
+
+namespace {
+
+using namespace nlobs;
+
+template <typename Model>
+Measurements record(const Model& model, const Eigen::VectorXd& x0, double h, double t_end) {
+  SimulationOptions o;
+  o.steps = std::lround(t_end / h) + 1;
+  o.sample_time = h;
+  return simulate(Discretized<Model>(model, h, Scheme::kRk4), x0, o);
+}
+
+template <typename Model>
+void run(benchmark::State& state, const Measurements& data,
+         const std::function<std::unique_ptr<HighGainObserver<Model>>()>& make) {
+  double z_error = 0.0;
+  long failures = 0, steps = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto observer = make();
+    state.ResumeTiming();
+    for (Eigen::Index k = 0; k < data.steps(); ++k) {
+      failures += observer->step(k, data.y.col(k), data.u.col(k)).failure.empty() ? 0 : 1;
+    }
+    steps += data.steps();
+    const Eigen::Index last = data.steps() - 1;
+    z_error = (observer->coordinates_of(data.x.col(last)) - observer->zhat()).norm();
+  }
+  state.counters["z_error"] = z_error;
+  state.counters["failures"] = static_cast<double>(failures);
+  state.counters["us_per_step"] = benchmark::Counter(
+      static_cast<double>(steps) * 1e-6, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+SmoothSaturation oscillator_saturation() {
+  return {Eigen::Vector4d(0.594, 0.421, 0.266, 0.153).asDiagonal(), 1.0, 2.0};
+}
+
+void BM_HighGainStepOscillator(benchmark::State& state) {
+  static const Measurements data =
+      record(OscillatorNonlinearOutput{}, Eigen::Vector2d(-0.5, 0.0), 0.01, 20.0);
+  const bool inverse = state.range(0) == 1;
+  run<OscillatorNonlinearOutput>(state, data, [inverse] {
+    HighGainObserver<OscillatorNonlinearOutput>::Design d;
+    d.map = std::make_shared<ExplicitObservabilityMap<OscillatorEmbedding>>();
+    d.alpha = explicit_alpha<OscillatorEmbedding>();
+    if (inverse) d.inverse = explicit_inverse<OscillatorEmbedding>();
+    HighGainOptions o;
+    o.sample_time = 0.01;
+    o.theta = 0.3;
+    o.saturation = oscillator_saturation();
+    return std::make_unique<HighGainObserver<OscillatorNonlinearOutput>>(
+        OscillatorNonlinearOutput{}, d, Eigen::Vector2d(-0.3, 0.0), o);
+  });
+  state.SetLabel(inverse ? "explicit inverse" : "ceres projection, hand map");
+}
+BENCHMARK(BM_HighGainStepOscillator)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
+
+void BM_HighGainStepDuffing(benchmark::State& state) {
+  static const Measurements data = record(Duffing{}, Eigen::Vector2d(1.2, 0.0), 1e-3, 12.0);
+  const bool ad = state.range(0) == 1;
+  run<Duffing>(state, data, [ad] {
+    HighGainObserver<Duffing>::Design d;
+    if (ad) {
+      d.map = std::make_shared<LieObservabilityMap>(Duffing{}, 6);
+    } else {
+      d.map = std::make_shared<ExplicitObservabilityMap<DuffingEmbedding>>();
+    }
+    d.alpha = explicit_alpha<DuffingEmbedding>();
+    HighGainOptions o;
+    o.sample_time = 1e-3;
+    o.theta = 0.1;
+    Eigen::VectorXd P(6);
+    P << 0.8, 0.145, 0.103, 0.0158, 4.07e-3, 5.26e-4;
+    o.saturation = SmoothSaturation{P.asDiagonal(), 1.0, 2.0};
+    return std::make_unique<HighGainObserver<Duffing>>(Duffing{}, d, Eigen::Vector2d::Zero(), o);
+  });
+  state.SetLabel(ad ? "ceres projection, ADOL-C map" : "ceres projection, hand map");
+}
+BENCHMARK(BM_HighGainStepDuffing)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+void BM_HighGainStepLorenzLieAlpha(benchmark::State& state) {
+  static const Measurements data = record(Lorenz{}, Eigen::Vector3d(1.0, 1.0, 20.0), 1e-3, 5.0);
+  run<Lorenz>(state, data, [] {
+    HighGainObserver<Lorenz>::Design d;
+    d.map = std::make_shared<LieObservabilityMap>(Lorenz{}, 4);
+    HighGainOptions o;
+    o.sample_time = 1e-3;
+    o.theta = 0.02;
+    return std::make_unique<HighGainObserver<Lorenz>>(Lorenz{}, d, Eigen::Vector3d(2, 3, 25), o);
+  });
+  state.SetLabel("alpha = L_f^4 h by ADOL-C, ceres projection");
+}
+BENCHMARK(BM_HighGainStepLorenzLieAlpha)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+void BM_HighGainIntegrator(benchmark::State& state) {
+  static const Measurements data =
+      record(OscillatorNonlinearOutput{}, Eigen::Vector2d(-0.5, 0.0), 0.01, 20.0);
+  const bool cvode = state.range(0) == 1;
+  const double theta = static_cast<double>(state.range(1)) / 1000.0;
+  run<OscillatorNonlinearOutput>(state, data, [cvode, theta] {
+    HighGainObserver<OscillatorNonlinearOutput>::Design d;
+    d.map = std::make_shared<ExplicitObservabilityMap<OscillatorEmbedding>>();
+    d.alpha = explicit_alpha<OscillatorEmbedding>();
+    d.inverse = explicit_inverse<OscillatorEmbedding>();
+    HighGainOptions o;
+    o.sample_time = 0.01;
+    o.theta = theta;
+    o.saturation = oscillator_saturation();
+    o.integrator = cvode ? HighGainIntegrator::kCvode : HighGainIntegrator::kRk4;
+    return std::make_unique<HighGainObserver<OscillatorNonlinearOutput>>(
+        OscillatorNonlinearOutput{}, d, Eigen::Vector2d(-0.3, 0.0), o);
+  });
+  state.SetLabel(std::string(cvode ? "cvode" : "rk4") +
+                 ", h*|p|/theta = " + std::to_string(0.01 / theta));
+}
+BENCHMARK(BM_HighGainIntegrator)
+    ->ArgsProduct({{0, 1}, {300, 100, 30, 10, 5, 3}})
+    ->Unit(benchmark::kMillisecond);
+
+}  // namespace
