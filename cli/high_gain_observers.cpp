@@ -144,6 +144,7 @@ std::unique_ptr<Observer> build(Model model, const HighGainSpec& spec, const Eig
   o.observability_floor = spec.observability_floor;
   o.residual_scale = spec.residual_scale;
   o.restart_residual = spec.restart_residual;
+  o.restart_every = spec.restart_every;
   std::optional<Eigen::VectorXd> z0 = spec.initial_z;
   if (spec.initial_z_from) {
     if (spec.initial_z_from->size() != Model::kStates) {
@@ -203,6 +204,9 @@ HighGainSpec parse_high_gain_spec(JsonReader& o) {
   s.observability_floor = o.number("observability_floor").value_or(s.observability_floor);
   s.residual_scale = o.number("residual_scale").value_or(s.residual_scale);
   s.restart_residual = o.number("restart_residual").value_or(s.restart_residual);
+  const long every = o.integer("restart_every").value_or(s.restart_every);
+  if (every < 1 || every > 1000000) o.fail("'restart_every' must be in 1..1000000 (samples)");
+  s.restart_every = static_cast<int>(every);
   s.initial_z = o.vector("initial_z");
   s.initial_z_from = o.vector("initial_z_from");
   if (s.initial_z && s.initial_z_from) o.fail("give 'initial_z' or 'initial_z_from', not both");
@@ -239,6 +243,7 @@ void write_high_gain_spec(const HighGainSpec& s, nlohmann::json& out) {
   out["observability_floor"] = s.observability_floor;
   out["residual_scale"] = s.residual_scale;
   out["restart_residual"] = s.restart_residual;
+  out["restart_every"] = s.restart_every;
   if (s.initial_z) out["initial_z"] = to_std(*s.initial_z);
   if (s.initial_z_from) out["initial_z_from"] = to_std(*s.initial_z_from);
 }

@@ -33,6 +33,7 @@ struct HighGainSpec {
   int substeps = 1;
   double jump_threshold = 0.1, observability_floor = 1e-2, residual_scale = 0.1,
          restart_residual = 1e-2;
+  int restart_every = 1;
   std::optional<Eigen::VectorXd> initial_z{};       // ẑ(0)
   std::optional<Eigen::VectorXd> initial_z_from{};  // ẑ(0) = q_N(this x)
 };

@@ -48,6 +48,7 @@ void print_list(const std::string& what, std::ostream& out) {
            "(auto|explicit|lie), inverse, saturation ({P | P_diagonal | box, R, rho}), "
            "projection (engine spec), start (previous|predicted), integrator (auto|rk4|cvode), "
            "substeps, jump_threshold, observability_floor, residual_scale, restart_residual, "
+           "restart_every, "
            "initial_z | initial_z_from, initial, name\n";
     for (const auto& b : pi_bank_catalog()) {
       out << "      bank " << b.name << ": " << b.description << "; channels";

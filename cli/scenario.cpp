@@ -410,6 +410,7 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
                 "observability_floor",
                 "residual_scale",
                 "restart_residual",
+                "restart_every",
                 "initial_z",
                 "initial_z_from",
                 "initial"});

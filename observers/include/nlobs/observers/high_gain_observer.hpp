@@ -109,11 +109,15 @@ struct HighGainOptions {
   double absolute_tolerance = 1e-10, relative_tolerance = 1e-10;  // CVODE
   std::string projection = "ceres";  // least-squares engine spec (EngineRegistry)
   ProjectionStart start = ProjectionStart::kPrevious;
-  double jump_threshold = 0.1;  // ‖x̂_k − x̂_{k−1}‖∞ above this is a discontinuity
+  double jump_threshold = 0.1;  // ‖x̂_k − x̄(t_k)‖∞ above this is a jump (x̄: prediction)
   double observability_floor = 1e-2;  // ε of the weight of α = L_f^N h (see above)
   double residual_scale = 0.1;        // ρ_r of the same weight's residual factor
   // Restart the projection from x̂(0) and 0 when ‖ẑ − q_N(x̂)‖ > this · (1 + ‖ẑ‖); 0: never.
   double restart_residual = 1e-2;
+  // At most one restart per this many samples. 1 (default): the Duffing hard start needs them
+  // at every sample while ẑ converges (with 100, x̂ wandered at residual ~1 in wrong minima);
+  // under noise ẑ stays off the image and every sample restarts — raise it there (cost).
+  int restart_every = 1;
 };
 
 // [l_0, …, l_{N−1}] of Π (s − p_j). Throws InvalidInput for a root that is not < 0.
@@ -190,6 +194,7 @@ class HighGainObserver final : public Observer {
       fail("HighGainOptions::absolute_tolerance and relative_tolerance must be > 0");
     }
     if (!(options_.jump_threshold > 0.0)) fail("HighGainOptions::jump_threshold must be > 0");
+    if (options_.restart_every < 1) fail("HighGainOptions::restart_every must be >= 1");
     if (!(options_.observability_floor >= 0.0)) {
       fail("HighGainOptions::observability_floor must be >= 0");
     }
@@ -296,6 +301,7 @@ class HighGainObserver final : public Observer {
     residual_ = 0.0;
     weight_ = 1.0;
     started_once_ = false;
+    samples_since_restart_ = 0;
     xbar_ = xhat0_;
   }
 
@@ -528,8 +534,10 @@ class HighGainObserver final : public Observer {
       candidate = solve_projection(
           options_.start == ProjectionStart::kPredicted && xbar_.allFinite() ? xbar_ : previous);
       // A poor local minimum: restart from x̂(0) and the origin, keep the best of all.
-      if (options_.restart_residual > 0.0 &&
+      ++samples_since_restart_;
+      if (options_.restart_residual > 0.0 && samples_since_restart_ >= options_.restart_every &&
           !(residual_at(candidate) <= options_.restart_residual * (1.0 + zhat_.norm()))) {
+        samples_since_restart_ = 0;
         for (const State& start : {xhat0_, State(State::Zero())}) {
           const State other = solve_projection(start);
           if (residual_at(other) < residual_at(candidate)) candidate = other;
@@ -621,7 +629,7 @@ class HighGainObserver final : public Observer {
   SampleInterpolator<1> samples_;
   bool started_ = false, started_once_ = false;
   double last_t_ = 0.0, residual_ = 0.0, weight_ = 1.0;
-  long jumps_ = 0;
+  long jumps_ = 0, samples_since_restart_ = 0;
   std::string failure_;
   std::vector<double> state_;
   std::unique_ptr<StiffIntegrator> stiff_;
