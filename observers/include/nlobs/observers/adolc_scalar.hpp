@@ -5,21 +5,9 @@
 
 #include <Eigen/Core>
 
+#include "nlobs/observers/eigen_scalar.hpp"
+
 namespace Eigen {
 template <>
-struct NumTraits<adouble> : NumTraits<double> {
-  using Real = adouble;
-  using NonInteger = adouble;
-  using Nested = adouble;
-  using Literal = adouble;
-  enum {
-    IsComplex = 0,
-    IsInteger = 0,
-    IsSigned = 1,
-    RequireInitialization = 1,
-    ReadCost = 1,
-    AddCost = 3,
-    MulCost = 3
-  };
-};
+struct NumTraits<adouble> : nlobs::DoubleLikeNumTraits<adouble> {};
 }  // namespace Eigen

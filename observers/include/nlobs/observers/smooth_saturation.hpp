@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string>
 
+#include "nlobs/observers/eigen_scalar.hpp"
 #include "nlobs/solvers/status.hpp"
 
 namespace nlobs {
@@ -75,21 +76,7 @@ using Interval = boost::numeric::interval<double>;
 
 namespace Eigen {
 template <>
-struct NumTraits<nlobs::detail::Interval> : NumTraits<double> {
-  using Real = nlobs::detail::Interval;
-  using NonInteger = nlobs::detail::Interval;
-  using Nested = nlobs::detail::Interval;
-  using Literal = nlobs::detail::Interval;
-  enum {
-    IsComplex = 0,
-    IsInteger = 0,
-    IsSigned = 1,
-    RequireInitialization = 1,
-    ReadCost = 1,
-    AddCost = 2,
-    MulCost = 2
-  };
-};
+struct NumTraits<nlobs::detail::Interval> : nlobs::DoubleLikeNumTraits<nlobs::detail::Interval> {};
 }  // namespace Eigen
 
 namespace nlobs {
