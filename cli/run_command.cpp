@@ -541,12 +541,22 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
   std::snprintf(line, sizeof line, "%-8s %-20s %12s %12s %12s %14s %6s %9s\n", "theta", "observer",
                 "max||zhat||", "z RMS after", "x RMS after", "z<1e-6 from", "jumps", "us/step");
   out << line;
+  std::vector<std::string> names;
+  struct Row {
+    double theta;
+    std::string name;
+    double peak, z_rms, x_rms;
+  };
+  std::vector<Row> rows;
   for (double theta : values) {
     Scenario run = only;
     for (ObserverSpec& o : run.observers) o.high_gain.theta = theta;
     auto observers = make_observers(run, model, false);
     RunResult r = run_observers(data, observers, settle_index);
     add_coordinate_errors(data, observers, r);
+    if (names.empty()) {
+      for (const ObserverMetrics& m : r.metrics) names.push_back(m.name);
+    }
     for (size_t i = 0; i < observers.size(); ++i) {
       const auto em = embedded_metrics(r, i);
       const ObserverMetrics& m = r.metrics[i];
@@ -561,6 +571,8 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
                     std::isfinite(t_below) ? ("t = " + fmt(t_below, "%.3f")).c_str() : "never",
                     em ? em->jumps : 0.0, m.ns_per_step / 1e3);
       out << line;
+      rows.push_back(
+          {theta, m.name, em ? em->max_zhat_norm : NAN, em ? em->z_rms_after : NAN, x_rms});
       csv << theta << ',' << m.name << ',' << (em ? em->max_zhat_norm : NAN) << ','
           << (em ? em->z_rms_after : NAN) << ',' << x_rms << ',' << t_below << ','
           << (em ? em->jumps : 0.0) << ',' << failures << ',' << m.ns_per_step / 1e3 << '\n';
@@ -575,15 +587,34 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
   out << "wrote " << (dir / "sweep.csv").string();
   if (have_gnuplot()) {
     std::ostringstream g;
-    g << "set datafile separator ','\nset terminal pngcairo size 1000,800\nset output '"
-      << (dir / "sweep.png").string()
+    // One block per observer (sweep.dat, gnuplot's index): sweep.csv interleaves them per θ.
+    std::ostringstream blocks;
+    blocks << std::setprecision(10);
+    for (const std::string& name : names) {
+      blocks << "# " << name << ": theta max_zhat_norm z_rms_after x_rms_after\n";
+      for (const auto& row : rows) {
+        if (row.name == name) {
+          blocks << row.theta << ' ' << row.peak << ' ' << row.z_rms << ' ' << row.x_rms << '\n';
+        }
+      }
+      blocks << "\n\n";
+    }
+    write_atomically(dir / "sweep.dat", blocks.str());
+    const auto series = [&](int column, const std::string& suffix) {
+      std::string text;
+      for (size_t i = 0; i < names.size(); ++i) {
+        text += (i ? ", " : "") + std::string("'sweep.dat' index ") + std::to_string(i) +
+                " using 1:" + std::to_string(column) + " with linespoints title '" + names[i] +
+                suffix + "'";
+      }
+      return text;
+    };
+    g << "set terminal pngcairo size 1000,800\nset output '" << (dir / "sweep.png").string()
       << "'\nset multiplot layout 2,1 title 'theta sweep: " << s.name << " (noise " << s.noise
       << ")'\nset logscale xy\nset grid\nset key outside right\n"
-      << "set xlabel 'theta'\nset ylabel 'max ||zhat|| (peaking)'\n"
-      << "plot 'sweep.csv' skip 1 using 1:3 with linespoints title 'max ||zhat||'\n"
-      << "set ylabel 'RMS error after settling'\n"
-      << "plot 'sweep.csv' skip 1 using 1:4 with linespoints title 'z', "
-         "'sweep.csv' skip 1 using 1:5 with linespoints title 'x'\nunset multiplot\n";
+      << "set xlabel 'theta'\nset ylabel 'max ||zhat|| (peaking)'\nplot " << series(2, "")
+      << "\nset ylabel 'RMS error after settling'\nplot " << series(3, " z") << ", "
+      << series(4, " x") << "\nunset multiplot\n";
     write_atomically(dir / "sweep.gp", g.str());
     const std::string cmd = "cd '" + dir.string() + "' && gnuplot sweep.gp 2>gnuplot.log";
     if (std::system(cmd.c_str()) != 0) {
