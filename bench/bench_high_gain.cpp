@@ -4,7 +4,7 @@
 //     inverse, the least-squares projection with a hand map (ceres::Jet Jacobian) and with the
 //     ADOL-C map, α explicit or L_f^N h;
 //   BM_HighGainIntegrator/<rk4|cvode>/<θ·1000>: the oscillator at h = 0.01 as θ shrinks —
-//     the measurement behind the `auto` choice (RK4 while h·max|p|/θ ≤ 0.5).
+//     the measurement behind the `auto` choice (RK4 while h·max|p|/θ ≤ 0.2).
 // Counters: z_error = ‖q_N(x) − ẑ‖ at the last sample, failures.
 #include <benchmark/benchmark.h>
 

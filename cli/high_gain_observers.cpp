@@ -90,6 +90,12 @@ std::unique_ptr<Observer> build(Model model, const HighGainSpec& spec, const Eig
     }
   };
   typename HighGainObserver<Model>::Design design;
+  if (start.size() != Model::kStates) {
+    refuse("'initial' must have " + std::to_string(Model::kStates) + " entries");
+  }
+  if (spec.initial_z && spec.initial_z->size() != N) {
+    refuse("'initial_z' must have N = " + std::to_string(N) + " entries");
+  }
   if (spec.map == "explicit") {
     need_hand("'map': explicit");
     if constexpr (kHand) design.map = std::make_shared<ExplicitObservabilityMap<Form>>();
@@ -100,6 +106,9 @@ std::unique_ptr<Observer> build(Model model, const HighGainSpec& spec, const Eig
     if constexpr (kHand) return has_alpha<Form> && hand_ok && N == Form::kDimension;
     return false;
   }();
+  if (spec.map == "explicit" && (spec.alpha == "lie" || (spec.alpha == "auto" && !hand_alpha))) {
+    refuse("α = L_f^N h needs 'map': ad (it comes from the model's ADOL-C tapes)");
+  }
   if (spec.alpha == "explicit" || (spec.alpha == "auto" && hand_alpha)) {
     if (!hand_alpha) refuse("'alpha': explicit needs a hand α (duffing N = 6, oscillator N = 4)");
     if constexpr (kHand) {
@@ -179,12 +188,15 @@ HighGainSpec parse_high_gain_spec(JsonReader& o) {
   }
   s.inverse = o.boolean("inverse").value_or(false);
   if (auto sat = o.object("saturation")) {
-    if (auto p = sat->matrix("P")) s.saturation_p = *p;
-    if (auto d = sat->vector("P_diagonal")) s.saturation_p = d->asDiagonal();
-    if (auto b = sat->vector("box")) s.saturation_box = *b;
-    if ((s.saturation_p.size() > 0) == (s.saturation_box.size() > 0)) {
+    const auto p = sat->matrix("P");
+    const auto d = sat->vector("P_diagonal");
+    const auto b = sat->vector("box");
+    if ((p ? 1 : 0) + (d ? 1 : 0) + (b ? 1 : 0) != 1) {
       sat->fail("give one of 'P', 'P_diagonal' or 'box'");
     }
+    if (p) s.saturation_p = *p;
+    if (d) s.saturation_p = d->asDiagonal();
+    if (b) s.saturation_box = *b;
     s.saturation_r = sat->number("R").value_or(1.0);
     s.saturation_rho = sat->number("rho").value_or(2.0);
     sat->finish({"P", "P_diagonal", "box", "R", "rho"});

@@ -190,7 +190,8 @@ std::optional<EmbeddedMetrics> embedded_metrics(const RunResult& r, size_t i) {
   }
   m.final_z_error = e(row, K - 1);
   for (Eigen::Index k = K - 1; k >= 0 && e(row, k) < 1e-6; --k) m.time_index_below = k;
-  const Eigen::Index from = std::clamp<Eigen::Index>(r.settle_index, 0, K - 1);
+  const Eigen::Index from = std::max<Eigen::Index>(r.settle_index, 0);
+  if (from >= K) return m;  // nothing after the settle index: the "after" figures stay NaN
   double sum = 0.0, worst = 0.0;
   for (Eigen::Index k = from; k < K; ++k) {
     sum += e(row, k) * e(row, k);
@@ -560,8 +561,9 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
     for (size_t i = 0; i < observers.size(); ++i) {
       const auto em = embedded_metrics(r, i);
       const ObserverMetrics& m = r.metrics[i];
+      // RMS of ‖x − x̂‖₂: the per-state mean squares summed over the states.
       const double x_rms =
-          m.mse_after_window.size() ? std::sqrt(m.mse_after_window.mean()) : std::nan("");
+          m.mse_after_window.size() ? std::sqrt(m.mse_after_window.sum()) : std::nan("");
       long failures = 0;
       for (const auto& [status, count] : m.failures) failures += count;
       const double t_below = em && em->time_index_below >= 0 ? data.t[em->time_index_below] : NAN;
@@ -579,27 +581,28 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
     }
   }
   if (options.out_dir.empty()) return;
-  const fs::path dir(options.out_dir);
+  // Absolute: gnuplot runs inside the directory and writes to this path.
+  const fs::path dir = fs::absolute(options.out_dir);
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) throw std::runtime_error("cannot create " + dir.string() + ": " + ec.message());
   write_atomically(dir / "sweep.csv", csv.str());
-  out << "wrote " << (dir / "sweep.csv").string();
+  // One block per observer (sweep.dat, gnuplot's index): sweep.csv interleaves them per θ.
+  std::ostringstream blocks;
+  blocks << std::setprecision(10);
+  for (const std::string& name : names) {
+    blocks << "# " << name << ": theta max_zhat_norm z_rms_after x_rms_after\n";
+    for (const auto& row : rows) {
+      if (row.name == name) {
+        blocks << row.theta << ' ' << row.peak << ' ' << row.z_rms << ' ' << row.x_rms << '\n';
+      }
+    }
+    blocks << "\n\n";
+  }
+  write_atomically(dir / "sweep.dat", blocks.str());
+  out << "wrote " << (dir / "sweep.csv").string() << ", sweep.dat";
   if (have_gnuplot()) {
     std::ostringstream g;
-    // One block per observer (sweep.dat, gnuplot's index): sweep.csv interleaves them per θ.
-    std::ostringstream blocks;
-    blocks << std::setprecision(10);
-    for (const std::string& name : names) {
-      blocks << "# " << name << ": theta max_zhat_norm z_rms_after x_rms_after\n";
-      for (const auto& row : rows) {
-        if (row.name == name) {
-          blocks << row.theta << ' ' << row.peak << ' ' << row.z_rms << ' ' << row.x_rms << '\n';
-        }
-      }
-      blocks << "\n\n";
-    }
-    write_atomically(dir / "sweep.dat", blocks.str());
     const auto series = [&](int column, const std::string& suffix) {
       std::string text;
       for (size_t i = 0; i < names.size(); ++i) {
@@ -618,6 +621,7 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
     write_atomically(dir / "sweep.gp", g.str());
     const std::string cmd = "cd '" + dir.string() + "' && gnuplot sweep.gp 2>gnuplot.log";
     if (std::system(cmd.c_str()) != 0) {
+      out << '\n';
       throw std::runtime_error("gnuplot failed; see " + (dir / "gnuplot.log").string());
     }
     out << ", sweep.png";
@@ -712,7 +716,8 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
   print_bounds(bounds, out);
 
   if (!options.out_dir.empty()) {
-    const fs::path dir(options.out_dir);
+    // Absolute: gnuplot runs inside the directory and writes to this path.
+    const fs::path dir = fs::absolute(options.out_dir);
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (ec) throw std::runtime_error("cannot create " + dir.string() + ": " + ec.message());

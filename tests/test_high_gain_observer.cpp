@@ -136,6 +136,27 @@ TEST(ObservabilityMap, OscillatorInverseIsExactOnTheImage) {
   }
 }
 
+// A time-varying model (the pendulum's friction c(t)) has no autonomous q_N: refused.
+TEST(ObservabilityMap, TimeVaryingModelsAreRefused) {
+  try {
+    LieObservabilityMap map(PendulumTimeVaryingFriction{}, 3);
+    FAIL() << "accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("depends on t"), std::string::npos) << e.what();
+  }
+  HighGainObserver<PendulumTimeVaryingFriction>::Design d;
+  d.map = std::make_shared<ExplicitObservabilityMap<OscillatorEmbedding>>();
+  d.alpha = explicit_alpha<OscillatorEmbedding>();
+  HighGainOptions o;
+  o.sample_time = 0.01;
+  try {
+    HighGainObserver<PendulumTimeVaryingFriction> observer({}, d, Eigen::Vector2d::Zero(), o);
+    FAIL() << "accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("depends on t"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ObservabilityMap, BadInputNamesWhatIsWrong) {
   try {
     LieObservabilityMap map(Lorenz{}, 2);
@@ -296,12 +317,65 @@ TEST(HighGainObserver, CvodeAgreesWithRk4) {
   const Measurements data =
       simulate_continuous(OscillatorNonlinearOutput{}, Eigen::Vector2d(-0.5, 0.0), h, 22.0);
   HighGainOptions o = oscillator_options(h);
+  o.integrator = HighGainIntegrator::kRk4;
+  OscillatorObserver explicit_steps(OscillatorNonlinearOutput{}, oscillator_design(true),
+                                    Eigen::Vector2d(-0.3, 0.0), o);
   o.integrator = HighGainIntegrator::kCvode;
   OscillatorObserver implicit(OscillatorNonlinearOutput{}, oscillator_design(true),
                               Eigen::Vector2d(-0.3, 0.0), o);
-  const Trace t = run(implicit, data);
-  EXPECT_TRUE(t.failures.empty());
-  EXPECT_LT(max_after(t.z_error, data, 20.0), 1e-6);
+  double largest_gap = 0.0;
+  for (Eigen::Index k = 0; k < data.steps(); ++k) {
+    ASSERT_TRUE(explicit_steps.step(k, data.y.col(k), data.u.col(k)).failure.empty());
+    ASSERT_TRUE(implicit.step(k, data.y.col(k), data.u.col(k)).failure.empty());
+    largest_gap = std::max(largest_gap, (implicit.zhat() - explicit_steps.zhat()).norm());
+  }
+  EXPECT_LT(largest_gap, 1e-6);  // both solve the same ODE (RK4 at h·|p|/θ = 0.017)
+  EXPECT_LT((implicit.coordinates_of(data.x.col(data.steps() - 1)) - implicit.zhat()).norm(), 1e-6);
+}
+
+// CVODE with α = L_f^N h: the prediction x̄ and its Jacobian rows are in the implicit system.
+TEST(HighGainObserver, CvodeWithLieAlphaMatchesRk4) {
+  const double h = 1e-3;
+  const Measurements data = simulate_continuous(Lorenz{}, Eigen::Vector3d(1.0, 1.0, 20.0), h, 0.3);
+  HighGainObserver<Lorenz>::Design d;
+  d.map = std::make_shared<LieObservabilityMap>(Lorenz{}, 4);
+  HighGainOptions o;
+  o.sample_time = h;
+  o.theta = 0.05;
+  o.integrator = HighGainIntegrator::kRk4;
+  o.substeps = 20;  // the reference: RK4 converged in the step
+  HighGainObserver<Lorenz> rk4(Lorenz{}, d, Eigen::Vector3d(2.0, 3.0, 25.0), o);
+  o.integrator = HighGainIntegrator::kCvode;
+  o.substeps = 1;
+  HighGainObserver<Lorenz> cvode(Lorenz{}, d, Eigen::Vector3d(2.0, 3.0, 25.0), o);
+  double worst = 0.0;
+  for (Eigen::Index k = 0; k < data.steps(); ++k) {
+    ASSERT_TRUE(rk4.step(k, data.y.col(k), data.u.col(k)).failure.empty());
+    ASSERT_TRUE(cvode.step(k, data.y.col(k), data.u.col(k)).failure.empty());
+    worst = std::max(worst, (cvode.zhat() - rk4.zhat()).norm() / (1.0 + rk4.zhat().norm()));
+  }
+  EXPECT_LT(worst, 1e-6);
+}
+
+// A sample CVODE cannot integrate past: an error for that sample, ẑ kept, and the sample does
+// not poison the interpolation of the next ones.
+TEST(HighGainObserver, CvodeFailureKeepsTheStateAndRecovers) {
+  const double h = 0.01;
+  const Measurements data =
+      simulate_continuous(OscillatorNonlinearOutput{}, Eigen::Vector2d(-0.5, 0.0), h, 1.0);
+  HighGainOptions o = oscillator_options(h);
+  o.integrator = HighGainIntegrator::kCvode;
+  OscillatorObserver observer(OscillatorNonlinearOutput{}, oscillator_design(true),
+                              Eigen::Vector2d(-0.3, 0.0), o);
+  for (Eigen::Index k = 0; k < 50; ++k) observer.step(k, data.y.col(k), data.u.col(k));
+  const Eigen::VectorXd before = observer.zhat();
+  const ObserverStep& bad = observer.step(50, Eigen::VectorXd::Constant(1, 1e300), data.u.col(50));
+  EXPECT_EQ(bad.failure, "non_finite");
+  EXPECT_FALSE(bad.failure_message.empty());
+  EXPECT_EQ(observer.zhat(), before);
+  for (Eigen::Index k = 51; k < 60; ++k) {
+    EXPECT_TRUE(observer.step(k, data.y.col(k), data.u.col(k)).failure.empty()) << k;
+  }
 }
 
 // METHODS §5's hard start: ẑ(0) = q6(0, 0) while x circles the equilibrium (1, 0).
@@ -382,20 +456,35 @@ TEST(HighGainObserver, VanDerPolWithLieAlphaConverges) {
   EXPECT_LT(max_after(t.x_error, data, 2.0), 1e-3);  // measured 7.1e-5
 }
 
-// Missing samples are held and bridged; the observer still converges.
+// Missing samples after convergence are bridged: the error right after the gap stays small.
 TEST(HighGainObserver, MissingSamplesAreBridged) {
   const double h = 0.005;
   Measurements data =
       simulate_continuous(OscillatorNonlinearOutput{}, Eigen::Vector2d(-0.5, 0.0), h, 25.0);
-  for (Eigen::Index k = 500; k < 510; ++k) data.y(0, k) = std::nan("");
+  for (Eigen::Index k = 4400; k < 4410; ++k) data.y(0, k) = std::nan("");  // t = 22–22.05 s
   OscillatorObserver observer(OscillatorNonlinearOutput{}, oscillator_design(true),
                               Eigen::Vector2d(-0.3, 0.0), oscillator_options(h));
   long missing = 0;
+  double after_gap = 0.0;
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
     missing += observer.step(k, data.y.col(k), data.u.col(k)).measurement_missing ? 1 : 0;
+    if (k >= 4410 && k < 4430) {
+      after_gap = std::max(after_gap, (data.x.col(k) - observer.xhat()).norm());
+    }
   }
   EXPECT_EQ(missing, 10);
+  EXPECT_LT(after_gap, 1e-5);
   EXPECT_LT((data.x.col(data.steps() - 1) - observer.xhat()).norm(), 1e-6);
+}
+
+TEST(HighGainObserver, SamplesMustArriveInOrder) {
+  OscillatorObserver observer(OscillatorNonlinearOutput{}, oscillator_design(true),
+                              Eigen::Vector2d(-0.3, 0.0), oscillator_options(0.01));
+  const Eigen::VectorXd y = Eigen::VectorXd::Constant(1, -0.25), none(0);
+  observer.step(0, y, none);
+  observer.step(1, y, none);
+  EXPECT_THROW(observer.step(1, y, none), InvalidInput);
+  EXPECT_TRUE(observer.step(2, y, none).failure.empty());
 }
 
 // A map that stops giving finite values when told to: the projection's failure keeps x̂.
@@ -481,6 +570,12 @@ TEST(HighGainObserver, BadOptionsAreErrorsNamingTheOption) {
   o = good;
   o.sample_time = 0.0;
   EXPECT_NE(message(o, oscillator_design(true)).find("sample_time"), std::string::npos);
+  o = good;
+  o.residual_scale = 0.0;
+  EXPECT_NE(message(o, oscillator_design(true)).find("residual_scale"), std::string::npos);
+  o = good;
+  o.theta = 1e-80;
+  EXPECT_NE(message(o, oscillator_design(true)).find("overflow"), std::string::npos);
   // No α and a map that cannot give L_f^N h.
   OscillatorObserver::Design no_alpha = oscillator_design(true);
   no_alpha.alpha = {};

@@ -398,6 +398,7 @@ TEST(RunHighGain, OscillatorAndDuffingReachOneMicro) {
     EXPECT_LT(o["time_to_z_1e-6"].get<double>(), 18.0) << name;  // measured 16.9 s
     EXPECT_LT(o["z_rms_after"].get<double>(), 1e-6) << name;
     EXPECT_LT(o["max_error_after"][0].get<double>(), 1e-6) << name;
+    EXPECT_LT(o["max_error_after"][1].get<double>(), 1e-6) << name;
     EXPECT_TRUE(o["failures"].empty()) << name;
   }
   EXPECT_FALSE(observer_of(osc, "ekf").contains("time_to_z_1e-6"));
@@ -482,6 +483,15 @@ TEST(RunHighGain, ScenariosRoundTripAndBadSpecsNameTheProblem) {
         scenario("duffing", 2,
                  R"({"type": "high_gain", "saturation": {"P_diagonal": [1, 1], "box": [1, 1]}})"));
   EXPECT_NE(error_of(f.string()).find("give one of"), std::string::npos);
+  write(f, scenario("duffing", 2,
+                    R"({"type": "high_gain", "saturation": {"P": [[1, 0], [0, 1]],
+                        "P_diagonal": [1, 1]}})"));
+  EXPECT_NE(error_of(f.string()).find("give one of"), std::string::npos);
+  write(f, scenario("pendulum", 2, R"({"type": "high_gain", "N": 3})"));
+  EXPECT_NE(error_of(f.string()).find("depends on t"), std::string::npos) << error_of(f.string());
+  write(f, scenario("lorenz", 3, R"({"type": "high_gain", "map": "explicit"})"));
+  EXPECT_NE(error_of(f.string()).find("needs 'map': ad"), std::string::npos)
+      << error_of(f.string());
   write(f, scenario("duffing", 2,
                     R"({"type": "high_gain", "saturation": {"P_diagonal": [1, 1, 1, 1, 1, -1]}})"));
   EXPECT_NE(error_of(f.string()).find("not positive definite"), std::string::npos)

@@ -2,16 +2,19 @@
 
 #include <adolc/drivers/odedrivers.h>
 
-#include <atomic>
 #include <cmath>
+#include <mutex>
 #include <sstream>
+#include <vector>
 
 namespace nlobs {
 
 namespace {
 // ADOL-C numbers tapes with shorts, process-wide: ours count up from 20000 so that a user's
-// own small tape numbers do not collide.
-std::atomic<int> next_tape{20000};
+// own small tape numbers do not collide; pairs freed by destroyed maps are reused first.
+std::mutex tapes_mutex;
+int next_tape = 20000;
+std::vector<int> free_tapes;
 }  // namespace
 
 LieObservabilityMap::Buffers::Buffers(int states, int d)
@@ -39,8 +42,20 @@ LieObservabilityMap::Buffers::~Buffers() {
 }
 
 void LieObservabilityMap::init() {
-  const int tag = next_tape.fetch_add(2);
-  if (tag + 1 > 32767) throw InvalidInput(description_ + ": ADOL-C's tape numbers are exhausted");
+  int tag = 0;
+  {
+    std::lock_guard<std::mutex> lock(tapes_mutex);
+    if (!free_tapes.empty()) {
+      tag = free_tapes.back();
+      free_tapes.pop_back();
+    } else {
+      if (next_tape + 1 > 32767) {
+        throw InvalidInput(description_ + ": ADOL-C's tape numbers are exhausted");
+      }
+      tag = next_tape;
+      next_tape += 2;
+    }
+  }
   tape_f_ = static_cast<short>(tag);
   tape_h_ = static_cast<short>(tag + 1);
   buffers_ = std::make_unique<Buffers>(n_, N_);
@@ -49,6 +64,8 @@ void LieObservabilityMap::init() {
 LieObservabilityMap::~LieObservabilityMap() {
   removeTape(tape_f_, ADOLC_REMOVE_COMPLETELY);
   removeTape(tape_h_, ADOLC_REMOVE_COMPLETELY);
+  std::lock_guard<std::mutex> lock(tapes_mutex);
+  free_tapes.push_back(tape_f_);
 }
 
 void LieObservabilityMap::check(const Eigen::VectorXd& x, int order) const {

@@ -7,6 +7,7 @@
 #include <sunmatrix/sunmatrix_dense.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <sstream>
 #include <vector>
 
@@ -76,7 +77,7 @@ StiffIntegrator::StiffIntegrator(int size, Rhs rhs, Jacobian jacobian, double re
   check(CVodeSetUserData(s.cvode, &s) == CV_SUCCESS, "CVodeSetUserData");
   check(CVodeSetLinearSolver(s.cvode, s.solver, s.matrix) == CV_SUCCESS, "CVodeSetLinearSolver");
   check(CVodeSetJacFn(s.cvode, Impl::jac) == CV_SUCCESS, "CVodeSetJacFn");
-  check(CVodeSetMaxNumSteps(s.cvode, 100000) == CV_SUCCESS, "CVodeSetMaxNumSteps");
+  check(CVodeSetMaxNumSteps(s.cvode, 20000) == CV_SUCCESS, "CVodeSetMaxNumSteps");
   // Its messages go to stderr by default; failures reach the caller as text instead.
   CVodeSetErrHandlerFn(
       s.cvode, [](int, const char*, const char*, char*, void*) {}, nullptr);
@@ -102,7 +103,9 @@ bool StiffIntegrator::integrate(double t0, double t1, double* state, std::string
   if (flag < 0) {
     if (failure) {
       std::ostringstream os;
-      os << "CVODE failed at t = " << t << " (" << CVodeGetReturnFlagName(flag) << ")";
+      char* name = CVodeGetReturnFlagName(flag);  // malloc'ed by SUNDIALS
+      os << "CVODE failed at t = " << t << " (" << name << ")";
+      free(name);
       *failure = os.str();
     }
     std::copy(s.backup.begin(), s.backup.end(), state);

@@ -66,4 +66,22 @@ std::string domain_violation_of(const M& model, const ModelVector<double, M::kSt
   }
 }
 
+// True when F(x, 0, t) changes with t at a few probe states: a time-varying model (observers
+// built for x' = f(x), such as the high-gain observer of METHODS §5, refuse it).
+template <ContinuousModel M>
+bool vector_field_depends_on_time(const M& model) {
+  static_assert(M::kStates != Eigen::Dynamic && M::kInputs != Eigen::Dynamic,
+                "vector_field_depends_on_time needs compile-time sizes");
+  using State = ModelVector<double, M::kStates>;
+  const ModelVector<double, M::kInputs> u = ModelVector<double, M::kInputs>::Zero();
+  for (const State& x : {State(State::LinSpaced(M::kStates, 0.3, 1.1)),
+                         State(State::LinSpaced(M::kStates, -0.7, 0.4))}) {
+    const State f0 = model.vector_field(x, u, 0.0);
+    for (double t : {0.7, 3.1}) {
+      if (!(model.vector_field(x, u, t) == f0)) return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace nlobs

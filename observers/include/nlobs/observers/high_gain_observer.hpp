@@ -32,6 +32,7 @@
 #include <cmath>
 #include <complex>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -195,6 +196,15 @@ class HighGainObserver final : public Observer {
     }
     if (!(options_.jump_threshold > 0.0)) fail("HighGainOptions::jump_threshold must be > 0");
     if (options_.restart_every < 1) fail("HighGainOptions::restart_every must be >= 1");
+    if (!(options_.residual_scale > 0.0) || !std::isfinite(options_.residual_scale)) {
+      fail("HighGainOptions::residual_scale must be finite and > 0");
+    }
+    if (!(options_.restart_residual >= 0.0) || !std::isfinite(options_.restart_residual)) {
+      fail("HighGainOptions::restart_residual must be finite and >= 0 (0: never restart)");
+    }
+    if (vector_field_depends_on_time(model_)) {
+      fail("the model's vector field depends on t: this observer is for autonomous x' = f(x)");
+    }
     if (!(options_.observability_floor >= 0.0)) {
       fail("HighGainOptions::observability_floor must be >= 0");
     }
@@ -240,8 +250,11 @@ class HighGainObserver final : public Observer {
           },
           [this](const Vector<n>& x, Matrix<Eigen::Dynamic, n>& jac) {
             x_ = x;
-            design_.map->jacobian(x_, dq_);
-            jac = dq_;
+            if (design_.map->jacobian(x_, dq_)) {
+              jac = dq_;
+            } else {  // never the previous point's Jacobian
+              jac.setConstant(std::numeric_limits<double>::quiet_NaN());
+            }
           },
           n, N_));
       if (!engine_->least_squares() && N_ != n) {
@@ -305,6 +318,42 @@ class HighGainObserver final : public Observer {
     xbar_ = xhat0_;
   }
 
+  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
+    if (y.size() != 1 || u.size() != Model::kInputs) {
+      throw InvalidInput(name_ + ": a sample must have 1 output and " +
+                         std::to_string(Model::kInputs) + " inputs");
+    }
+    const double t = static_cast<double>(k) * options_.sample_time;
+    step_.failure.clear();
+    step_.failure_message.clear();
+    step_.measurement_missing = !y.allFinite();
+    step_.ready = true;
+    if (!u.allFinite()) {
+      step_.failure = "non_finite";
+      step_.failure_message = name_ + ": u_k is not finite at t = " + std::to_string(t);
+      return publish();
+    }
+    if (started_ && !(t > last_t_)) {
+      throw InvalidInput(name_ + ": sample k = " + std::to_string(k) +
+                         " does not come after the last one: samples must arrive in order");
+    }
+    input_ = u;
+    if (step_.measurement_missing) return publish();  // hold; the next sample bridges the gap
+    const SampleInterpolator<1> before = samples_;
+    samples_.push(t, Eigen::Matrix<double, 1, 1>(y[0]));
+    if (started_ && !integrate(last_t_, t)) {
+      samples_ = before;  // the sample that broke the step does not shape the next ones
+      step_.failure = "non_finite";
+      step_.failure_message = failure_;
+      return publish();  // the last good state; the next sample integrates from last_t_
+    }
+    started_ = true;
+    last_t_ = t;
+    project(t);
+    return publish();
+  }
+
+ private:
   // The observer's right-hand side at t for the state s = (ẑ, x̄) with y(t) given: METHODS §5.
   // False (derivatives zero) when α or f is not finite there.
   bool derivatives(double t, const double* s, double y, double* ds) {
@@ -331,36 +380,6 @@ class HighGainObserver final : public Observer {
     return true;
   }
 
-  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
-    if (y.size() != 1 || u.size() != Model::kInputs) {
-      throw InvalidInput(name_ + ": a sample must have 1 output and " +
-                         std::to_string(Model::kInputs) + " inputs");
-    }
-    const double t = static_cast<double>(k) * options_.sample_time;
-    step_.failure.clear();
-    step_.failure_message.clear();
-    step_.measurement_missing = !y.allFinite();
-    step_.ready = true;
-    if (!u.allFinite()) {
-      step_.failure = "non_finite";
-      step_.failure_message = name_ + ": u_k is not finite at t = " + std::to_string(t);
-      return publish();
-    }
-    input_ = u;
-    if (step_.measurement_missing) return publish();  // hold; the next sample bridges the gap
-    samples_.push(t, Eigen::Matrix<double, 1, 1>(y[0]));
-    if (started_ && !integrate(last_t_, t)) {
-      step_.failure = "non_finite";
-      step_.failure_message = failure_;
-      return publish();  // the last good state; the next sample integrates from last_t_
-    }
-    started_ = true;
-    last_t_ = t;
-    project(t);
-    return publish();
-  }
-
- private:
   bool zero(double* ds) const {
     for (Eigen::Index i = 0; i < state_size(); ++i) ds[i] = 0.0;
     return false;
@@ -405,6 +424,10 @@ class HighGainObserver final : public Observer {
     gains_.resize(N_);
     for (Eigen::Index i = 1; i <= N_; ++i) {
       gains_[i - 1] = coefficients_[N_ - i] / std::pow(options_.theta, static_cast<double>(i));
+    }
+    if (!gains_.allFinite()) {
+      throw InvalidInput(name_ + ": HighGainOptions::theta = " + std::to_string(options_.theta) +
+                         " makes the gains l/θ^N overflow");
     }
   }
 
@@ -552,6 +575,7 @@ class HighGainObserver final : public Observer {
       os << name_ << ": the projection of ẑ = [" << zhat_.transpose() << "] at t = " << t
          << " failed (no finite x̂); x̂ kept";
       step_.failure_message = os.str();
+      residual_ = std::numeric_limits<double>::quiet_NaN();  // no x̂ belongs to this ẑ
       return;
     }
     residual_ = (z_ - zhat_).norm();

@@ -84,6 +84,11 @@ LieObservabilityMap::LieObservabilityMap(const Model& model, int N, std::string 
     throw InvalidInput(description_ + ": N = " + std::to_string(N) +
                        " must be >= 2 and >= the state dimension " + std::to_string(n));
   }
+  if (vector_field_depends_on_time(model)) {
+    throw InvalidInput(description_ +
+                       ": the model's vector field depends on t; observability maps here are for "
+                       "autonomous systems x' = f(x)");
+  }
   init();  // tape numbers and buffers
   using ADState = ModelVector<adouble, n>;
   const typename Model::Input u = Model::Input::Zero();

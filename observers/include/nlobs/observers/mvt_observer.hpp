@@ -222,6 +222,7 @@ class MvtObserver final : public Observer {
       return publish();
     }
     if (step_.measurement_missing) return publish();  // hold; the next sample bridges the gap
+    const SampleInterpolator<P> before = samples_;
     samples_.push(t, Output(y));
     if (!started_) {
       // The first sample: the state is the initial condition; evaluate once to report β.
@@ -233,6 +234,7 @@ class MvtObserver final : public Observer {
       }
       started_ = true;
     } else if (!integrate(last_t_, t)) {
+      samples_ = before;  // the sample that broke the step does not shape the next ones
       step_.failure = "non_finite";
       step_.failure_message = failure_;
       return publish();  // the last good state; the next sample integrates from last_t_
