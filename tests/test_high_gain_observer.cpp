@@ -3,6 +3,7 @@
 // observer's convergence and failure modes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -475,6 +476,31 @@ TEST(HighGainObserver, MissingSamplesAreBridged) {
   EXPECT_EQ(missing, 10);
   EXPECT_LT(after_gap, 1e-5);
   EXPECT_LT((data.x.col(data.steps() - 1) - observer.xhat()).norm(), 1e-6);
+}
+
+// With an explicit α the model's prediction only warm-starts the projection: from an x̂ where
+// the prediction overflows (Duffing at x̂ = (1e100, 0); the projection fails there and keeps
+// x̂ until the fifth sample's restart from the origin) the observer keeps integrating ẑ
+// instead of failing every step, and converges.
+TEST(HighGainObserver, ABlownUpPredictionDoesNotStopAnExplicitAlpha) {
+  const double h = 1e-3;
+  const Measurements data = simulate_continuous(Duffing{}, Eigen::Vector2d(1.2, 0.0), h, 12.0);
+  HighGainObserver<Duffing>::Design d;
+  d.map = std::make_shared<ExplicitObservabilityMap<DuffingEmbedding>>();
+  d.alpha = explicit_alpha<DuffingEmbedding>();
+  HighGainOptions o;
+  o.sample_time = h;
+  o.theta = 0.1;
+  Eigen::VectorXd P(6);
+  P << 0.8, 0.145, 0.103, 0.0158, 4.07e-3, 5.26e-4;
+  o.saturation = SmoothSaturation{P.asDiagonal(), 1.0, 2.0};
+  o.restart_every = 5;
+  HighGainObserver<Duffing> observer(Duffing{}, d, Eigen::Vector2d(1e100, 0.0), o,
+                                     Eigen::VectorXd::Zero(6));
+  const Trace t = run(observer, data);
+  EXPECT_TRUE(std::find(t.failures.begin(), t.failures.end(), "non_finite") == t.failures.end());
+  EXPECT_LT(max_after(t.z_error, data, 10.5), 1e-6);
+  EXPECT_LT(max_after(t.x_error, data, 10.5), 1e-6);
 }
 
 TEST(HighGainObserver, SamplesMustArriveInOrder) {

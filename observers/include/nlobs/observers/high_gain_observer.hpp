@@ -374,8 +374,16 @@ class HighGainObserver final : public Observer {
     if (options_.saturation) alpha *= options_.saturation->factor(zs_);
     for (Eigen::Index i = 0; i + 1 < N_; ++i) ds[i] = s[i + 1] + gains_[i] * innovation;
     ds[N_ - 1] = alpha + gains_[N_ - 1] * innovation;
-    for (Eigen::Index i = 0; i < state_size(); ++i) {
+    for (Eigen::Index i = 0; i < N_; ++i) {
       if (!std::isfinite(ds[i])) return zero(ds);
+    }
+    for (Eigen::Index i = N_; i < state_size(); ++i) {
+      if (std::isfinite(ds[i])) continue;
+      if (lie_alpha_) return zero(ds);
+      // With an explicit α, x̄ only warm-starts the projection: a prediction that blows up (x̂
+      // far off, f superlinear) is frozen instead of failing the observer.
+      for (Eigen::Index j = N_; j < state_size(); ++j) ds[j] = 0.0;
+      break;
     }
     return true;
   }
@@ -480,7 +488,14 @@ class HighGainObserver final : public Observer {
       failure_ = name_ + ": " + failure_;
       finite = false;
     }
-    for (double v : state_) finite = finite && std::isfinite(v);
+    for (Eigen::Index i = 0; i < state_size(); ++i) {
+      if (std::isfinite(state_[static_cast<size_t>(i)])) continue;
+      if (i < N_ || lie_alpha_) {
+        finite = false;
+      } else {  // a blown-up prediction (explicit α): predict nothing this step
+        for (int j = 0; j < n; ++j) state_[static_cast<size_t>(N_ + j)] = xhat_[j];
+      }
+    }
     if (!finite) {
       if (failure_.empty()) {
         std::ostringstream os;
