@@ -49,7 +49,12 @@ void print_list(const std::string& what, std::ostream& out) {
            "projection (engine spec), start (previous|predicted), integrator (auto|rk4|cvode), "
            "substeps, jump_threshold, observability_floor, residual_scale, restart_residual, "
            "restart_every, "
-           "initial_z | initial_z_from, initial, name\n";
+           "initial_z | initial_z_from, initial, name\n"
+        << "  modulating — modulating-function algebraic observer of seed 003, models with a "
+           "canonical form (lti-injection, pendulum): horizon, order, degree, noise_weights, "
+           "engine, quadrature (simpson|trapezoid), sample_period (0: every sample), resample, "
+           "disturbance_bound, initial, name\n"
+        << "  finite_difference — backward differences of y as (y, y', ...): name\n";
     for (const auto& b : pi_bank_catalog()) {
       out << "      bank " << b.name << ": " << b.description << "; channels";
       for (const auto& c : b.channels) out << ' ' << c;

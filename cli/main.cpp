@@ -72,7 +72,8 @@ int main(int argc, char** argv) {
   run->add_option("--out", run_options.out_dir,
                   "Directory for summary.json, trajectories.csv and PNG plots");
   run->add_option("--sweep", run_options.sweep,
-                  "theta=v1,v2,...: rerun the high_gain observers per theta (peaking vs noise)");
+                  "KEY=v1,v2,...: theta (high_gain: peaking vs noise), horizon or "
+                  "sample_period (modulating), or a model parameter (re-simulated)");
   run->add_option("--data", run_options.data_file,
                   "Observe recorded measurements (CSV: t, y1..yp[, u1..um]) instead of simulating");
 

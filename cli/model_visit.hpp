@@ -101,6 +101,13 @@ decltype(auto) visit_model(JsonReader& spec, F&& f) {
     p.finish({"amplitude", "omega"});
     return f(m, 0.001, Scheme::kRk4);
   }
+  if (name == "lti-injection") {
+    LtiOutputInjection m;
+    set_parameter(p, "a0", m.p.a0), set_parameter(p, "a1", m.p.a1),
+        set_parameter(p, "gain", m.p.gain);
+    p.finish({"a0", "a1", "gain"});
+    return f(m, 0.01, Scheme::kRk4);
+  }
   if (name == "pendulum") {
     PendulumTimeVaryingFriction m;
     set_parameter(p, "g", m.p.g), set_parameter(p, "length", m.p.length),

@@ -14,13 +14,17 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "modulating_report.hpp"
 #include "nlobs/observers/simulation.hpp"
+#include "run_support.hpp"
 #include "scenario.hpp"
 
 namespace nlobs::cli {
 namespace {
 
 namespace fs = std::filesystem;
+
+}  // namespace
 
 // Writes through a temporary name and renames at the end: nothing half-written looks complete.
 void write_atomically(const fs::path& path, const std::string& content) {
@@ -33,6 +37,8 @@ void write_atomically(const fs::path& path, const std::string& content) {
   }
   fs::rename(tmp, path);
 }
+
+namespace {
 
 // Recorded measurements: columns t, y1..yp[, u1..um]; an optional header line.
 Measurements read_data(const std::string& file, const AnyModel& model) {
@@ -105,9 +111,13 @@ Measurements read_data(const std::string& file, const AnyModel& model) {
   return data;
 }
 
+}  // namespace
+
 nlohmann::json number_or_null(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
+
+namespace {
 
 nlohmann::json vector_or_null(const Eigen::VectorXd& v) {
   nlohmann::json a = nlohmann::json::array();
@@ -115,12 +125,16 @@ nlohmann::json vector_or_null(const Eigen::VectorXd& v) {
   return a;
 }
 
-std::string fmt(double v, const char* f = "%.3e") {
+}  // namespace
+
+std::string fmt(double v, const char* f) {
   if (!std::isfinite(v)) return "-";
   char buf[32];
   std::snprintf(buf, sizeof buf, f, v);
   return buf;
 }
+
+namespace {
 
 // MVT observers publish ‖X(β)‖ per step as the extra signal "residual" (beside β): its largest
 // value over the run, or nothing for other observers.
@@ -139,27 +153,35 @@ std::optional<double> max_beta_residual(const RunResult& r, size_t i) {
   return worst;
 }
 
-// Observers in other coordinates (high gain: z = q_N(x)) publish ẑ as extras zhat1…; with the
-// truth known, ‖q_N(x_k) − ẑ_k‖ becomes one more extra, "z_error".
+}  // namespace
+
 void add_coordinate_errors(const Measurements& data,
                            const std::vector<std::unique_ptr<Observer>>& observers, RunResult& r) {
   if (!data.has_truth()) return;
   for (size_t i = 0; i < observers.size(); ++i) {
-    const Eigen::VectorXd z0 = observers[i]->coordinates_of(data.x.col(0));
+    const Eigen::VectorXd z0 = observers[i]->coordinates_at(data.x.col(0), data.t[0]);
     if (z0.size() == 0) continue;
     const auto& names = r.extra_names[i];
-    const auto first = std::find(names.begin(), names.end(), "zhat1");
+    auto first = std::find(names.begin(), names.end(), "zhat1");
+    const bool eta = first == names.end();
+    if (eta) first = std::find(names.begin(), names.end(), "eta1");
     if (first == names.end()) continue;
     const Eigen::Index row = first - names.begin(), K = data.steps();
     Eigen::MatrixXd& extras = r.extras[i];
-    extras.conservativeResize(extras.rows() + 1, Eigen::NoChange);
+    const Eigen::Index added = eta ? 2 : 1;
+    extras.conservativeResize(extras.rows() + added, Eigen::NoChange);
     for (Eigen::Index k = 0; k < K; ++k) {
-      const Eigen::VectorXd z = observers[i]->coordinates_of(data.x.col(k));
-      extras(extras.rows() - 1, k) = (z - extras.col(k).segment(row, z.size())).norm();
+      const Eigen::VectorXd z = observers[i]->coordinates_at(data.x.col(k), data.t[k]);
+      const Eigen::Index at = extras.rows() - added;
+      extras(at, k) = (z - extras.col(k).segment(row, z.size())).norm();
+      if (eta) extras(at + 1, k) = z.norm();
     }
-    r.extra_names[i].push_back("z_error");
+    r.extra_names[i].push_back(eta ? "eta_error" : "z_error");
+    if (eta) r.extra_names[i].push_back("eta_norm");
   }
 }
+
+namespace {
 
 // Per observer with a "z_error" extra: what seed 004's figures show.
 struct EmbeddedMetrics {
@@ -310,7 +332,8 @@ void print_bounds(const nlohmann::json& bounds, std::ostream& out) {
 
 nlohmann::json summary_json(const Scenario& s, const Measurements& data, const RunResult& r,
                             const std::string& source, const nlohmann::json& bounds,
-                            const std::vector<std::string>& warnings) {
+                            const std::vector<std::string>& warnings,
+                            const std::vector<long>& horizon_indices) {
   nlohmann::json observers = nlohmann::json::array();
   for (const ObserverMetrics& m : r.metrics) {
     nlohmann::json o{{"name", m.name},
@@ -342,6 +365,7 @@ nlohmann::json summary_json(const Scenario& s, const Measurements& data, const R
       o["max_projection_residual_after"] = number_or_null(em->max_residual_after);
       o["projection_jumps"] = em->jumps;
     }
+    add_modulating_json(r, i, horizon_indices[i], o);
     observers.push_back(o);
   }
   nlohmann::json j{{"scenario", s.name}, {"steps", data.steps()},  {"noise_std", s.noise},
@@ -400,9 +424,13 @@ std::string first_window_csv(const RunResult& r, std::vector<std::string>* names
   return os.str();
 }
 
+}  // namespace
+
 bool have_gnuplot() {
   return std::system("command -v gnuplot >/dev/null 2>&1") == 0;
 }
+
+namespace {
 
 // PNG plots through gnuplot: estimates vs truth, errors, and the first window's convergence.
 std::vector<std::string> plot(const fs::path& dir, const Measurements& data, const RunResult& r,
@@ -464,25 +492,29 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
     g << "unset multiplot\n";
     written.push_back(file);
   }
-  // Seed 004's Figs. 3 and 6: ‖z − ẑ‖ on a log scale.
-  std::vector<std::pair<long, std::string>> z_columns;
-  for (size_t o = 0, c = static_cast<size_t>(2 + offset + observers * n); o < r.extra_names.size();
-       c += r.extra_names[o].size(), ++o) {
-    const auto& names = r.extra_names[o];
-    const auto at = std::find(names.begin(), names.end(), "z_error");
-    if (at != names.end()) {
-      z_columns.emplace_back(static_cast<long>(c) + (at - names.begin()), r.metrics[o].name);
+  // Seed 004's Figs. 3 and 6 (‖z − ẑ‖) and seed 003's canonical error ‖η − η̂‖ on a log scale.
+  for (const auto& [extra, label] :
+       {std::pair<std::string, std::string>{"z_error", "||z - zhat||_2"},
+        {"eta_error", "||eta - etahat||_2"}}) {
+    std::vector<std::pair<long, std::string>> columns;
+    for (size_t o = 0, c = static_cast<size_t>(2 + offset + observers * n);
+         o < r.extra_names.size(); c += r.extra_names[o].size(), ++o) {
+      const auto& names = r.extra_names[o];
+      const auto at = std::find(names.begin(), names.end(), extra);
+      if (at != names.end()) {
+        columns.emplace_back(static_cast<long>(c) + (at - names.begin()), r.metrics[o].name);
+      }
     }
-  }
-  if (!z_columns.empty()) {
-    g << "set terminal pngcairo size 1000,600\nset output '" << (dir / "z_error.png").string()
-      << "'\nset logscale y\nset xlabel 't'\nset ylabel '||z - zhat||_2'\nplot ";
-    for (size_t i = 0; i < z_columns.size(); ++i) {
-      g << "'trajectories.csv' using 1:($" << z_columns[i].first << "+1e-16) with lines title '"
-        << z_columns[i].second << "'" << (i + 1 < z_columns.size() ? ", " : "\n");
+    if (columns.empty()) continue;
+    const std::string file = extra + ".png";
+    g << "set terminal pngcairo size 1000,600\nset output '" << (dir / file).string()
+      << "'\nset logscale y\nset xlabel 't'\nset ylabel '" << label << "'\nplot ";
+    for (size_t i = 0; i < columns.size(); ++i) {
+      g << "'trajectories.csv' using 1:($" << columns[i].first << "+1e-16) with lines title '"
+        << columns[i].second << "'" << (i + 1 < columns.size() ? ", " : "\n");
     }
     g << "unset logscale y\nunset xlabel\n";
-    written.push_back("z_error.png");
+    written.push_back(file);
   }
   if (!traced.empty()) {
     g << "set datafile separator whitespace\nset terminal pngcairo size 1000,600\n"
@@ -508,8 +540,32 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
                long settle_index, const RunOptions& options, std::ostream& out) {
   const std::string& spec = options.sweep;
   const auto eq = spec.find('=');
-  if (eq == std::string::npos || spec.substr(0, eq) != "theta") {
-    throw std::invalid_argument("--sweep: expected theta=v1,v2,... (got '" + spec + "')");
+  if (eq == std::string::npos || eq == 0) {
+    throw std::invalid_argument("--sweep: expected KEY=v1,v2,... (got '" + spec + "')");
+  }
+  const std::string key = spec.substr(0, eq);
+  if (is_modulating_sweep(key)) {
+    // horizon and sample_period: > 0; a model parameter (the disturbance level a_max) may be 0.
+    const bool positive = key == "horizon" || key == "sample_period";
+    std::vector<double> values;
+    std::stringstream items(spec.substr(eq + 1));
+    for (std::string item; std::getline(items, item, ',');) {
+      size_t used = 0;
+      double v = NAN;
+      try {
+        v = std::stod(item, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != item.size() || !std::isfinite(v) || (positive && !(v > 0.0))) {
+        throw std::invalid_argument("--sweep " + key + ": '" + item + "' is not a number" +
+                                    (positive ? " > 0" : ""));
+      }
+      values.push_back(v);
+    }
+    if (values.empty()) throw std::invalid_argument("--sweep " + key + ": no values");
+    run_modulating_sweep(s, key, values, data, settle_index, options, out);
+    return;
   }
   std::vector<double> values;
   std::stringstream list(spec.substr(eq + 1));
@@ -712,7 +768,10 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
   if (printed) err << '\n';
   add_coordinate_errors(data, observers, r);
 
+  std::vector<long> horizon_indices;  // the first sample with a full window, per observer
+  for (const auto& o : observers) horizon_indices.push_back(static_cast<long>(o->window()) - 1);
   print_table(s, data, r, out);
+  print_modulating_metrics(r, horizon_indices, out);
   print_bounds(bounds, out);
 
   if (!options.out_dir.empty()) {
@@ -732,8 +791,9 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
       err << "nlobs: gnuplot not found: no PNG plots (apt-get install gnuplot-nox)\n";
     }
     // Last: summary.json marks a complete output directory.
-    write_atomically(dir / "summary.json",
-                     summary_json(s, data, r, source, bounds, warnings).dump(2) + "\n");
+    write_atomically(
+        dir / "summary.json",
+        summary_json(s, data, r, source, bounds, warnings, horizon_indices).dump(2) + "\n");
     out << "wrote " << (dir / "summary.json").string() << ", trajectories.csv, scenario.json";
     for (const auto& p : plots) out << ", " << p;
     out << '\n';

@@ -1,6 +1,6 @@
 #pragma once
 // `nlobs run SCENARIO [--steps N] [--noise SIGMA] [--seed S] [--out DIR] [--data FILE.csv]
-//  [--sweep theta=v1,v2,...]`.
+//  [--sweep KEY=v1,v2,...]`.
 #include <cstdint>
 #include <iosfwd>
 #include <optional>
@@ -15,7 +15,9 @@ struct RunOptions {
   std::string out_dir{};    // empty: no files
   std::string data_file{};  // empty: simulate
   // "theta=0.05,0.1,0.2": run the scenario's high_gain observers once per value on the same
-  // data; prints and writes (with --out) sweep.csv and sweep.png instead of the usual outputs.
+  // data; "horizon=…" / "sample_period=…": the modulating observers (all observers run);
+  // "PARAMETER=…": a model parameter, re-simulated per value. Prints and writes (with --out)
+  // sweep.csv, sweep.dat and sweep.png instead of the usual outputs.
   std::string sweep{};
 };
 

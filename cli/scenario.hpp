@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "high_gain_observers.hpp"
+#include "modulating_observers.hpp"
 #include "mvt_observers.hpp"
 #include "nlobs/observers/any_model.hpp"
 #include "nlobs/observers/observer.hpp"
@@ -20,7 +21,9 @@
 namespace nlobs::cli {
 
 struct ObserverSpec {
-  std::string type;  // "window", "luenberger", "sliding_mode", "ekf", "pi_bank", "mvt", "high_gain"
+  // "window", "luenberger", "sliding_mode", "ekf", "pi_bank", "mvt", "high_gain", "modulating",
+  // "finite_difference"
+  std::string type;
   // window
   std::string engine = "newton";
   std::optional<double> tol{};  // step and residual tolerance of the engine
@@ -35,9 +38,11 @@ struct ObserverSpec {
   // luenberger, sliding_mode, ekf: the observer's own design model (same sizes and sample
   // time as the scenario's), e.g. one that assumes an unknown input constant
   std::optional<nlohmann::json> model{};
-  PiBankSpec pi{};           // pi_bank
-  MvtSpec mvt{};             // mvt
-  HighGainSpec high_gain{};  // high_gain
+  PiBankSpec pi{};              // pi_bank
+  MvtSpec mvt{};                // mvt
+  HighGainSpec high_gain{};     // high_gain
+  ModulatingSpec modulating{};  // modulating
+  std::string label;            // finite_difference: its name
 };
 
 struct InputSpec {

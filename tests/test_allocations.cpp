@@ -10,6 +10,7 @@
 #include "nlobs/models/systems.hpp"
 #include "nlobs/observers/embedded_forms.hpp"
 #include "nlobs/observers/high_gain_observer.hpp"
+#include "nlobs/observers/modulating_function_observer.hpp"
 #include "nlobs/observers/mvt_observer.hpp"
 #include "nlobs/observers/pi_bank.hpp"
 #include "nlobs/solvers/ceres_engine.hpp"
@@ -168,6 +169,27 @@ TEST(Allocations, HighGainStepWithExplicitFormsAllocatesNothing) {
   }
   EXPECT_EQ(g_allocations.load() - before, 0);
   EXPECT_GT(observer.zhat().norm(), 0.1);
+}
+
+// A modulating-function step (FIR mode and sampled-data mode with the predictor): ring buffers
+// and weights are allocated at construction.
+TEST(Allocations, ModulatingFunctionStepAllocatesNothing) {
+  for (double period : {0.0, 0.1}) {
+    ModulatingOptions o;
+    o.sample_time = 0.01;
+    o.horizon = 0.5;
+    o.sample_period = period;
+    ModulatingFunctionObserver<PendulumForm> observer(PendulumForm{}, Eigen::Vector2d::Zero(), o);
+    const Eigen::VectorXd none(0);
+    Eigen::VectorXd yk(1);
+    const long before = g_allocations.load();
+    for (long k = 0; k < 200; ++k) {
+      yk[0] = std::sin(0.01 * static_cast<double>(k));
+      observer.step(k, yk, none);
+    }
+    EXPECT_EQ(g_allocations.load() - before, 0) << period;
+    EXPECT_GT(Eigen::VectorXd(observer.eta()).norm(), 0.1);
+  }
 }
 
 }  // namespace

@@ -74,7 +74,8 @@ RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Ob
     for (long k = 0; k < steps; ++k) {
       const Eigen::VectorXd y = data.y.col(k), u = data.u.col(k);
       const auto t0 = std::chrono::steady_clock::now();
-      const ObserverStep& s = observer->step(k, y, u);
+      const ObserverStep& s = data.t.size() == data.steps() ? observer->step_at(k, data.t[k], y, u)
+                                                            : observer->step(k, y, u);
       elapsed_ns +=
           std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count();
       if (estimate.rows() == 0) estimate.resize(s.estimate.size(), steps);

@@ -201,6 +201,25 @@ struct UnknownInputIntegrator : ModelSizes<2, 1, 1> {
   }
 };
 
+// Second-order LTI system with a nonlinear output injection (METHODS §4, the modulating-function
+// paper's first example; its parameters were lost, these are the issue's):
+//   x1' = x2,  x2' = −a0 x1 − a1 x2 + gain · sin(y),  y = x1.
+struct LtiInjectionParameters {
+  double a0 = 1.0, a1 = 0.5, gain = 1.0;
+};
+struct LtiOutputInjection : ModelSizes<2, 0, 1> {
+  LtiInjectionParameters p{};
+  template <typename T>
+  State<T> vector_field(const State<T>& x, const Input&, double) const {
+    using std::sin;
+    return State<T>(x[1], -p.a0 * x[0] - p.a1 * x[1] + p.gain * sin(x[0]));
+  }
+  template <typename T>
+  Output<T> h(const State<T>& x) const {
+    return Output<T>(x[0]);
+  }
+};
+
 // Pendulum with time-varying friction and an unknown bounded horizontal acceleration
 // (METHODS §4; the paper's table was lost, these values are ours): θ = x1, y = θ,
 //   x1' = x2,  x2' = −(g/l) sin x1 − c(t) x2 − (a(t)/l) cos x1,

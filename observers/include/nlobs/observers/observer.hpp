@@ -37,9 +37,20 @@ class Observer {
   // as the extras zhat1…): the image of a true state, so that a harness can measure the error
   // there. Empty for observers that estimate x directly.
   virtual Eigen::VectorXd coordinates_of(const Eigen::VectorXd& /*x*/) const { return {}; }
+  // The same at time t, for coordinates that move with t (the modulating-function observer's
+  // canonical state of a time-varying system).
+  virtual Eigen::VectorXd coordinates_at(const Eigen::VectorXd& x, double /*t*/) const {
+    return coordinates_of(x);
+  }
   virtual void reset() = 0;  // back to the initial guess, empty window
   // Sample k (consecutive from 0). A non-finite y means a missing measurement.
   virtual const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) = 0;
+  // Sample k taken at time t (recorded data carry their times): observers that need uniform
+  // sampling check it here; the others ignore t.
+  virtual const ObserverStep& step_at(long k, double /*t*/, const Eigen::VectorXd& y,
+                                      const Eigen::VectorXd& u) {
+    return step(k, y, u);
+  }
 };
 
 }  // namespace nlobs

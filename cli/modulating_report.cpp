@@ -1,0 +1,255 @@
+#include "modulating_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <ostream>
+#include <sstream>
+#include <stdexcept>
+
+#include "run_support.hpp"
+
+namespace nlobs::cli {
+namespace {
+
+std::optional<Eigen::Index> row_of(const RunResult& r, size_t i, const char* name) {
+  const auto& names = r.extra_names[i];
+  const auto at = std::find(names.begin(), names.end(), name);
+  if (at == names.end()) return std::nullopt;
+  return at - names.begin();
+}
+
+// Largest of a row over [from, K); NaN as soon as one entry is not finite.
+double max_over(const Eigen::MatrixXd& e, Eigen::Index row, Eigen::Index from) {
+  double worst = 0.0;
+  if (from >= e.cols()) return NAN;
+  for (Eigen::Index k = from; k < e.cols(); ++k) {
+    const double v = e(row, k);
+    if (!(v <= worst)) worst = v;  // NaN propagates
+  }
+  return worst;
+}
+
+}  // namespace
+
+std::optional<ModulatingMetrics> modulating_metrics(const RunResult& r, size_t i,
+                                                    long horizon_index) {
+  const auto error = row_of(r, i, "eta_error");
+  const auto norm = row_of(r, i, "eta_norm");
+  if (!error || !norm) return std::nullopt;
+  const Eigen::MatrixXd& e = r.extras[i];
+  const Eigen::Index K = e.cols();
+  ModulatingMetrics m;
+  if (K == 0) return m;
+  const double scale = e.row(*norm).maxCoeff();
+  m.abs_after_horizon = max_over(e, *error, std::max<Eigen::Index>(horizon_index, 0));
+  m.rel_after_horizon = m.abs_after_horizon / scale;
+  m.final_rel = max_over(e, *error, K - std::max<Eigen::Index>(K / 10, 1)) / scale;
+  const Eigen::Index from = std::max<Eigen::Index>(r.settle_index, 0);
+  if (from < K) {
+    m.eta_rms_after =
+        std::sqrt(e.row(*error).tail(K - from).squaredNorm() / static_cast<double>(K - from));
+  }
+  if (const auto bound = row_of(r, i, "eta_bound")) m.max_bound = max_over(e, *bound, 0);
+  return m;
+}
+
+void print_modulating_metrics(const RunResult& r, const std::vector<long>& horizon_indices,
+                              std::ostream& out) {
+  bool header = false;
+  char line[256];
+  for (size_t i = 0; i < r.metrics.size(); ++i) {
+    const auto m = modulating_metrics(r, i, horizon_indices[i]);
+    if (!m) continue;
+    if (!header) {
+      out << "canonical state (||eta - etahat||_2): max relative error from one horizon on, over "
+             "the last 10 %, RMS after, Theorem 1 bound:\n";
+      header = true;
+    }
+    std::snprintf(line, sizeof line, "  %-24s %10s %10s %10s %10s\n", r.metrics[i].name.c_str(),
+                  fmt(m->rel_after_horizon).c_str(), fmt(m->final_rel).c_str(),
+                  fmt(m->eta_rms_after).c_str(), fmt(m->max_bound).c_str());
+    out << line;
+  }
+}
+
+void add_modulating_json(const RunResult& r, size_t i, long horizon_index, nlohmann::json& o) {
+  const auto m = modulating_metrics(r, i, horizon_index);
+  if (!m) return;
+  o["max_eta_rel_error_after_horizon"] = number_or_null(m->rel_after_horizon);
+  o["final_eta_rel_error"] = number_or_null(m->final_rel);
+  o["eta_rms_after"] = number_or_null(m->eta_rms_after);
+  o["max_eta_bound"] = number_or_null(m->max_bound);
+}
+
+bool is_modulating_sweep(const std::string& key) {
+  return key != "theta";
+}
+
+void run_modulating_sweep(const Scenario& s, const std::string& key,
+                          const std::vector<double>& values, const Measurements& data,
+                          long settle_index, const RunOptions& options, std::ostream& out) {
+  namespace fs = std::filesystem;
+  const bool observer_key = key == "horizon" || key == "sample_period";
+  if (observer_key && std::none_of(s.observers.begin(), s.observers.end(),
+                                   [](const ObserverSpec& o) { return o.type == "modulating"; })) {
+    throw std::invalid_argument("--sweep " + key + " needs a modulating observer in the scenario");
+  }
+  if (observer_key && key == "sample_period" &&
+      std::none_of(s.observers.begin(), s.observers.end(), [](const ObserverSpec& o) {
+        return o.type == "modulating" && o.modulating.sample_period > 0.0;
+      })) {
+    throw std::invalid_argument(
+        "--sweep sample_period needs a modulating observer in sampled-data mode (sample_period "
+        "> 0) in the scenario");
+  }
+  if (!data.has_truth()) throw std::invalid_argument("--sweep needs simulated data (the truth)");
+  if (key == "horizon" && data.steps() > 1) {
+    // Every row counts the same samples: those after the longest horizon has filled.
+    const double delta = data.t[1] - data.t[0];
+    const double longest = *std::max_element(values.begin(), values.end());
+    settle_index = std::max(settle_index, static_cast<long>(std::ceil(longest / delta - 1e-9)));
+  }
+  std::ostringstream csv;
+  csv << std::setprecision(10) << key
+      << ",observer,x_rms_after,x2_rms_after,eta_rms_after,max_eta_rel_error_after_horizon,"
+         "final_eta_rel_error,max_eta_bound,converged,failures,us_per_step\n";
+  char line[320];
+  out << "sweep over " << key << " on scenario " << s.name << " (noise sigma " << s.noise
+      << "); 'after' counts samples k >= " << settle_index
+      << "; converged: final relative eta error < 1e-3\n";
+  std::snprintf(line, sizeof line, "%-10s %-22s %11s %11s %11s %11s %11s %11s %5s %9s\n",
+                key.c_str(), "observer", "x RMS", "x2 RMS", "eta RMS", "eta rel hor", "eta rel end",
+                "bound", "conv", "us/step");
+  out << line;
+  struct Row {
+    double value;
+    std::string name;
+    double x2, eta_abs, final_rel, bound;
+  };
+  std::vector<Row> rows;
+  std::vector<std::string> names;
+  for (double value : values) {
+    Scenario run = s;
+    Measurements local;
+    const Measurements* d = &data;
+    if (observer_key) {
+      for (ObserverSpec& o : run.observers) {
+        if (o.type != "modulating") continue;
+        if (key == "horizon") o.modulating.horizon = value;
+        if (key == "sample_period" && o.modulating.sample_period > 0.0) {
+          o.modulating.sample_period = value;
+        }
+      }
+    } else {
+      run.model["parameters"][key] = value;
+    }
+    const AnyModel model = scenario_model(run);
+    if (!observer_key) {
+      SimulationOptions sim;
+      sim.steps = run.steps;
+      sim.noise_std = run.noise;
+      sim.seed = run.seed;
+      sim.sample_time = model.sample_time() > 0 ? model.sample_time() : 1.0;
+      sim.input = [&run, &model](long k) { return scenario_input(run, model, k); };
+      local = simulate(model, run.x0, sim);
+      if (!local.stop_message.empty()) {
+        throw std::runtime_error(key + " = " + fmt(value, "%g") + ": simulation " +
+                                 local.stop_message);
+      }
+      d = &local;
+    }
+    auto observers = make_observers(run, model, false);
+    RunResult r = run_observers(*d, observers, settle_index);
+    add_coordinate_errors(*d, observers, r);
+    if (names.empty()) {
+      for (const ObserverMetrics& m : r.metrics) names.push_back(m.name);
+    }
+    for (size_t i = 0; i < observers.size(); ++i) {
+      const ObserverMetrics& m = r.metrics[i];
+      const auto mm = modulating_metrics(r, i, static_cast<long>(observers[i]->window()) - 1);
+      const double x_rms =
+          m.mse_after_window.size() ? std::sqrt(m.mse_after_window.sum()) : std::nan("");
+      const double x2_rms =
+          m.mse_after_window.size() > 1 ? std::sqrt(m.mse_after_window[1]) : std::nan("");
+      long failures = 0;
+      for (const auto& [status, count] : m.failures) failures += count;
+      const double eta_rms = mm ? mm->eta_rms_after : NAN, rel = mm ? mm->rel_after_horizon : NAN,
+                   final_rel = mm ? mm->final_rel : NAN, bound = mm ? mm->max_bound : NAN;
+      const char* converged = !mm ? "-" : (final_rel < 1e-3 ? "yes" : "no");
+      std::snprintf(line, sizeof line, "%-10.4g %-22s %11s %11s %11s %11s %11s %11s %5s %9.2f\n",
+                    value, m.name.c_str(), fmt(x_rms).c_str(), fmt(x2_rms).c_str(),
+                    fmt(eta_rms).c_str(), fmt(rel).c_str(), fmt(final_rel).c_str(),
+                    fmt(bound).c_str(), converged, m.ns_per_step / 1e3);
+      out << line;
+      csv << value << ',' << m.name << ',' << x_rms << ',' << x2_rms << ',' << eta_rms << ',' << rel
+          << ',' << final_rel << ',' << bound << ',' << converged << ',' << failures << ','
+          << m.ns_per_step / 1e3 << '\n';
+      rows.push_back({value, m.name, x2_rms, mm ? mm->abs_after_horizon : NAN, final_rel, bound});
+    }
+  }
+  if (options.out_dir.empty()) return;
+  const fs::path dir = fs::absolute(options.out_dir);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw std::runtime_error("cannot create " + dir.string() + ": " + ec.message());
+  write_atomically(dir / "sweep.csv", csv.str());
+  std::ostringstream blocks;
+  blocks << std::setprecision(10);
+  for (const std::string& name : names) {
+    blocks << "# " << name << ": " << key
+           << " x2_rms_after max_eta_error_after_horizon final_eta_rel_error max_eta_bound\n";
+    for (const auto& row : rows) {
+      if (row.name != name) continue;
+      blocks << row.value << ' ' << row.x2 << ' ' << row.eta_abs << ' ' << row.final_rel << ' '
+             << row.bound << '\n';
+    }
+    blocks << "\n\n";
+  }
+  write_atomically(dir / "sweep.dat", blocks.str());
+  out << "wrote " << (dir / "sweep.csv").string() << ", sweep.dat";
+  if (have_gnuplot()) {
+    const bool positive = std::all_of(values.begin(), values.end(), [](double v) { return v > 0; });
+    std::ostringstream g;
+    // Only the observers that have the column's quantity (η, a bound) get a line for it.
+    const auto has = [&](const std::string& name, double Row::*field) {
+      return std::any_of(rows.begin(), rows.end(), [&](const Row& row) {
+        return row.name == name && std::isfinite(row.*field);
+      });
+    };
+    const auto series = [&](int column, const std::string& suffix, double Row::*field) {
+      std::string text;
+      for (size_t i = 0; i < names.size(); ++i) {
+        if (!has(names[i], field)) continue;
+        text += (text.empty() ? "" : ", ") + std::string("'sweep.dat' index ") + std::to_string(i) +
+                " using 1:" + std::to_string(column) + " with linespoints title '" + names[i] +
+                suffix + "'";
+      }
+      return text;
+    };
+    g << "set terminal pngcairo size 1000,800\nset output '" << (dir / "sweep.png").string()
+      << "'\nset multiplot layout 2,1 title '" << key << " sweep: " << s.name << " (noise "
+      << s.noise << ")'\n"
+      << (positive ? "set logscale xy\n" : "set logscale y\n")
+      << "set grid\nset key outside right\n"
+      << "set xlabel '" << key
+      << "'\nset ylabel 'RMS error of x2 (derivative) after settling'\nplot "
+      << series(2, "", &Row::x2) << "\nset ylabel 'max ||eta - etahat|| from one horizon'\nplot "
+      << series(3, "", &Row::eta_abs);
+    const std::string bounds = series(5, " Theorem 1 bound", &Row::bound);
+    if (!bounds.empty()) g << ", " << bounds;
+    g << "\nunset multiplot\n";
+    write_atomically(dir / "sweep.gp", g.str());
+    const std::string cmd = "cd '" + dir.string() + "' && gnuplot sweep.gp 2>gnuplot.log";
+    if (std::system(cmd.c_str()) != 0) {
+      out << '\n';
+      throw std::runtime_error("gnuplot failed; see " + (dir / "gnuplot.log").string());
+    }
+    out << ", sweep.png";
+  }
+  out << '\n';
+}
+
+}  // namespace nlobs::cli

@@ -1,0 +1,70 @@
+#pragma once
+// The naive baseline for derivative estimation: for a system whose state is the output's phase
+// variables x = (y, y', …, y⁽ⁿ⁻¹⁾), x̂_{i+1} = ∇ⁱ y_k / δⁱ (backward differences of the samples).
+// Its noise gain grows as 1/δⁱ — what the modulating-function observer's integration avoids.
+#include <Eigen/Core>
+#include <cmath>
+#include <string>
+
+#include "nlobs/observers/observer.hpp"
+#include "nlobs/solvers/status.hpp"
+
+namespace nlobs {
+
+class FiniteDifferenceObserver final : public Observer {
+ public:
+  // Throws InvalidInput for states < 1 or a sample time that is not finite and positive.
+  FiniteDifferenceObserver(Eigen::Index states, double sample_time,
+                           std::string name = "finite_difference")
+      : n_(states), delta_(sample_time), name_(std::move(name)) {
+    if (n_ < 1) throw InvalidInput(name_ + ": states must be >= 1");
+    if (!(delta_ > 0.0) || !std::isfinite(delta_)) {
+      throw InvalidInput(name_ + ": the sample time must be finite and > 0");
+    }
+    history_.resize(n_);
+    differences_.resize(n_);
+    reset();
+  }
+
+  std::string name() const override { return name_; }
+  Eigen::Index window() const override { return n_; }
+  void reset() override {
+    history_.setZero();
+    filled_ = 0;
+    step_.estimate = Eigen::VectorXd::Zero(n_);
+    step_.ready = false;
+  }
+  const ObserverStep& step(long, const Eigen::VectorXd& y, const Eigen::VectorXd&) override {
+    step_.measurement_missing = !(y.size() == 1 && std::isfinite(y[0]));
+    if (step_.measurement_missing) {  // the differences restart after a gap
+      filled_ = 0;
+      step_.ready = false;
+      return step_;
+    }
+    for (Eigen::Index i = n_ - 1; i > 0; --i) history_[i] = history_[i - 1];
+    history_[0] = y[0];  // newest first
+    if (filled_ < n_) ++filled_;
+    step_.ready = filled_ == n_;
+    if (!step_.ready) return step_;
+    // ∇ⁱ y_k from the newest n samples: repeated differences, newest first.
+    differences_ = history_;
+    double scale = 1.0;
+    step_.estimate[0] = differences_[0];
+    for (Eigen::Index i = 1; i < n_; ++i) {
+      for (Eigen::Index m = 0; m + i < n_; ++m) differences_[m] -= differences_[m + 1];
+      scale *= delta_;
+      step_.estimate[i] = differences_[0] / scale;
+    }
+    return step_;
+  }
+
+ private:
+  Eigen::Index n_;
+  double delta_;
+  std::string name_;
+  Eigen::VectorXd history_, differences_;
+  Eigen::Index filled_ = 0;
+  ObserverStep step_;
+};
+
+}  // namespace nlobs

@@ -1,0 +1,374 @@
+#pragma once
+// Modulating-function algebraic observer (seed 003, METHODS §4; derivation in
+// docs/observers.md). For a form (modulating_forms.hpp) with g_i = a_i y − b_iᵀ v (g_n = y),
+// integrating the input–output equation against the unitary kernel φ_j by parts leaves
+//   η_j(t) = (−1)^{j+1} Σ_{i=0}^{n} (−1)^i ∫_{t−T}^{t} φ_j⁽ⁱ⁾(τ − t + T) g_i(τ) dτ,
+// exact after one horizon T. On uniformly sampled data each integral is an FIR filter: the
+// weights K_{j,i}[m] = (−1)^{i+j+1} w_m φ_j⁽ⁱ⁾(m δ) (trapezoid or Simpson w_m) are computed once
+// and the channels g_i(τ_m) (coefficients evaluated on the grid as the samples arrive) are
+// kept in ring buffers — a step is n(n+1) dot products of length T/δ + 1 and allocates nothing.
+//
+// Sampled-data mode (sample_period h = M δ): outputs arrive every h; between them the output
+// predictor ŷ' = η̂_{n−2} − a_{n−1}(t) ŷ + b_{n−1}ᵀ v(t, ŷ, u) (the copy of the output's own
+// equation driven by the estimate), reset to y at each sample, fills the grid (Heun's method
+// with η̂ extrapolated over one δ). Before the first horizon the predictor runs on the initial
+// guess (the paper's constant initial function).
+#include <Eigen/Core>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "nlobs/observers/modulating_forms.hpp"
+#include "nlobs/observers/modulating_kernel.hpp"
+#include "nlobs/observers/observer.hpp"
+#include "nlobs/solvers/status.hpp"
+
+namespace nlobs {
+
+enum class Quadrature { kTrapezoid, kSimpson };
+
+struct ModulatingOptions {
+  double sample_time = 0.0;  // δ: the spacing of the samples the observer is stepped with
+  double horizon = 1.0;      // T: a multiple of δ, at least 4 intervals
+  Quadrature quadrature = Quadrature::kSimpson;  // Simpson needs an even number of intervals
+  ModulatingKernelOptions kernel{};
+  // Sampled-data mode: outputs every h = M δ (M ≥ 1 integer), the predictor between; 0: FIR
+  // mode, every sample is a measurement.
+  double sample_period = 0.0;
+  // FIR mode, times off the grid t_0 + k δ: interpolate linearly onto the grid (true) or refuse
+  // the sample (false: failure "non_uniform", state kept).
+  bool resample = false;
+  // Theorem 1's bound on |η_j − η̂_j| when an unknown d with |d| ≤ disturbance_level enters
+  // η' as disturbance_gains · d (FIR mode; empty: no bound).
+  Eigen::VectorXd disturbance_gains;
+  double disturbance_level = 0.0;
+  std::string name = "modulating";
+};
+
+template <typename Form>
+class ModulatingFunctionObserver final : public Observer {
+ public:
+  static constexpr int n = Form::n, p = Form::p, nx = Form::state_size;
+  using Eta = Vector<n>;
+  using State = Vector<nx>;
+
+  // Throws InvalidInput naming the option: δ or T not finite and positive, T not a multiple
+  // of δ or shorter than 4 samples, Simpson with an odd count, h not a multiple of δ, kernel
+  // options (modulating_kernel.hpp), disturbance gains of the wrong size, a bad x̂(0).
+  ModulatingFunctionObserver(Form form, const Eigen::VectorXd& initial, ModulatingOptions options)
+      : form_(std::move(form)), options_(std::move(options)), kernels_(make_kernels()) {
+    if (initial.size() != nx || !initial.allFinite()) {
+      fail("the initial guess must be " + std::to_string(nx) + " finite numbers");
+    }
+    initial_ = initial;
+    eta_guess_ = form_.canonical(0.0, initial_);
+    const double delta = options_.sample_time;
+    if (options_.sample_period != 0.0) {
+      const double M = options_.sample_period / delta;
+      if (!(M >= 1.0 - 1e-9) || std::abs(M - std::round(M)) > 1e-6 * M) {
+        fail("sample_period must be a positive multiple of the sample time " + fmt(delta));
+      }
+      every_ = std::lround(M);
+    }
+    if (options_.disturbance_gains.size() != 0) {
+      if (options_.disturbance_gains.size() != n || !options_.disturbance_gains.allFinite() ||
+          !(options_.disturbance_level >= 0.0) || !std::isfinite(options_.disturbance_level)) {
+        fail("disturbance_gains must be n = " + std::to_string(n) +
+             " finite numbers and disturbance_level finite and >= 0");
+      }
+    }
+    // K_{j,i}[m] = (−1)^{i+j+1} w_m φ_j⁽ⁱ⁾(m δ), column j(n+1)+i, m oldest (t − T) to newest.
+    weights_.resize(L_ + 1, n * (n + 1));
+    for (Eigen::Index m = 0; m <= L_; ++m) {
+      double w = delta;
+      if (options_.quadrature == Quadrature::kTrapezoid) {
+        if (m == 0 || m == L_) w = delta / 2.0;
+      } else {
+        w = (m == 0 || m == L_) ? delta / 3.0 : (m % 2 ? 4.0 * delta / 3.0 : 2.0 * delta / 3.0);
+      }
+      for (int j = 0; j < n; ++j) {
+        for (int i = 0; i <= n; ++i) {
+          const double sign = (i + j + 1) % 2 ? -1.0 : 1.0;
+          weights_(m, j * (n + 1) + i) =
+              sign * w * kernels_.value(j, i, static_cast<double>(m) * delta);
+        }
+      }
+    }
+    bound_ = Eta::Constant(std::numeric_limits<double>::quiet_NaN());
+    if (options_.disturbance_gains.size() != 0 && every_ == 0) {
+      // d enters g_i as −gains_i d: |η_j − η̂_j| ≤ D Σ_m |Σ_i K_{j,i}[m] gains_i|.
+      for (int j = 0; j < n; ++j) {
+        Eigen::VectorXd k = Eigen::VectorXd::Zero(L_ + 1);
+        for (int i = 0; i < n; ++i) {
+          k += options_.disturbance_gains[i] * weights_.col(j * (n + 1) + i);
+        }
+        bound_[j] = options_.disturbance_level * k.cwiseAbs().sum();
+      }
+    }
+    channels_.resize(2 * (L_ + 1), n + 1);
+    step_.extras.resize(static_cast<Eigen::Index>(extra_names().size()));
+    reset();
+  }
+
+  std::string name() const override { return options_.name; }
+  // The horizon in samples: the harness's "after the window" is "one horizon after start".
+  Eigen::Index window() const override { return L_ + 1; }
+  std::vector<std::string> extra_names() const override {
+    std::vector<std::string> names;
+    for (int j = 0; j < n; ++j) names.push_back("eta" + std::to_string(j + 1));
+    names.push_back("yhat");
+    if (options_.disturbance_gains.size() != 0) names.push_back("eta_bound");
+    return names;
+  }
+  Eigen::VectorXd coordinates_at(const Eigen::VectorXd& x, double t) const override {
+    if (x.size() != nx) return {};
+    return form_.canonical(t, State(x));
+  }
+  std::vector<std::string> warnings() const override {
+    if (options_.disturbance_gains.size() != 0 && every_ != 0) {
+      return {options_.name +
+              ": the disturbance bound is Theorem 1's (FIR mode); it is not "
+              "reported in sampled-data mode"};
+    }
+    return {};
+  }
+
+  void reset() override {
+    xhat_ = initial_;
+    eta_ = eta_guess_;
+    eta_previous_ = eta_guess_;
+    channels_.setZero();
+    write_ = 0;
+    filled_ = 0;
+    count_ = 0;
+    started_ = false;
+    yhat_ = eta_guess_[n - 1];
+    rate_ = 0.0;
+    step_.estimate = initial_;
+    step_.extras.setConstant(std::numeric_limits<double>::quiet_NaN());
+  }
+
+  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
+    return step_at(k, static_cast<double>(k) * options_.sample_time, y, u);
+  }
+
+  const ObserverStep& step_at(long k, double t, const Eigen::VectorXd& y,
+                              const Eigen::VectorXd& u) override {
+    step_.failure.clear();
+    step_.failure_message.clear();
+    step_.measurement_missing = false;
+    if (y.size() != 1) {
+      return refuse(k, "input", "y must have one entry (SISO), got " + std::to_string(y.size()));
+    }
+    if (!std::isfinite(t)) return refuse(k, "input", "the sample time is not finite");
+    if (!started_) {
+      started_ = true;
+      t0_ = t;  // the grid t0 + m δ starts at the first sample
+      t_raw_ = t;
+      y_raw_ = y[0];
+    }
+    const double delta = options_.sample_time;
+    const double position = (t - t0_) / delta;
+    const double grid = std::round(position);
+    if (!(t > t_raw_) && count_ > 0) {
+      return refuse(k, "non_uniform",
+                    "sample times must increase (t = " + fmt(t) + " after " + fmt(t_raw_) + ")");
+    }
+    if (std::abs(position - grid) <= 1e-6) {
+      // On the grid; skipped grid times are missing samples (the window refills, or the
+      // predictor bridges them).
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      while (static_cast<double>(count_) < grid) {
+        advance(t0_ + static_cast<double>(count_) * delta, nan, u);
+      }
+      advance(t0_ + grid * delta, y[0], u);
+    } else if (!options_.resample || every_ != 0) {
+      return refuse(k, "non_uniform",
+                    "t = " + fmt(t) + " is off the uniform grid t0 + m·" + fmt(delta) +
+                        " (t0 = " + fmt(t0_) +
+                        (every_ != 0 ? "); the sampled-data mode needs the grid"
+                                     : "); set resample to interpolate onto the grid"));
+    } else {
+      // Linear interpolation between the last raw sample and this one at each grid time in
+      // (t_raw, t]; a missing y at either end makes the interpolated samples missing.
+      while (t0_ + static_cast<double>(count_) * delta <= t) {
+        const double tg = t0_ + static_cast<double>(count_) * delta;
+        advance(tg, y_raw_ + (tg - t_raw_) / (t - t_raw_) * (y[0] - y_raw_), u);
+      }
+    }
+    t_raw_ = t;
+    y_raw_ = y[0];
+    return step_;
+  }
+
+  const Eta& eta() const { return eta_; }  // η̂ at the last grid time
+  const ModulatingKernels& kernels() const { return kernels_; }
+  // Samples per horizon minus one: T = L δ.
+  Eigen::Index intervals() const { return L_; }
+  // Theorem 1's bound per η_j (NaN without disturbance gains or in sampled-data mode).
+  const Eta& disturbance_bound() const { return bound_; }
+  // The FIR's gain from white noise on y to η̂_j at time t: ‖Σ_i a_i(τ_m) K_{j,i}[m]‖₂, with
+  // the coefficients frozen at t (exact for constant a_i). η̂_j's noise σ is this times σ_y.
+  Eta noise_gains(double t = 0.0) const {
+    Vector<n> a;
+    Matrix<n, p> b;
+    form_.coefficients(t, a, b);
+    Eta gains;
+    for (int j = 0; j < n; ++j) {
+      Eigen::VectorXd k = weights_.col(j * (n + 1) + n);
+      for (int i = 0; i < n; ++i) k += a[i] * weights_.col(j * (n + 1) + i);
+      gains[j] = k.norm();
+    }
+    return gains;
+  }
+
+ private:
+  ModulatingKernels make_kernels() {
+    const double delta = options_.sample_time, T = options_.horizon;
+    if (!(delta > 0.0) || !std::isfinite(delta)) fail("sample_time must be finite and > 0");
+    if (!(T > 0.0) || !std::isfinite(T)) fail("horizon must be finite and > 0");
+    const double intervals = T / delta;
+    L_ = std::lround(intervals);
+    if (std::abs(intervals - static_cast<double>(L_)) > 1e-6 * intervals) {
+      fail("horizon " + fmt(T) + " is not a multiple of the sample time " + fmt(delta));
+    }
+    if (L_ < 4) {
+      fail("horizon " + fmt(T) + " spans " + std::to_string(L_) +
+           " sample intervals; at least 4 are needed");
+    }
+    if (options_.quadrature == Quadrature::kSimpson && L_ % 2 != 0) {
+      fail("Simpson quadrature needs an even number of intervals per horizon (T/δ = " +
+           std::to_string(L_) + "); change the horizon or use the trapezoid rule");
+    }
+    return ModulatingKernels(n, T, options_.kernel);
+  }
+
+  // One grid time: a measured output (FIR mode; sampled mode at multiples of h) or the
+  // predictor's. NaN: the window is invalid until refilled (FIR) or the predictor bridges it.
+  void advance(double t, double y, const Eigen::VectorXd& u) {
+    const bool measured_now = every_ == 0 || count_ % every_ == 0;
+    ++count_;
+    coefficients_at(t);
+    if (every_ != 0) {
+      if (count_ > 1) {  // Heun over δ with η̂ extrapolated: ŷ* = ŷ + δF, ŷ⁺ = ŷ + δ(F + F*)/2
+        const double delta = options_.sample_time;
+        const double ystar = yhat_ + delta * rate_;
+        const Eta extrapolated = 2.0 * eta_ - eta_previous_;
+        const double rate_star = predictor_rate(t, ystar, extrapolated, u);
+        yhat_ += delta / 2.0 * (rate_ + rate_star);
+      }
+      if (measured_now && std::isfinite(y)) {
+        yhat_ = y;
+      } else if (measured_now) {
+        step_.measurement_missing = true;
+      }
+      if (!std::isfinite(yhat_)) {
+        invalidate("non_finite", "the output predictor left the finite numbers at t = " + fmt(t));
+        yhat_ = eta_guess_[n - 1];
+        return;
+      }
+    } else {
+      if (!std::isfinite(y)) {
+        step_.measurement_missing = true;
+        invalidate("", "");
+        return;
+      }
+      yhat_ = y;
+    }
+    v_ = form_.inputs(t, yhat_, u);
+    if (!v_.allFinite()) {
+      invalidate("non_finite", "v(t, y, u) is not finite at t = " + fmt(t));
+      return;
+    }
+    // g_i = a_i y − b_iᵀ v, g_n = y: written twice so that the window is one contiguous block.
+    for (int i = 0; i < n; ++i) {
+      const double g = a_[i] * yhat_ - b_.row(i).dot(v_);
+      channels_(write_, i) = g;
+      channels_(write_ + L_ + 1, i) = g;
+    }
+    channels_(write_, n) = yhat_;
+    channels_(write_ + L_ + 1, n) = yhat_;
+    write_ = (write_ + 1) % (L_ + 1);
+    if (filled_ <= L_) ++filled_;
+    eta_previous_ = eta_;
+    step_.ready = filled_ == L_ + 1;
+    if (step_.ready) {
+      for (int j = 0; j < n; ++j) {
+        double sum = 0.0;
+        for (int i = 0; i <= n; ++i) {
+          sum += weights_.col(j * (n + 1) + i).dot(channels_.col(i).segment(write_, L_ + 1));
+        }
+        eta_[j] = sum;
+      }
+      xhat_ = form_.state(t, eta_);
+      step_.estimate = xhat_;
+    } else {
+      eta_ = eta_guess_;
+    }
+    if (every_ != 0) rate_ = predictor_rate(t, yhat_, eta_, u);
+    publish();
+  }
+
+  // ŷ' = η̂_{n−2} − a_{n−1}(t) ŷ + b_{n−1}ᵀ v(t, ŷ, u) (η̂_{−1} = 0); a_, b_ hold t's values.
+  double predictor_rate(double t, double y, const Eta& eta, const Eigen::VectorXd& u) const {
+    const double lower = n >= 2 ? eta[n - 2] : 0.0;
+    return lower - a_[n - 1] * y + b_.row(n - 1).dot(form_.inputs(t, y, u));
+  }
+
+  void coefficients_at(double t) { form_.coefficients(t, a_, b_); }
+
+  void invalidate(const std::string& failure, const std::string& message) {
+    filled_ = 0;
+    step_.ready = false;
+    if (!failure.empty()) {
+      step_.failure = failure;
+      step_.failure_message = options_.name + ": " + message + "; the window refills";
+    }
+    publish();
+  }
+
+  void publish() {
+    step_.extras.head(n) = eta_;
+    step_.extras[n] = yhat_;
+    if (options_.disturbance_gains.size() != 0) step_.extras[n + 1] = bound_.norm();
+  }
+
+  const ObserverStep& refuse(long k, const std::string& failure, const std::string& message) {
+    step_.failure = failure;
+    std::ostringstream os;
+    os << options_.name << ": sample " << k << ": " << message << "; estimate kept";
+    step_.failure_message = os.str();
+    return step_;
+  }
+
+  [[noreturn]] void fail(const std::string& what) const {
+    throw InvalidInput(options_.name + ": " + what);
+  }
+  static std::string fmt(double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+  }
+
+  Form form_;
+  ModulatingOptions options_;
+  Eigen::Index L_ = 0;
+  ModulatingKernels kernels_;
+  long every_ = 0;
+  Eigen::MatrixXd weights_, channels_;
+  Eigen::Index write_ = 0, filled_ = 0;
+  long count_ = 0;
+  bool started_ = false;
+  double t0_ = 0.0, t_raw_ = 0.0, y_raw_ = 0.0, yhat_ = 0.0, rate_ = 0.0;
+  State initial_ = State::Zero(), xhat_ = State::Zero();
+  Eta eta_guess_ = Eta::Zero(), eta_ = Eta::Zero(), eta_previous_ = Eta::Zero(),
+      bound_ = Eta::Zero();
+  Vector<n> a_ = Vector<n>::Zero();
+  Matrix<n, p> b_ = Matrix<n, p>::Zero();
+  Vector<p> v_ = Vector<p>::Zero();
+  ObserverStep step_;
+};
+
+}  // namespace nlobs
