@@ -148,13 +148,7 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
     }
     const AnyModel model = scenario_model(run);
     if (!observer_key) {
-      SimulationOptions sim;
-      sim.steps = run.steps;
-      sim.noise_std = run.noise;
-      sim.seed = run.seed;
-      sim.sample_time = model.sample_time() > 0 ? model.sample_time() : 1.0;
-      sim.input = [&run, &model](long k) { return scenario_input(run, model, k); };
-      local = simulate(model, run.x0, sim);
+      local = simulate_scenario(run, model);
       if (!local.stop_message.empty()) {
         throw std::runtime_error(key + " = " + fmt(value, "%g") + ": simulation " +
                                  local.stop_message);
@@ -191,10 +185,7 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
     }
   }
   if (options.out_dir.empty()) return;
-  const fs::path dir = fs::absolute(options.out_dir);
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw std::runtime_error("cannot create " + dir.string() + ": " + ec.message());
+  const fs::path dir = output_directory(options.out_dir);
   write_atomically(dir / "sweep.csv", csv.str());
   std::ostringstream blocks;
   blocks << std::setprecision(10);
@@ -241,12 +232,7 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
     const std::string bounds = series(5, " Theorem 1 bound", &Row::bound);
     if (!bounds.empty()) g << ", " << bounds;
     g << "\nunset multiplot\n";
-    write_atomically(dir / "sweep.gp", g.str());
-    const std::string cmd = "cd '" + dir.string() + "' && gnuplot sweep.gp 2>gnuplot.log";
-    if (std::system(cmd.c_str()) != 0) {
-      out << '\n';
-      throw std::runtime_error("gnuplot failed; see " + (dir / "gnuplot.log").string());
-    }
+    run_gnuplot(dir, "sweep.gp", g.str());
     out << ", sweep.png";
   }
   out << '\n';

@@ -430,6 +430,54 @@ bool have_gnuplot() {
   return std::system("command -v gnuplot >/dev/null 2>&1") == 0;
 }
 
+Measurements simulate_scenario(const Scenario& s, const AnyModel& model) {
+  SimulationOptions sim;
+  sim.steps = s.steps;
+  sim.noise_std = s.noise;
+  sim.seed = s.seed;
+  sim.sample_time = model.sample_time() > 0 ? model.sample_time() : 1.0;
+  sim.input = [&s, &model](long k) { return scenario_input(s, model, k); };
+  return simulate(model, s.x0, sim);
+}
+
+fs::path output_directory(const std::string& out_dir) {
+  const fs::path dir = fs::absolute(out_dir);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw std::runtime_error("cannot create " + dir.string() + ": " + ec.message());
+  return dir;
+}
+
+void run_gnuplot(const fs::path& dir, const std::string& file, const std::string& script) {
+  write_atomically(dir / file, script);
+  const std::string cmd = "cd '" + dir.string() + "' && gnuplot " + file + " 2>gnuplot.log";
+  if (std::system(cmd.c_str()) != 0) {
+    throw std::runtime_error("gnuplot failed; see " + (dir / "gnuplot.log").string());
+  }
+}
+
+std::vector<double> parse_sweep_values(const std::string& key, const std::string& list,
+                                       bool positive) {
+  std::vector<double> values;
+  std::stringstream items(list);
+  for (std::string item; std::getline(items, item, ',');) {
+    size_t used = 0;
+    double v = NAN;
+    try {
+      v = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || !std::isfinite(v) || (positive && !(v > 0.0))) {
+      throw std::invalid_argument("--sweep " + key + ": '" + item + "' is not a number" +
+                                  (positive ? " > 0" : ""));
+    }
+    values.push_back(v);
+  }
+  if (values.empty()) throw std::invalid_argument("--sweep " + key + ": no values");
+  return values;
+}
+
 namespace {
 
 // PNG plots through gnuplot: estimates vs truth, errors, and the first window's convergence.
@@ -526,16 +574,13 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
     }
     written.push_back("first_window.png");
   }
-  write_atomically(dir / "plots.gp", g.str());
-  const std::string cmd = "cd '" + dir.string() + "' && gnuplot plots.gp 2>gnuplot.log";
-  if (std::system(cmd.c_str()) != 0) {
-    throw std::runtime_error("gnuplot failed; see " + (dir / "gnuplot.log").string());
-  }
+  run_gnuplot(dir, "plots.gp", g.str());
   return written;
 }
 
 // --sweep theta=v1,v2,…: the high_gain observers once per θ on the same data (seed 004's
-// peaking/noise trade-off: peaking grows as θ shrinks, noise amplification too).
+// peaking/noise trade-off: peaking grows as θ shrinks, noise amplification too). Other keys
+// are the modulating-function sweeps (modulating_report.cpp).
 void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& data,
                long settle_index, const RunOptions& options, std::ostream& out) {
   const std::string& spec = options.sweep;
@@ -546,39 +591,12 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
   const std::string key = spec.substr(0, eq);
   if (is_modulating_sweep(key)) {
     // horizon and sample_period: > 0; a model parameter (the disturbance level a_max) may be 0.
-    const bool positive = key == "horizon" || key == "sample_period";
-    std::vector<double> values;
-    std::stringstream items(spec.substr(eq + 1));
-    for (std::string item; std::getline(items, item, ',');) {
-      size_t used = 0;
-      double v = NAN;
-      try {
-        v = std::stod(item, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used == 0 || used != item.size() || !std::isfinite(v) || (positive && !(v > 0.0))) {
-        throw std::invalid_argument("--sweep " + key + ": '" + item + "' is not a number" +
-                                    (positive ? " > 0" : ""));
-      }
-      values.push_back(v);
-    }
-    if (values.empty()) throw std::invalid_argument("--sweep " + key + ": no values");
+    const std::vector<double> values =
+        parse_sweep_values(key, spec.substr(eq + 1), key == "horizon" || key == "sample_period");
     run_modulating_sweep(s, key, values, data, settle_index, options, out);
     return;
   }
-  std::vector<double> values;
-  std::stringstream list(spec.substr(eq + 1));
-  for (std::string item; std::getline(list, item, ',');) {
-    try {
-      size_t used = 0;
-      values.push_back(std::stod(item, &used));
-      if (used != item.size() || !(values.back() > 0.0)) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw std::invalid_argument("--sweep theta: '" + item + "' is not a number > 0");
-    }
-  }
-  if (values.empty()) throw std::invalid_argument("--sweep theta: no values");
+  const std::vector<double> values = parse_sweep_values(key, spec.substr(eq + 1), true);
   Scenario only = s;
   only.observers.clear();
   for (const ObserverSpec& o : s.observers) {
@@ -637,11 +655,7 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
     }
   }
   if (options.out_dir.empty()) return;
-  // Absolute: gnuplot runs inside the directory and writes to this path.
-  const fs::path dir = fs::absolute(options.out_dir);
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw std::runtime_error("cannot create " + dir.string() + ": " + ec.message());
+  const fs::path dir = output_directory(options.out_dir);
   write_atomically(dir / "sweep.csv", csv.str());
   // One block per observer (sweep.dat, gnuplot's index): sweep.csv interleaves them per θ.
   std::ostringstream blocks;
@@ -674,12 +688,7 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
       << "set xlabel 'theta'\nset ylabel 'max ||zhat|| (peaking)'\nplot " << series(2, "")
       << "\nset ylabel 'RMS error after settling'\nplot " << series(3, " z") << ", "
       << series(4, " x") << "\nunset multiplot\n";
-    write_atomically(dir / "sweep.gp", g.str());
-    const std::string cmd = "cd '" + dir.string() + "' && gnuplot sweep.gp 2>gnuplot.log";
-    if (std::system(cmd.c_str()) != 0) {
-      out << '\n';
-      throw std::runtime_error("gnuplot failed; see " + (dir / "gnuplot.log").string());
-    }
+    run_gnuplot(dir, "sweep.gp", g.str());
     out << ", sweep.png";
   }
   out << '\n';
@@ -704,13 +713,7 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
   Measurements data;
   std::string source = "simulation";
   if (options.data_file.empty()) {
-    SimulationOptions sim;
-    sim.steps = s.steps;
-    sim.noise_std = s.noise;
-    sim.seed = s.seed;
-    sim.sample_time = model.sample_time() > 0 ? model.sample_time() : 1.0;
-    sim.input = [&s, &model](long k) { return scenario_input(s, model, k); };
-    data = simulate(model, s.x0, sim);
+    data = simulate_scenario(s, model);
     if (!data.stop_message.empty()) err << "nlobs: simulation " << data.stop_message << '\n';
     if (data.steps() == 0) throw std::runtime_error("the simulation produced no samples");
   } else {
@@ -775,11 +778,7 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
   print_bounds(bounds, out);
 
   if (!options.out_dir.empty()) {
-    // Absolute: gnuplot runs inside the directory and writes to this path.
-    const fs::path dir = fs::absolute(options.out_dir);
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) throw std::runtime_error("cannot create " + dir.string() + ": " + ec.message());
+    const fs::path dir = output_directory(options.out_dir);
     write_atomically(dir / "trajectories.csv", trajectories_csv(data, r));
     std::vector<std::string> traced;
     write_atomically(dir / "first_window.dat", first_window_csv(r, &traced));

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "nlobs/observers/simulation.hpp"
+#include "scenario.hpp"
 
 namespace nlobs::cli {
 
@@ -15,6 +16,17 @@ void write_atomically(const std::filesystem::path& path, const std::string& cont
 nlohmann::json number_or_null(double v);
 std::string fmt(double v, const char* f = "%.3e");  // "-" for non-finite values
 bool have_gnuplot();
+// --out DIR made absolute (gnuplot runs inside it and writes to this path) and created.
+std::filesystem::path output_directory(const std::string& out_dir);
+// Writes `script` to dir/file and runs gnuplot on it there; throws naming gnuplot.log.
+void run_gnuplot(const std::filesystem::path& dir, const std::string& file,
+                 const std::string& script);
+// "v1,v2,…" of `--sweep key=…`: finite numbers (> 0 when `positive`), at least one.
+std::vector<double> parse_sweep_values(const std::string& key, const std::string& list,
+                                       bool positive);
+// The scenario's true system simulated (steps, noise, seed, input); a domain exit ends the data
+// early with Measurements::stop_message set.
+Measurements simulate_scenario(const Scenario& s, const AnyModel& model);
 // Observers in other coordinates publish their estimate there as extras zhat1… (high gain) or
 // eta1… (modulating functions): with the truth known, the error in those coordinates becomes
 // the extra "z_error" or "eta_error" (and, for eta, the true norm "eta_norm").
