@@ -115,6 +115,7 @@ decltype(auto) visit_model(JsonReader& spec, F&& f) {
         set_parameter(p, "omega_c", m.p.omega_c), set_parameter(p, "a_max", m.p.a_max),
         set_parameter(p, "omega_a", m.p.omega_a);
     p.finish({"g", "length", "c0", "c1", "omega_c", "a_max", "omega_a"});
+    if (!(m.p.length > 0.0)) p.fail("'length' must be > 0");
     return f(m, 0.01, Scheme::kRk4);
   }
   std::string list;

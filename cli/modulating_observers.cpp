@@ -28,6 +28,7 @@ std::unique_ptr<Observer> build(Form form, const ModulatingSpec& spec, const Eig
   }
   o.sample_period = spec.sample_period;
   o.resample = spec.resample;
+  o.resample_max_gap = spec.resample_max_gap;
   if (spec.disturbance_bound) {
     if constexpr (std::is_same_v<Form, PendulumForm>) {
       o.disturbance_gains = Eigen::Vector2d(1.0, 0.0);  // d enters η_0' (modulating_forms.hpp)
@@ -63,6 +64,8 @@ ModulatingSpec parse_modulating_spec(JsonReader& o) {
   s.sample_period = o.number("sample_period").value_or(0.0);
   if (!(s.sample_period >= 0.0)) o.fail("'sample_period' must be >= 0 (0: every sample)");
   s.resample = o.boolean("resample").value_or(false);
+  s.resample_max_gap = o.number("resample_max_gap").value_or(0.0);
+  if (!(s.resample_max_gap >= 0.0)) o.fail("'resample_max_gap' must be >= 0 (0: 4 steps)");
   s.disturbance_bound = o.boolean("disturbance_bound").value_or(false);
   return s;
 }
@@ -80,6 +83,7 @@ void write_modulating_spec(const ModulatingSpec& s, nlohmann::json& out) {
   out["quadrature"] = s.quadrature;
   out["sample_period"] = s.sample_period;
   out["resample"] = s.resample;
+  if (s.resample_max_gap > 0.0) out["resample_max_gap"] = s.resample_max_gap;
   out["disturbance_bound"] = s.disturbance_bound;
 }
 

@@ -22,6 +22,7 @@ struct ModulatingSpec {
   std::string quadrature = "simpson";  // simpson | trapezoid
   double sample_period = 0.0;          // 0: every sample (FIR mode)
   bool resample = false;
+  double resample_max_gap = 0.0;   // 0: 4 steps
   bool disturbance_bound = false;  // Theorem 1's bound from the model's disturbance level
 };
 

@@ -79,6 +79,7 @@ void add_modulating_json(const RunResult& r, size_t i, long horizon_index, nlohm
   const auto m = modulating_metrics(r, i, horizon_index);
   if (!m) return;
   o["max_eta_rel_error_after_horizon"] = number_or_null(m->rel_after_horizon);
+  o["max_eta_error_after_horizon"] = number_or_null(m->abs_after_horizon);
   o["final_eta_rel_error"] = number_or_null(m->final_rel);
   o["eta_rms_after"] = number_or_null(m->eta_rms_after);
   o["max_eta_bound"] = number_or_null(m->max_bound);
@@ -115,7 +116,8 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
   std::ostringstream csv;
   csv << std::setprecision(10) << key
       << ",observer,x_rms_after,x2_rms_after,eta_rms_after,max_eta_rel_error_after_horizon,"
-         "final_eta_rel_error,max_eta_bound,converged,failures,us_per_step\n";
+         "final_eta_rel_error,max_eta_bound,converged,failures,us_per_step,"
+         "max_eta_error_after_horizon\n";
   char line[320];
   out << "sweep over " << key << " on scenario " << s.name << " (noise sigma " << s.noise
       << "); 'after' counts samples k >= " << settle_index
@@ -146,16 +148,32 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
     } else {
       run.model["parameters"][key] = value;
     }
-    const AnyModel model = scenario_model(run);
+    const std::string which = "--sweep " + key + " = " + fmt(value, "%g") + ": ";
+    const auto named = [&](auto&& build) {
+      try {
+        return build();
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(which + e.what());
+      }
+    };
+    const AnyModel model = named([&] {
+      try {
+        return scenario_model(run);
+      } catch (const std::invalid_argument& e) {
+        if (observer_key) throw;
+        throw std::invalid_argument(std::string(e.what()) +
+                                    " (a sweep key is theta, horizon, sample_period or a "
+                                    "parameter of the scenario's model)");
+      }
+    });
     if (!observer_key) {
       local = simulate_scenario(run, model);
       if (!local.stop_message.empty()) {
-        throw std::runtime_error(key + " = " + fmt(value, "%g") + ": simulation " +
-                                 local.stop_message);
+        throw std::runtime_error(which + "simulation " + local.stop_message);
       }
       d = &local;
     }
-    auto observers = make_observers(run, model, false);
+    auto observers = named([&] { return make_observers(run, model, false); });
     RunResult r = run_observers(*d, observers, settle_index);
     add_coordinate_errors(*d, observers, r);
     if (names.empty()) {
@@ -180,7 +198,7 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
       out << line;
       csv << value << ',' << m.name << ',' << x_rms << ',' << x2_rms << ',' << eta_rms << ',' << rel
           << ',' << final_rel << ',' << bound << ',' << converged << ',' << failures << ','
-          << m.ns_per_step / 1e3 << '\n';
+          << m.ns_per_step / 1e3 << ',' << (mm ? mm->abs_after_horizon : NAN) << '\n';
       rows.push_back({value, m.name, x2_rms, mm ? mm->abs_after_horizon : NAN, final_rel, bound});
     }
   }

@@ -462,7 +462,8 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
       spec.modulating = parse_modulating_spec(o);
       spec.initial = o.vector("initial");
       o.finish({"type", "name", "horizon", "order", "degree", "noise_weights", "engine",
-                "quadrature", "sample_period", "resample", "disturbance_bound", "initial"});
+                "quadrature", "sample_period", "resample", "resample_max_gap", "disturbance_bound",
+                "initial"});
     } else if (spec.type == "finite_difference") {
       spec.label = o.text("name").value_or("finite_difference");
       o.finish({"type", "name"});
@@ -621,6 +622,11 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& s, const A
         out.push_back(
             make_modulating_observer(o.modulating, s.model, start, model.sample_time(), where));
       } else if (o.type == "finite_difference") {
+        if (model.outputs() != 1) {
+          throw std::invalid_argument(
+              "finite_difference needs a model with one output (its "
+              "state the output's phase variables y, y', ...)");
+        }
         out.push_back(std::make_unique<FiniteDifferenceObserver>(model.states(),
                                                                  model.sample_time(), o.label));
       } else if (o.type == "window") {

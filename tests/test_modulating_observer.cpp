@@ -87,10 +87,9 @@ TEST(ModulatingKernels, BoundaryConditionsHold) {
           o.order = n + extra_order;
           o.degree = o.order + n - 1 + extra_degree;
           const ModulatingKernels K(n, T, o);
+          // The left-end conditions hold by construction (c_k = 0 for k < r); the right-end
+          // ones come out of the solve and the long-double refinement.
           for (int j = 0; j < n; ++j) {
-            for (int k = 0; k < o.order; ++k) {
-              EXPECT_NEAR(K.value(j, k, 0.0), 0.0, 1e-12) << n << ' ' << j << ' ' << k;
-            }
             for (int k = 0; k < n; ++k) {
               // φ⁽ᵏ⁾(T) carries T^{−k} from the σ-scaling: compare relative to that scale.
               EXPECT_NEAR(K.value(j, k, T) * std::pow(T, k - j), k == j ? 1.0 : 0.0, 1e-12)
@@ -104,7 +103,8 @@ TEST(ModulatingKernels, BoundaryConditionsHold) {
 }
 
 // With y⁽ⁿ⁾ = 0 (a polynomial of degree < n) the kernels give y⁽ⁿ⁻¹⁻ʲ⁾(t) exactly:
-// η_j = (−1)^{j+1+n} ∫ φ_j⁽ⁿ⁾ y, integrated here by Gauss–Legendre (exact for polynomials).
+// η_j = (−1)^{j+1+n} ∫ φ_j⁽ⁿ⁾ y, integrated here by composite Simpson on 2000 panels (its error
+// on these low-degree integrands is far below the tolerance).
 TEST(ModulatingKernels, ExactOnPolynomialsBelowTheOrder) {
   const int n = 3;
   const double T = 0.8, t = 2.0;
@@ -115,8 +115,6 @@ TEST(ModulatingKernels, ExactOnPolynomialsBelowTheOrder) {
     // y = 1 − 2τ + 0.7τ², on [t − T, t].
     const auto y = [](double tau) { return 1.0 - 2.0 * tau + 0.7 * tau * tau; };
     const double expected[3] = {1.4, -2.0 + 1.4 * t, y(t)};  // η_0 = y'', η_1 = y', η_2 = y
-    // 20-point Gauss–Legendre by Golub–Welsch would be overkill: a fine composite Simpson with
-    // 2000 panels is exact to rounding for this degree-(d − n + 2) integrand.
     for (int j = 0; j < n; ++j) {
       const int panels = 2000;
       const double h = T / panels;
@@ -258,7 +256,8 @@ TEST(ModulatingFunctionObserver, BeatsFiniteDifferencesUnderNoise) {
   FiniteDifferenceObserver differences(2, 0.01);
   const double mf = derivative_rms(observer, data, 200);
   const double fd = derivative_rms(differences, data, 200);
-  EXPECT_LT(5.0 * mf, fd) << "modulating " << mf << ", finite differences " << fd;
+  // The issue asks for 5×; measured 540× (mf 2.7e-3): 100× catches a regression.
+  EXPECT_LT(100.0 * mf, fd) << "modulating " << mf << ", finite differences " << fd;
 }
 
 // Outputs every 0.1 s (10 grid steps), the predictor between: converges, noise-free.
@@ -269,7 +268,105 @@ TEST(ModulatingFunctionObserver, SampledDataConverges) {
   o.sample_period = 0.1;
   ModulatingFunctionObserver<LtiInjectionForm> observer(LtiInjectionForm{}, Eigen::Vector2d::Zero(),
                                                         o);
-  EXPECT_LT(relative_error_from(observer, data, 1000), 1e-3);
+  EXPECT_LT(relative_error_from(observer, data, 1000), 1e-6);
+}
+
+// A sample missing at a measurement time: the predictor bridges it, no failure, convergence.
+TEST(ModulatingFunctionObserver, SampledDataBridgesAMissingSample) {
+  Measurements data =
+      simulate_continuous(LtiOutputInjection{}, Eigen::Vector2d(2.0, 0.0), 0.01, 12.0);
+  data.y(0, 500) = std::nan("");  // t = 5 s, a measurement time (every 10th sample)
+  ModulatingOptions o = options(0.01, 1.0);
+  o.sample_period = 0.1;
+  ModulatingFunctionObserver<LtiInjectionForm> observer(LtiInjectionForm{}, Eigen::Vector2d::Zero(),
+                                                        o);
+  int failures = 0;
+  for (Eigen::Index k = 0; k < data.steps(); ++k) {
+    const ObserverStep& s = observer.step(k, data.y.col(k), data.u.col(k));
+    failures += s.failure.empty() ? 0 : 1;
+    if (k == 500) {
+      EXPECT_TRUE(s.measurement_missing);
+      EXPECT_TRUE(s.ready);  // the window holds predicted outputs, still valid
+    }
+  }
+  EXPECT_EQ(failures, 0);
+  const Eigen::Index K = data.steps() - 1;
+  EXPECT_LT(
+      (observer.coordinates_at(data.x.col(K), data.t[K]) - Eigen::VectorXd(observer.eta())).norm(),
+      1e-6);
+}
+
+// n = 1: y' = v with v = u (a_0 = 0): η_0 = y, in FIR and in sampled-data mode (the predictor
+// ŷ' = b_0 v integrates u exactly).
+TEST(ModulatingFunctionObserver, FirstOrderChainInBothModes) {
+  const double delta = 0.01;
+  Measurements data;
+  const Eigen::Index K = 400;
+  data.t = Eigen::VectorXd::LinSpaced(K, 0.0, static_cast<double>(K - 1) * delta);
+  data.y.resize(1, K);
+  data.u = Eigen::MatrixXd::Constant(1, K, 2.0);
+  data.x.resize(1, K);
+  for (Eigen::Index k = 0; k < K; ++k) data.x(0, k) = data.y(0, k) = 3.0 + 2.0 * data.t[k];
+  for (double period : {0.0, 0.2}) {
+    ModulatingOptions o = options(delta, 0.5);
+    o.sample_period = period;
+    ModulatingFunctionObserver<ChainForm<1>> observer(ChainForm<1>{}, Vector<1>(0.0), o);
+    EXPECT_LT(relative_error_from(observer, data, 100), 1e-9) << period;
+  }
+}
+
+TEST(ModulatingFunctionObserver, RepeatedOrDecreasingTimesAreRefused) {
+  ModulatingFunctionObserver<LtiInjectionForm> observer(LtiInjectionForm{}, Eigen::Vector2d::Zero(),
+                                                        options(0.01, 1.0));
+  const Eigen::VectorXd y = Eigen::VectorXd::Ones(1), u(0);
+  EXPECT_TRUE(observer.step_at(0, 0.0, y, u).failure.empty());
+  EXPECT_TRUE(observer.step_at(1, 0.01, y, u).failure.empty());
+  EXPECT_EQ(observer.step_at(2, 0.01, y, u).failure, "non_uniform");
+  EXPECT_EQ(observer.step_at(3, 0.01 + 1e-9, y, u).failure, "non_uniform");  // same grid point
+  EXPECT_EQ(observer.step_at(4, 0.005, y, u).failure, "non_uniform");
+  EXPECT_FALSE(observer.step_at(4, 0.005, y, u).ready);
+  EXPECT_TRUE(observer.step_at(5, 0.02, y, u).failure.empty());  // back on the grid
+}
+
+// Absolute (epoch) times carry their decimal rounding: still on the grid.
+TEST(ModulatingFunctionObserver, AbsoluteTimesStayOnTheGrid) {
+  ModulatingFunctionObserver<LtiInjectionForm> observer(LtiInjectionForm{}, Eigen::Vector2d::Zero(),
+                                                        options(0.01, 0.1));
+  const Eigen::VectorXd y = Eigen::VectorXd::Ones(1), u(0);
+  for (long k = 0; k < 30; ++k) {
+    const double t = std::stod("1700000000." + std::to_string(100 + k).substr(1));  // ….00, ….01
+    EXPECT_TRUE(observer.step_at(k, t, y, u).failure.empty()) << k;
+  }
+  EXPECT_TRUE(observer.step_at(30, 1700000000.30, y, u).ready);
+}
+
+// Resampling: samples every 15 ms onto a 10 ms grid are interpolated (short spans), a long gap
+// leaves its grid points missing (the window refills).
+TEST(ModulatingFunctionObserver, ResamplingBridgesShortSpansNotGaps) {
+  const Measurements fine =
+      simulate_continuous(LtiOutputInjection{}, Eigen::Vector2d(2.0, 0.0), 0.005, 8.0);
+  ModulatingOptions o = options(0.01, 1.0);
+  o.resample = true;
+  o.quadrature = Quadrature::kTrapezoid;
+  ModulatingFunctionObserver<LtiInjectionForm> observer(LtiInjectionForm{}, Eigen::Vector2d::Zero(),
+                                                        o);
+  double worst = 0.0;
+  long k = 0;
+  for (Eigen::Index i = 0; i < fine.steps(); i += 3, ++k) {  // every 15 ms
+    const ObserverStep& s = observer.step_at(k, fine.t[i], fine.y.col(i), fine.u.col(i));
+    EXPECT_TRUE(s.failure.empty()) << s.failure_message;
+    if (fine.t[i] > 1.5 && fine.t[i] < 5.0) {
+      EXPECT_TRUE(s.ready) << fine.t[i];
+      worst = std::max(worst, (s.estimate - fine.x.col(i)).norm());
+    }
+  }
+  // Linear interpolation of y between samples 15 ms apart (error ~ y''·h²/8 ≈ 6e-5 in y, a
+  // bias the kernels' second derivatives amplify): measured 3.5e-3 in x, against 1e-9 on-grid.
+  EXPECT_LT(worst, 1e-2);
+  // A 0.5 s gap (more than 4 δ): its grid points are missing, the window refills for 1 s.
+  const double t_gap = fine.t[fine.steps() - 1] + 0.5;
+  const Eigen::VectorXd y = fine.y.col(fine.steps() - 1);
+  EXPECT_FALSE(observer.step_at(k, t_gap, y, fine.u.col(0)).ready);
 }
 
 TEST(ModulatingFunctionObserver, NanSampleInvalidatesTheWindowUntilRefilled) {

@@ -136,7 +136,11 @@ ModulatingKernels::ModulatingKernels(int n, double horizon, ModulatingKernelOpti
       Eigen::VectorXd gradient = QJ.transpose() * r0;
       for (int pass = 0; pass < 6 && gradient.norm() > kGradientTolerance * (1.0 + r0.norm());
            ++pass) {
-        s = engine->solve_least_squares(problem, q);
+        try {
+          s = engine->solve_least_squares(problem, q);
+        } catch (const std::exception& e) {
+          fail("engine '" + options.engine + "' failed on the noise-optimal kernel: " + e.what());
+        }
         gradient = QJ.transpose() * (r0 + QJ * q);
       }
       if (!q.allFinite() || gradient.norm() > kGradientTolerance * (1.0 + r0.norm())) {
@@ -151,7 +155,7 @@ ModulatingKernels::ModulatingKernels(int n, double horizon, ModulatingKernelOpti
       c = particular + Q2 * RJ.triangularView<Eigen::Upper>().solve(q);
     }
     // Monomial coefficients of a degree-d kernel alternate in sign and grow like 2^d: the
-    // boundary sums cancel to ~1e-11 in double. Refine them in long double (one Newton step on
+    // boundary sums cancel to ~1e-11 in double. Refine them in long double (two Newton steps on
     // A c = b with the residual in extended precision) and evaluate in long double.
     Eigen::Matrix<long double, Eigen::Dynamic, 1> refined = c.cast<long double>();
     for (int pass = 0; pass < 2; ++pass) {

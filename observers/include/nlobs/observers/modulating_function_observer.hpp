@@ -40,6 +40,9 @@ struct ModulatingOptions {
   // FIR mode, times off the grid t_0 + k δ: interpolate linearly onto the grid (true) or refuse
   // the sample (false: failure "non_uniform", state kept).
   bool resample = false;
+  // With resample: spans between samples up to this are interpolated; longer ones are gaps
+  // (their grid points missing). 0 means 4 δ.
+  double resample_max_gap = 0.0;
   // Theorem 1's bound on |η_j − η̂_j| when an unknown d with |d| ≤ disturbance_level enters
   // η' as disturbance_gains · d (FIR mode; empty: no bound).
   Eigen::VectorXd disturbance_gains;
@@ -71,6 +74,10 @@ class ModulatingFunctionObserver final : public Observer {
         fail("sample_period must be a positive multiple of the sample time " + fmt(delta));
       }
       every_ = std::lround(M);
+    }
+    max_gap_ = options_.resample_max_gap == 0.0 ? 4.0 * delta : options_.resample_max_gap;
+    if (!(max_gap_ >= delta) || !std::isfinite(max_gap_)) {
+      fail("resample_max_gap must be at least the sample time " + fmt(delta));
     }
     if (options_.disturbance_gains.size() != 0) {
       if (options_.disturbance_gains.size() != n || !options_.disturbance_gains.allFinite() ||
@@ -146,6 +153,9 @@ class ModulatingFunctionObserver final : public Observer {
     started_ = false;
     yhat_ = eta_guess_[n - 1];
     rate_ = 0.0;
+    ever_ready_ = false;
+    step_.ready = false;
+    step_.measurement_missing = false;
     step_.estimate = initial_;
     step_.extras.setConstant(std::numeric_limits<double>::quiet_NaN());
   }
@@ -172,31 +182,39 @@ class ModulatingFunctionObserver final : public Observer {
     const double delta = options_.sample_time;
     const double position = (t - t0_) / delta;
     const double grid = std::round(position);
-    if (!(t > t_raw_) && count_ > 0) {
+    // Recorded times carry their decimal rounding: a few ulps of t, relative to δ.
+    const double tolerance =
+        1e-6 + 4.0 * std::numeric_limits<double>::epsilon() * std::abs(t) / delta;
+    const bool on_grid = std::abs(position - grid) <= tolerance;
+    if (count_ > 0 && (!(t > t_raw_) || (on_grid && grid < static_cast<double>(count_)))) {
       return refuse(k, "non_uniform",
-                    "sample times must increase (t = " + fmt(t) + " after " + fmt(t_raw_) + ")");
+                    "sample times must increase by at least one grid step (t = " + fmt(t) +
+                        " after " + fmt(t_raw_) + ")");
     }
-    if (std::abs(position - grid) <= 1e-6) {
-      // On the grid; skipped grid times are missing samples (the window refills, or the
-      // predictor bridges them).
-      const double nan = std::numeric_limits<double>::quiet_NaN();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    if (options_.resample && every_ == 0) {
+      // Linear interpolation between the last raw sample and this one at each grid time in
+      // (t_raw, t]; a span longer than the gap limit, or a missing y at either end, makes
+      // those samples missing.
+      const bool bridge = t - t_raw_ <= max_gap_ * (1.0 + 1e-9);
+      while (t0_ + static_cast<double>(count_) * delta <= t + tolerance * delta) {
+        const double tg = t0_ + static_cast<double>(count_) * delta;
+        const double s = std::min(1.0, (tg - t_raw_) / (t - t_raw_));
+        const bool at_sample = std::abs(tg - t) <= tolerance * delta;
+        advance(tg, at_sample ? y[0] : (bridge ? y_raw_ + s * (y[0] - y_raw_) : nan), u);
+      }
+    } else if (on_grid) {
+      // Skipped grid times are missing samples (the window refills, or the predictor bridges).
       while (static_cast<double>(count_) < grid) {
         advance(t0_ + static_cast<double>(count_) * delta, nan, u);
       }
       advance(t0_ + grid * delta, y[0], u);
-    } else if (!options_.resample || every_ != 0) {
+    } else {
       return refuse(k, "non_uniform",
                     "t = " + fmt(t) + " is off the uniform grid t0 + m·" + fmt(delta) +
                         " (t0 = " + fmt(t0_) +
                         (every_ != 0 ? "); the sampled-data mode needs the grid"
                                      : "); set resample to interpolate onto the grid"));
-    } else {
-      // Linear interpolation between the last raw sample and this one at each grid time in
-      // (t_raw, t]; a missing y at either end makes the interpolated samples missing.
-      while (t0_ + static_cast<double>(count_) * delta <= t) {
-        const double tg = t0_ + static_cast<double>(count_) * delta;
-        advance(tg, y_raw_ + (tg - t_raw_) / (t - t_raw_) * (y[0] - y_raw_), u);
-      }
     }
     t_raw_ = t;
     y_raw_ = y[0];
@@ -242,7 +260,8 @@ class ModulatingFunctionObserver final : public Observer {
       fail("Simpson quadrature needs an even number of intervals per horizon (T/δ = " +
            std::to_string(L_) + "); change the horizon or use the trapezoid rule");
     }
-    return ModulatingKernels(n, T, options_.kernel);
+    // Designed on the span the FIR covers (T within 1e-6 of it).
+    return ModulatingKernels(n, static_cast<double>(L_) * delta, options_.kernel);
   }
 
   // One grid time: a measured output (FIR mode; sampled mode at multiples of h) or the
@@ -302,11 +321,12 @@ class ModulatingFunctionObserver final : public Observer {
         }
         eta_[j] = sum;
       }
+      // The first estimate replaces the guess: no extrapolation across that jump.
+      if (!ever_ready_) eta_previous_ = eta_;
+      ever_ready_ = true;
       xhat_ = form_.state(t, eta_);
       step_.estimate = xhat_;
-    } else {
-      eta_ = eta_guess_;
-    }
+    }  // not ready: η̂ stays the guess before the first horizon, the last estimate after
     if (every_ != 0) rate_ = predictor_rate(t, yhat_, eta_, u);
     publish();
   }
@@ -336,6 +356,7 @@ class ModulatingFunctionObserver final : public Observer {
   }
 
   const ObserverStep& refuse(long k, const std::string& failure, const std::string& message) {
+    step_.ready = false;  // the estimate kept is an earlier time's
     step_.failure = failure;
     std::ostringstream os;
     os << options_.name << ": sample " << k << ": " << message << "; estimate kept";
@@ -348,6 +369,7 @@ class ModulatingFunctionObserver final : public Observer {
   }
   static std::string fmt(double v) {
     std::ostringstream os;
+    os.precision(12);
     os << v;
     return os.str();
   }
@@ -357,10 +379,11 @@ class ModulatingFunctionObserver final : public Observer {
   Eigen::Index L_ = 0;
   ModulatingKernels kernels_;
   long every_ = 0;
+  double max_gap_ = 0.0;
   Eigen::MatrixXd weights_, channels_;
   Eigen::Index write_ = 0, filled_ = 0;
   long count_ = 0;
-  bool started_ = false;
+  bool started_ = false, ever_ready_ = false;
   double t0_ = 0.0, t_raw_ = 0.0, y_raw_ = 0.0, yhat_ = 0.0, rate_ = 0.0;
   State initial_ = State::Zero(), xhat_ = State::Zero();
   Eta eta_guess_ = Eta::Zero(), eta_ = Eta::Zero(), eta_previous_ = Eta::Zero(),
