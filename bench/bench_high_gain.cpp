@@ -1,10 +1,12 @@
 // The high-gain observer (seed 004), whole runs over recorded data so that the cost per step
 // and the accuracy come from the same steps:
 //   BM_HighGainStep/<example>: µs per sample for each way of getting x̂ and α — the explicit
-//     inverse, the least-squares projection with a hand map (ceres::Jet Jacobian) and with the
-//     ADOL-C map, α explicit or L_f^N h;
+//     inverse, the least-squares projection with a hand map (ceres::Jet Jacobian), the Taylor
+//     map (Boost autodiff) and the ADOL-C map, α explicit or L_f^N h;
 //   BM_HighGainIntegrator/<rk4|cvode>/<θ·1000>: the oscillator at h = 0.01 as θ shrinks —
-//     the measurement behind the `auto` choice (RK4 while h·max|p|/θ ≤ 0.2).
+//     the measurement behind the `auto` choice (RK4 while h·max|p|/θ ≤ 0.2);
+//   BM_ObservabilityMap/<call>/<map>: one call of q_N, ∂q_N/∂x or L_f^N h with its gradient,
+//     hand expansion vs Taylor mode (Boost autodiff) vs ADOL-C, Duffing N = 6 and Lorenz N = 4.
 // Counters: z_error = ‖q_N(x) − ẑ‖ at the last sample, failures.
 #include <benchmark/benchmark.h>
 
@@ -14,6 +16,7 @@
 #include "nlobs/observers/high_gain_observer.hpp"
 #include "nlobs/observers/lie_observability_map.hpp"
 #include "nlobs/observers/simulation.hpp"
+#include "nlobs/observers/taylor_observability_map.hpp"
 
 namespace {
 
@@ -73,13 +76,16 @@ void BM_HighGainStepOscillator(benchmark::State& state) {
 }
 BENCHMARK(BM_HighGainStepOscillator)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 
+// Map 0: hand expansion, 1: ADOL-C, 2: Taylor mode.
 void BM_HighGainStepDuffing(benchmark::State& state) {
   static const Measurements data = record(Duffing{}, Eigen::Vector2d(1.2, 0.0), 1e-3, 12.0);
-  const bool ad = state.range(0) == 1;
-  run<Duffing>(state, data, [ad] {
+  const long which = state.range(0);
+  run<Duffing>(state, data, [which] {
     HighGainObserver<Duffing>::Design d;
-    if (ad) {
+    if (which == 1) {
       d.map = std::make_shared<LieObservabilityMap>(Duffing{}, 6);
+    } else if (which == 2) {
+      d.map = std::make_shared<TaylorObservabilityMap<Duffing, 6>>();
     } else {
       d.map = std::make_shared<ExplicitObservabilityMap<DuffingEmbedding>>();
     }
@@ -92,23 +98,41 @@ void BM_HighGainStepDuffing(benchmark::State& state) {
     o.saturation = SmoothSaturation{P.asDiagonal(), 1.0, 2.0};
     return std::make_unique<HighGainObserver<Duffing>>(Duffing{}, d, Eigen::Vector2d::Zero(), o);
   });
-  state.SetLabel(ad ? "ceres projection, ADOL-C map" : "ceres projection, hand map");
+  state.SetLabel(which == 1   ? "ceres projection, ADOL-C map"
+                 : which == 2 ? "ceres projection, Taylor map"
+                              : "ceres projection, hand map");
 }
-BENCHMARK(BM_HighGainStepDuffing)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_HighGainStepDuffing)
+    ->Arg(0)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 
+// Map 1: ADOL-C, 2: Taylor mode.
 void BM_HighGainStepLorenzLieAlpha(benchmark::State& state) {
   static const Measurements data = record(Lorenz{}, Eigen::Vector3d(1.0, 1.0, 20.0), 1e-3, 5.0);
-  run<Lorenz>(state, data, [] {
+  const bool taylor = state.range(0) == 2;
+  run<Lorenz>(state, data, [taylor] {
     HighGainObserver<Lorenz>::Design d;
-    d.map = std::make_shared<LieObservabilityMap>(Lorenz{}, 4);
+    if (taylor) {
+      d.map = std::make_shared<TaylorObservabilityMap<Lorenz, 4>>();
+    } else {
+      d.map = std::make_shared<LieObservabilityMap>(Lorenz{}, 4);
+    }
     HighGainOptions o;
     o.sample_time = 1e-3;
     o.theta = 0.02;
     return std::make_unique<HighGainObserver<Lorenz>>(Lorenz{}, d, Eigen::Vector3d(2, 3, 25), o);
   });
-  state.SetLabel("alpha = L_f^4 h by ADOL-C, ceres projection");
+  state.SetLabel(taylor ? "alpha = L_f^4 h by Taylor mode, ceres projection"
+                        : "alpha = L_f^4 h by ADOL-C, ceres projection");
 }
-BENCHMARK(BM_HighGainStepLorenzLieAlpha)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_HighGainStepLorenzLieAlpha)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 
 void BM_HighGainIntegrator(benchmark::State& state) {
   static const Measurements data =
@@ -134,5 +158,59 @@ void BM_HighGainIntegrator(benchmark::State& state) {
 BENCHMARK(BM_HighGainIntegrator)
     ->ArgsProduct({{0, 1}, {300, 100, 30, 10, 5, 3}})
     ->Unit(benchmark::kMillisecond);
+
+// One map call: range(0) = 0 value, 1 Jacobian, 2 L_f^N h with its gradient; range(1) = the map
+// as above (0 hand, 1 ADOL-C, 2 Taylor).
+template <typename Model, typename Form>
+void map_calls(benchmark::State& state, const Eigen::VectorXd& x0) {
+  constexpr int N = Form::kDimension;
+  std::shared_ptr<ObservabilityMap> map;
+  if (state.range(1) == 1) {
+    map = std::make_shared<LieObservabilityMap>(Model{}, N);
+  } else if (state.range(1) == 2) {
+    map = std::make_shared<TaylorObservabilityMap<Model, N>>();
+  } else {
+    map = std::make_shared<ExplicitObservabilityMap<Form>>();
+  }
+  const long call = state.range(0);
+  if (call == 2 && !map->has_next()) {
+    state.SkipWithError("the hand map has no L_f^N h");
+    return;
+  }
+  Eigen::VectorXd x = x0, z(N), gradient(x0.size());
+  Eigen::MatrixXd dq(N, x0.size());
+  double next = 0.0;
+  for (auto _ : state) {
+    x[0] += 1e-9;  // not a constant the compiler could fold
+    const bool ok = call == 0   ? map->value(x, z)
+                    : call == 1 ? map->jacobian(x, dq)
+                                : map->next(x, next, &gradient);
+    benchmark::DoNotOptimize(ok);
+    benchmark::DoNotOptimize(z.data());
+    benchmark::DoNotOptimize(dq.data());
+    benchmark::DoNotOptimize(next);
+  }
+  static const char* calls[] = {"q_N", "dq_N/dx", "L_f^N h + gradient"};
+  static const char* maps[] = {"hand", "ADOL-C", "Taylor"};
+  state.SetLabel(std::string(calls[call]) + ", " + maps[state.range(1)]);
+}
+
+void BM_ObservabilityMapDuffing6(benchmark::State& state) {
+  map_calls<Duffing, DuffingEmbedding>(state, Eigen::Vector2d(1.3, -0.7));
+}
+BENCHMARK(BM_ObservabilityMapDuffing6)
+    ->ArgsProduct({{0, 1}, {0, 1, 2}})
+    ->Args({2, 1})
+    ->Args({2, 2})
+    ->Unit(benchmark::kMicrosecond);
+
+void BM_ObservabilityMapLorenz4(benchmark::State& state) {
+  map_calls<Lorenz, LorenzEmbedding>(state, Eigen::Vector3d(1.3, -0.7, 20.0));
+}
+BENCHMARK(BM_ObservabilityMapLorenz4)
+    ->ArgsProduct({{0, 1}, {0, 1, 2}})
+    ->Args({2, 1})
+    ->Args({2, 2})
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace

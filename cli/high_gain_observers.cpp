@@ -6,6 +6,7 @@
 #include "nlobs/observers/embedded_forms.hpp"
 #include "nlobs/observers/high_gain_observer.hpp"
 #include "nlobs/observers/lie_observability_map.hpp"
+#include "nlobs/observers/taylor_observability_map.hpp"
 
 namespace nlobs::cli {
 namespace {
@@ -99,15 +100,21 @@ std::unique_ptr<Observer> build(Model model, const HighGainSpec& spec, const Eig
   if (spec.map == "explicit") {
     need_hand("'map': explicit");
     if constexpr (kHand) design.map = std::make_shared<ExplicitObservabilityMap<Form>>();
-  } else {
+  } else if (spec.map == "adolc" || (spec.map == "ad" && N > kMaxTaylorObservabilityOrder)) {
     design.map = std::make_shared<LieObservabilityMap>(model, N);
+  } else {
+    if (N > kMaxTaylorObservabilityOrder) {
+      refuse("'map': taylor exists for N <= " + std::to_string(kMaxTaylorObservabilityOrder) +
+             " (use ad or adolc)");
+    }
+    design.map = make_taylor_observability_map(model, N);
   }
   const bool hand_alpha = [&] {
     if constexpr (kHand) return has_alpha<Form> && hand_ok && N == Form::kDimension;
     return false;
   }();
   if (spec.map == "explicit" && (spec.alpha == "lie" || (spec.alpha == "auto" && !hand_alpha))) {
-    refuse("α = L_f^N h needs 'map': ad (it comes from the model's ADOL-C tapes)");
+    refuse("α = L_f^N h needs a map built from the model ('map': ad, taylor or adolc)");
   }
   if (spec.alpha == "explicit" || (spec.alpha == "auto" && hand_alpha)) {
     if (!hand_alpha) refuse("'alpha': explicit needs a hand α (duffing N = 6, oscillator N = 4)");
@@ -181,7 +188,9 @@ HighGainSpec parse_high_gain_spec(JsonReader& o) {
   if (auto p = o.vector("poles")) s.poles = to_std(*p);
   if (auto c = o.vector("coefficients")) s.coefficients = *c;
   s.map = o.text("map").value_or("ad");
-  if (s.map != "ad" && s.map != "explicit") o.fail("'map' must be ad or explicit");
+  if (s.map != "ad" && s.map != "taylor" && s.map != "adolc" && s.map != "explicit") {
+    o.fail("'map' must be ad, taylor, adolc or explicit");
+  }
   s.alpha = o.text("alpha").value_or("auto");
   if (s.alpha != "auto" && s.alpha != "explicit" && s.alpha != "lie") {
     o.fail("'alpha' must be auto, explicit or lie");

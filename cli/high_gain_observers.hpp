@@ -20,7 +20,9 @@ struct HighGainSpec {
   double theta = 0.1;
   std::vector<double> poles;  // empty: all at −1
   Eigen::VectorXd coefficients;
-  std::string map = "ad";      // ad (ADOL-C from the model) | explicit (hand expansion)
+  // From the model: ad (taylor for N <= 8, else adolc) | taylor (Boost autodiff) | adolc;
+  // explicit (hand expansion).
+  std::string map = "ad";
   std::string alpha = "auto";  // auto (explicit if the model has one, else lie) | explicit | lie
   bool inverse = false;        // the explicit inverse (oscillator) instead of the projection
   // Saturation: P given, or from a box |x_i| ≤ X_i through the hand map; none when both empty.

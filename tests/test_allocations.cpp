@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <new>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "nlobs/observers/modulating_function_observer.hpp"
 #include "nlobs/observers/mvt_observer.hpp"
 #include "nlobs/observers/pi_bank.hpp"
+#include "nlobs/observers/taylor_observability_map.hpp"
 #include "nlobs/solvers/ceres_engine.hpp"
 #include "nlobs/solvers/solvers.hpp"
 #include "reference/chua_window.hpp"
@@ -169,6 +171,50 @@ TEST(Allocations, HighGainStepWithExplicitFormsAllocatesNothing) {
   }
   EXPECT_EQ(g_allocations.load() - before, 0);
   EXPECT_GT(observer.zhat().norm(), 0.1);
+}
+
+// q_N, its Jacobian and L_f^N h with its gradient by Taylor mode (fvar lives on the stack) into
+// outputs of the right size: no allocation, unlike the ADOL-C map whose drivers allocate.
+TEST(Allocations, TaylorObservabilityMapAllocatesNothing) {
+  const TaylorObservabilityMap<Lorenz, 4> map;
+  Eigen::VectorXd x = Eigen::Vector3d(1.0, -2.0, 20.0), z(4), gradient(3);
+  Eigen::MatrixXd dq(4, 3);
+  double next = 0.0, sum = 0.0;
+  const long before = g_allocations.load();
+  for (int k = 0; k < 100; ++k) {
+    x[0] += 0.01;
+    EXPECT_TRUE(map.value(x, z));
+    EXPECT_TRUE(map.jacobian(x, dq));
+    EXPECT_TRUE(map.next(x, next, &gradient));
+    sum += z[3] + dq(3, 2) + next + gradient[0];
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_TRUE(std::isfinite(sum));
+  EXPECT_NE(dq(3, 2), 0.0);  // ∂(L_f^3 h)/∂x3 ≠ 0 off the x3 axis
+}
+
+// With that map a whole high-gain step without explicit forms — α = L_f^4 h along the
+// prediction and x̂ by the Ceres projection (Lorenz, RK4) — allocates nothing either.
+TEST(Allocations, HighGainStepWithTaylorMapAndProjectionAllocatesNothing) {
+  HighGainObserver<Lorenz>::Design d;
+  d.map = std::make_shared<TaylorObservabilityMap<Lorenz, 4>>();
+  HighGainOptions o;
+  o.sample_time = 1e-3;
+  o.theta = 0.02;
+  HighGainObserver<Lorenz> observer(Lorenz{}, d, Eigen::Vector3d(2.0, 3.0, 25.0), o);
+  const Eigen::VectorXd none(0);
+  Eigen::VectorXd yk = Eigen::VectorXd::Constant(1, 1.0);
+  for (long k = 0; k < 5; ++k) observer.step(k, yk, none);
+  const Eigen::VectorXd z5 = observer.zhat();
+  long failures = 0;
+  const long before = g_allocations.load();
+  for (long k = 5; k < 100; ++k) {
+    yk[0] = 1.0 + 0.1 * std::sin(0.01 * static_cast<double>(k));
+    failures += observer.step(k, yk, none).failure.empty() ? 0 : 1;
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(failures, 0);
+  EXPECT_GT((observer.zhat() - z5).norm(), 1e-3);
 }
 
 // A modulating-function step (FIR mode and sampled-data mode with the predictor): ring buffers

@@ -465,6 +465,39 @@ TEST(RunHighGain, ThetaSweepShowsPeakingAndNoise) {
             std::string::npos);
 }
 
+// The maps from the model through the CLI: taylor, adolc and ad (taylor up to N = 8) run the
+// same observer on Lorenz to rounding; past N = 8, ad takes ADOL-C and taylor is refused.
+TEST(RunHighGain, MapsFromTheModelGiveTheSameRun) {
+  const auto file = [](const std::string& map, int N) {
+    const fs::path f = scratch("hg_map_" + map + "_" + std::to_string(N) + ".json");
+    write(f, R"({"name": "m", "model": {"name": "lorenz", "step": 0.001}, "x0": [1, 1, 20],
+                 "initial_guess": [2, 3, 25], "steps": 301, "settle_time": 0.2,
+                 "observers": [{"type": "high_gain", "name": "hg", "theta": 0.05, "N": )" +
+                 std::to_string(N) + R"(, "map": ")" + map + R"("}]})");
+    return f;
+  };
+  const auto run_with = [&](const std::string& map, int N) {
+    const fs::path f = file(map, N), dir = f.parent_path() / f.stem();
+    std::ostringstream out, err;
+    run_scenario(f.string(), {.out_dir = dir.string()}, out, err);
+    std::ifstream in(dir / "summary.json");
+    return observer_of(nlohmann::json::parse(in), "hg");
+  };
+  const nlohmann::json taylor = run_with("taylor", 4), adolc = run_with("adolc", 4),
+                       ad = run_with("ad", 4);
+  const double z = adolc["final_z_error"].get<double>();
+  EXPECT_GT(z, 0.0);
+  EXPECT_NEAR(taylor["final_z_error"].get<double>(), z, 1e-8 * (1.0 + z));
+  EXPECT_EQ(ad["final_z_error"], taylor["final_z_error"]);
+  EXPECT_EQ(ad["mse"], taylor["mse"]);
+  EXPECT_TRUE(taylor["failures"].empty());
+  // N = 9: ad takes ADOL-C (taylor stops at 8), the same run as adolc.
+  const nlohmann::json ad9 = run_with("ad", 9), adolc9 = run_with("adolc", 9);
+  EXPECT_EQ(ad9["mse"], adolc9["mse"]);
+  EXPECT_NE(error_of(file("taylor", 9).string()).find("taylor exists for N <= 8"),
+            std::string::npos);
+}
+
 TEST(RunHighGain, ScenariosRoundTripAndBadSpecsNameTheProblem) {
   for (const char* name : {"hg-duffing", "hg-oscillator", "hg-lorenz", "hg-vdp"}) {
     const nlohmann::json j = to_json(load_scenario(name));
@@ -491,7 +524,7 @@ TEST(RunHighGain, ScenariosRoundTripAndBadSpecsNameTheProblem) {
   write(f, scenario("pendulum", 2, R"({"type": "high_gain", "N": 3})"));
   EXPECT_NE(error_of(f.string()).find("depends on t"), std::string::npos) << error_of(f.string());
   write(f, scenario("lorenz", 3, R"({"type": "high_gain", "map": "explicit"})"));
-  EXPECT_NE(error_of(f.string()).find("needs 'map': ad"), std::string::npos)
+  EXPECT_NE(error_of(f.string()).find("needs a map built from the model"), std::string::npos)
       << error_of(f.string());
   write(f, scenario("duffing", 2,
                     R"({"type": "high_gain", "saturation": {"P_diagonal": [1, 1, 1, 1, 1, -1]}})"));
@@ -506,6 +539,10 @@ TEST(RunHighGain, ScenariosRoundTripAndBadSpecsNameTheProblem) {
   EXPECT_NE(error_of(f.string()).find("give 'N'"), std::string::npos) << error_of(f.string());
   write(f, scenario("lorenz", 3, R"({"type": "high_gain", "N": 2})"));
   EXPECT_NE(error_of(f.string()).find("N = 2"), std::string::npos) << error_of(f.string());
+  write(f, scenario("lorenz", 3, R"({"type": "high_gain", "map": "tape"})"));
+  EXPECT_NE(error_of(f.string()).find("'map' must be ad, taylor, adolc or explicit"),
+            std::string::npos)
+      << error_of(f.string());
   write(f, scenario("lorenz", 3, R"({"type": "high_gain", "N": 4, "alpha": "explicit"})"));
   EXPECT_NE(error_of(f.string()).find("needs a hand α"), std::string::npos) << error_of(f.string());
 }

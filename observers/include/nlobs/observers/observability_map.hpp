@@ -32,6 +32,15 @@ class ObservabilityMap {
                     Eigen::VectorXd* /*gradient*/) const {
     throw InvalidInput(description() + ": L_f^N h is not available (not built from the model)");
   }
+
+ protected:
+  // Throws InvalidInput naming the map when x is not of the state dimension.
+  void check_states(const Eigen::VectorXd& x) const {
+    if (x.size() != states()) {
+      throw InvalidInput(description() + ": x must have " + std::to_string(states()) +
+                         " entries, got " + std::to_string(x.size()));
+    }
+  }
 };
 
 // A hand-written map. Form (a struct, or a lambda with `auto` parameters is not enough — the
@@ -50,12 +59,12 @@ class ExplicitObservabilityMap final : public ObservabilityMap {
   Eigen::Index dimension() const override { return N; }
   std::string description() const override { return description_; }
   bool value(const Eigen::VectorXd& x, Eigen::VectorXd& z) const override {
-    check(x);
+    check_states(x);
     z = map_(Eigen::Matrix<double, n, 1>(x));
     return z.allFinite();
   }
   bool jacobian(const Eigen::VectorXd& x, Eigen::MatrixXd& dq) const override {
-    check(x);
+    check_states(x);
     using Jet = ceres::Jet<double, n>;
     Eigen::Matrix<Jet, n, 1> xj;
     for (int i = 0; i < n; ++i) xj[i] = Jet(x[i], i);
@@ -67,12 +76,6 @@ class ExplicitObservabilityMap final : public ObservabilityMap {
   const Map& map() const { return map_; }
 
  private:
-  void check(const Eigen::VectorXd& x) const {
-    if (x.size() != n) {
-      throw InvalidInput(description_ + ": x must have " + std::to_string(n) + " entries, got " +
-                         std::to_string(x.size()));
-    }
-  }
   Map map_;
   std::string description_;
 };
