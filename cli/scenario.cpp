@@ -174,7 +174,7 @@ const char* kMvtRobot = R"({
 
 // METHODS §5 / seed 004: the Duffing oscillator's hard start ẑ(0) = q6(0, 0) while x(0) is on an
 // orbit around the equilibrium (1, 0); P, R, ρ and θ are the paper's. The hand q6 (the maps from
-// the model give the same run, "map": "ad" 10× and "adolc" 100× slower).
+// the model give the same run, "map": "ad" 7× and "adolc" 100× slower).
 constexpr const char* kHgDuffing = R"({
   "name": "hg-duffing",
   "model": {"name": "duffing", "scheme": "rk4", "step": 0.001},
@@ -195,7 +195,7 @@ constexpr const char* kHgDuffing = R"({
 
 // The oscillator with y = x1² + x1: x(0) = (−1/2, 0), initial error (0.2, 0), θ = 0.3, the
 // paper's P; the explicit inverse (the paper) beside the least-squares projection (through the
-// hand q4: the maps from the model give the same run at 4× (Taylor) and 80× (ADOL-C) the cost).
+// hand q4: the maps from the model give the same run at 2.5× (Taylor) and 80× (ADOL-C) the cost).
 constexpr const char* kHgOscillator = R"({
   "name": "hg-oscillator",
   "model": {"name": "oscillator", "scheme": "rk4", "step": 0.001},

@@ -12,9 +12,9 @@
 // Against LieObservabilityMap (ADOL-C): no tape, so value-dependent branches in f and h are
 // fine; the map is const and stateless, so thread-safe; nothing allocates (fvar is a
 // std::array), which makes a whole high-gain step with the projection allocation-free; and it is
-// faster — per call 24–27× for q_N, 8–9× for ∂q_N/∂x, 10× for L_f^N h with its gradient
+// faster — per call 34–41× for q_N, 12–13× for ∂q_N/∂x, 12–16× for L_f^N h with its gradient
 // (Duffing N = 6, Lorenz N = 4; bench BM_ObservabilityMap*), the gap narrowing with N (Lorenz
-// N = 8: 2.2× for the Jacobian). But N is a compile-time parameter:
+// N = 8: 3.3× for the Jacobian). But N is a compile-time parameter:
 // make_taylor_observability_map dispatches a run-time N up to kMaxTaylorObservabilityOrder;
 // past it, ADOL-C.
 // Inputs are held at zero and time at 0: the maps are for x' = f(x) (METHODS §5).
@@ -115,22 +115,38 @@ class TaylorObservabilityMap final : public ObservabilityMap {
     return g;
   }
 
+  // t^k and ε t^k (ε the inner direction, for Tangent coefficients): the monomials g t^k are
+  // built from them by scalar products. Not T(g) t^k: for g = Tangent, T(g) picks fvar's
+  // converting constructor, which puts g's derivative into the t¹ coefficient; and t comes from a
+  // depth-one fvar converted to T, since one mixed into T directly would land outermost too.
+  // Constants of (T, D): built once per type (thread-safe static initialisation), not per call.
+  template <typename T, int D>
+  struct Monomials {
+    std::array<T, D + 1> power, inner;
+  };
+  template <typename T, int D>
+  static const Monomials<T, D>& monomials() {
+    static const Monomials<T, D> basis = [] {
+      Monomials<T, D> b;
+      b.power[0] = T(1.0);
+      const T t = T(boost::math::differentiation::make_fvar<double, D>(0.0));
+      for (size_t k = 1; k <= D; ++k) b.power[k] = b.power[k - 1] * t;
+      if constexpr (T::depth > 1) {      // Tangent coefficients
+        const T epsilon = T(0.0, true);  // 0 + ε, constant in t
+        for (size_t k = 0; k <= D; ++k) b.inner[k] = b.power[k] * epsilon;
+      }
+      return b;
+    }();
+    return basis;
+  }
+
   // L_f^0 h … L_f^D h at x0 (coefficients G: values, or values with one directional derivative).
   template <int D, typename G>
   std::array<G, D + 1> series(const Eigen::Matrix<G, n, 1>& x0) const {
     using T = typename Series<G, D>::type;
-    // The monomials g t^k, built from t^k and ε t^k (ε the inner direction) by scalar products.
-    // Not T(g) t^k: for g = Tangent, T(g) picks fvar's converting constructor, which puts g's
-    // derivative into the t¹ coefficient; and t comes from a depth-one fvar converted to T,
-    // since one mixed into T directly would land outermost too.
-    std::array<T, D + 1> power, inner;
-    power[0] = T(1.0);
-    const T t = T(boost::math::differentiation::make_fvar<double, D>(0.0));
-    for (size_t k = 1; k <= D; ++k) power[k] = power[k - 1] * t;
-    if constexpr (!std::is_same_v<G, double>) {
-      const T epsilon = T(0.0, true);  // 0 + ε, constant in t
-      for (size_t k = 0; k <= D; ++k) inner[k] = power[k] * epsilon;
-    }
+    const Monomials<T, D>& basis = monomials<T, D>();
+    const auto& power = basis.power;
+    const auto& inner = basis.inner;
     const auto monomial = [&](const G& g, size_t k) {
       if constexpr (std::is_same_v<G, double>) {
         return T(power[k] * g);
