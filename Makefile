@@ -1,12 +1,15 @@
 # nlobs — two commands: `make demo` (the main job) and `make test`.
 # Both install missing Debian packages (scripts/ensure-deps.sh), configure (Release), build, run.
+# `make demo` builds only the CLI and the libraries it links; `make test` builds everything.
+# ccache is used when installed (NLOBS_CCACHE=OFF in CMAKE_ARGS turns it off).
 BUILD      ?= build
 BUILD_TYPE ?= Release
 WERROR     ?= OFF
 JOBS       ?= 2
 CMAKE_ARGS ?=
 
-.PHONY: all deps configure build test demo bench sanitize format format-check clean
+.PHONY: all deps configure build build-cli test demo bench sanitize format format-check clean \
+        compile-cost
 
 all: build
 
@@ -19,10 +22,13 @@ configure: deps
 build: configure
 	cmake --build $(BUILD) -j $(JOBS)
 
+build-cli: configure
+	cmake --build $(BUILD) -j $(JOBS) --target nlobs
+
 test: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
 
-demo: build
+demo: build-cli
 	$(BUILD)/cli/nlobs run chua-fp --out $(BUILD)/demo
 	@echo "plots: $(BUILD)/demo/states.png errors.png first_window.png (summary.json, trajectories.csv beside them)"
 
@@ -41,5 +47,9 @@ format: deps
 format-check: deps
 	find solvers observers models bench cli tests examples -name '*.hpp' -o -name '*.cpp' | xargs clang-format --dry-run --Werror
 
+# Per-translation-unit wall time and peak memory of a from-scratch build (docs/architecture.md).
+compile-cost: deps
+	./scripts/compile-cost
+
 clean:
-	rm -rf $(BUILD) build-asan
+	rm -rf $(BUILD) build-asan build-cost

@@ -7,6 +7,8 @@ set -euo pipefail
 packages=(
   g++ make cmake pkg-config
   clang-format         # the formatting check CI runs (make format-check)
+  ccache               # compiler cache: rebuilds and CI runs reuse unchanged units
+  time                 # /usr/bin/time: scripts/compile-cost's per-unit wall time and memory
   libeigen3-dev        # linear algebra, fixed-size vectors
   libceres-dev         # ceres::Jet forward-mode AD, least-squares engine (Ceres, TinySolver)
   libgoogle-glog-dev   # Ceres' logging; the CLI silences it

@@ -1,8 +1,14 @@
 // Engines by name: every built-in round-trips, options reach the engine, errors list the
-// valid names and options, users register their own engines.
+// valid names and options, users register their own engines, and one registration at Dynamic
+// serves every size (library sizes and others).
 #include <gtest/gtest.h>
 
+#include "nlobs/solvers/builtin_engines.hpp"
+#include "nlobs/solvers/ceres_engine.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
+#include "nlobs/solvers/fixed_point_engines.hpp"
+#include "nlobs/solvers/newton_engine.hpp"
+#include "nlobs/solvers/nlopt_engine.hpp"
 #include "test_support.hpp"
 
 namespace nlobs {
@@ -152,6 +158,182 @@ TEST(EngineRegistry, UsersRegisterTheirOwn) {
             }).find("has no factory"),
             std::string::npos);
   EXPECT_FALSE(registry.contains("nofactory"));
+}
+
+// A user's engine, generic in the size: x ← x + w (G(x) − x), written once.
+template <int N>
+class Relaxed final : public Engine<N> {
+ public:
+  Relaxed(double w, SolverOptions o) : Engine<N>(std::move(o)), w_(w) {}
+  std::string_view name() const override { return "relaxed"; }
+  Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override {
+    detail::check_initial_guess(name(), problem, x);
+    Summary s;
+    s.engine = name();
+    Vector<N> g = x;
+    for (; s.iterations < this->options_.stop.max_iterations; ++s.iterations) {
+      problem.evaluate(x, g);
+      ++s.function_evaluations;
+      const double step = w_ * (g - x).template lpNorm<Eigen::Infinity>();
+      x += w_ * (g - x);
+      if (!(step > *this->options_.stop.step_tolerance)) {
+        s.status = Status::kConverged;
+        s.residual_norm = step / w_;
+        return s;
+      }
+    }
+    s.status = Status::kMaxIterations;
+    return s;
+  }
+
+ private:
+  double w_;
+};
+
+// G_i(x) = 0.5 cos(x_i) + 0.1 i: a contraction in any dimension n.
+template <int N>
+FixedPointProblem<N> cosine_chain(Index n = N) {
+  return FixedPointProblem<N>::with_autodiff(
+      [n](const auto& x) {
+        using T = typename std::decay_t<decltype(x)>::Scalar;
+        Eigen::Matrix<T, N, 1> g(n);
+        for (Index i = 0; i < n; ++i) g[i] = 0.5 * cos(x[i]) + 0.1 * static_cast<double>(i);
+        return g;
+      },
+      n);
+}
+
+template <int N>
+double fixed_point_residual(const Vector<N>& x) {
+  double r = 0.0;
+  for (Index i = 0; i < x.size(); ++i) {
+    r = std::max(r, std::abs(0.5 * std::cos(x[i]) + 0.1 * static_cast<double>(i) - x[i]));
+  }
+  return r;
+}
+
+template <int N>
+void expect_relaxed_solves(Index n = N) {
+  auto engine = EngineRegistry<N>::global().create("relaxed:w=0.8,tol=1e-13");
+  ASSERT_TRUE(engine);
+  EXPECT_EQ(engine->name(), "relaxed");
+  Vector<N> x = Vector<N>::Zero(n);
+  const Summary s = engine->solve(cosine_chain<N>(n), x);
+  EXPECT_TRUE(s.converged()) << N << '\n' << s.full_report();
+  EXPECT_LT(fixed_point_residual<N>(x), 1e-12) << N;
+}
+
+TEST(EngineRegistry, OneRegistrationAtDynamicServesEverySize) {
+  auto& dynamic = EngineRegistry<Dynamic>::global();
+  if (!dynamic.contains("relaxed")) {
+    dynamic.add({"relaxed",
+                 "relaxed Picard",
+                 {{"w", "weight in (0, 1]; default 0.5"}},
+                 {"relaxed:w=0.8"},
+                 [](EngineSpecReader& s, SolverOptions o) -> std::unique_ptr<Engine<Dynamic>> {
+                   return std::make_unique<Relaxed<Dynamic>>(s.number("w").value_or(0.5),
+                                                             std::move(o));
+                 }});
+  }
+  expect_relaxed_solves<Dynamic>(6);
+  expect_relaxed_solves<1>();  // library sizes
+  expect_relaxed_solves<3>();
+  expect_relaxed_solves<5>();  // sizes the library does not compile
+  expect_relaxed_solves<7>();
+  EXPECT_TRUE(EngineRegistry<7>::global().contains("relaxed"));
+  const auto names = EngineRegistry<7>::global().names();
+  EXPECT_NE(std::find(names.begin(), names.end(), "relaxed"), names.end());
+  // Its options are checked as at Dynamic.
+  EXPECT_NE(message_of([] {
+              EngineRegistry<5>::global().create("relaxed:q=1");
+            }).find("unknown option(s) q"),
+            std::string::npos);
+}
+
+TEST(EngineRegistry, AFixedSizeEntryShadowsTheDynamicOne) {
+  auto& dynamic = EngineRegistry<Dynamic>::global();
+  if (!dynamic.contains("shadowed")) {
+    dynamic.add({"shadowed", "at Dynamic", {}, {}, [](EngineSpecReader&, SolverOptions o) {
+                   return std::make_unique<Relaxed<Dynamic>>(0.5, std::move(o));
+                 }});
+  }
+  auto& fixed = EngineRegistry<6>::global();
+  try {
+    fixed.add({"shadowed", "at 6", {}, {}, [](EngineSpecReader&, SolverOptions o) {
+                 return std::make_unique<Relaxed<6>>(0.5, std::move(o));
+               }});
+  } catch (const InvalidInput& e) {  // a repeated test: added the first time
+    EXPECT_NE(std::string(e.what()).find("already registered"), std::string::npos);
+  }
+  auto engine = fixed.create("shadowed");
+  EXPECT_NE(dynamic_cast<Relaxed<6>*>(engine.get()), nullptr);
+  for (const auto& e : fixed.entries()) {
+    if (e.name == "shadowed") {
+      EXPECT_EQ(e.description, "at 6");
+    }
+  }
+  // At another fixed size the Dynamic entry still serves, adapted.
+  auto other = EngineRegistry<5>::global().create("shadowed");
+  EXPECT_NE(dynamic_cast<DynamicSizeEngine<5>*>(other.get()), nullptr);
+}
+
+TEST(EngineRegistry, BuiltInsAtSizesTheLibraryDoesNotCompile) {
+  static_assert(!is_library_size(5) && is_library_size(3) && is_library_size(Dynamic));
+  SolverOptions o;
+  o.stop.step_tolerance = 1e-12;
+  o.stop.residual_tolerance = 1e-12;
+  // Through the Dynamic entries: every built-in solves a 5-dimensional problem.
+  for (const char* spec : {"picard", "aitken", "steffensen", "anderson", "newton", "ceres",
+                           "nlopt:LN_BOBYQA,xtol_rel=1e-14"}) {
+    auto engine = EngineRegistry<5>::global().create(spec, o);
+    ASSERT_NE(dynamic_cast<DynamicSizeEngine<5>*>(engine.get()), nullptr) << spec;
+    Vector<5> x = Vector<5>::Zero();
+    const Summary s = engine->solve(cosine_chain<5>(), x);
+    EXPECT_LT(fixed_point_residual<5>(x), 1e-6) << spec << '\n' << s.full_report();
+  }
+  // Newton sees the problem's AD Jacobian through the adapter: no differencing.
+  auto newton = EngineRegistry<5>::global().create("newton", o);
+  Vector<5> x = Vector<5>::Zero();
+  const Summary s = newton->solve(cosine_chain<5>(), x);
+  EXPECT_TRUE(s.converged());
+  EXPECT_GT(s.jacobian_evaluations, 0);
+  EXPECT_LE(s.function_evaluations, s.iterations + 2) << s.full_report();
+  // Least squares (m = 7 > n = 5) through the adapter: F_i = x_{i mod 5} − c_{i mod 5}.
+  const Vector<5> c(1.0, -2.0, 3.0, 0.5, 4.0);
+  const auto f = [c](const Vector<5>& v, Vector<Dynamic>& r) {
+    r.resize(7);
+    for (Index i = 0; i < 7; ++i) r[i] = v[i % 5] - c[i % 5];
+  };
+  auto ceres = EngineRegistry<5>::global().create("ceres", o);
+  EXPECT_TRUE(ceres->least_squares());
+  Vector<5> y = Vector<5>::Zero();
+  const Summary ls = ceres->solve_least_squares(RootProblem<5, Dynamic>::from_map(f, 5, 7), y);
+  EXPECT_TRUE(ls.converged()) << ls.full_report();
+  EXPECT_LT((y - c).lpNorm<Eigen::Infinity>(), 1e-8);
+  // Fixed-size built-ins at another size on request (builtin_engines.hpp): no adapter. The
+  // registry is process-wide, so a repeated test finds them there already.
+  auto& eight = EngineRegistry<8>::global();
+  if (!dynamic_cast<NewtonEngine<8>*>(eight.create("newton").get())) add_builtin_engines<8>(eight);
+  auto fixed_newton = eight.create("newton", o);
+  ASSERT_NE(dynamic_cast<NewtonEngine<8>*>(fixed_newton.get()), nullptr);
+  Vector<8> z = Vector<8>::Zero();
+  EXPECT_TRUE(fixed_newton->solve(cosine_chain<8>(), z).converged());
+  EXPECT_LT(fixed_point_residual<8>(z), 1e-12);
+}
+
+TEST(EngineRegistry, FactoriesThatReturnNothingAreNamed) {
+  auto& registry = EngineRegistry<Dynamic>::global();
+  if (!registry.contains("nothing")) {
+    registry.add({"nothing", "", {}, {}, [](EngineSpecReader&, SolverOptions) {
+                    return std::unique_ptr<Engine<Dynamic>>();
+                  }});
+  }
+  EXPECT_NE(message_of([&] { registry.create("nothing"); }).find("returned no engine"),
+            std::string::npos);
+  EXPECT_NE(
+      message_of([] { EngineRegistry<5>::global().create("nothing"); }).find("returned no engine"),
+      std::string::npos);
+  EXPECT_NE(message_of([] { DynamicSizeEngine<2> e(nullptr); }).find("null"), std::string::npos);
 }
 
 }  // namespace

@@ -26,9 +26,6 @@
 // exceeds 0.2 (bench BM_HighGainIntegrator: RK4 is as accurate and ~200× cheaper up to 0.1, its
 // error reaches 1e-2 at 0.33 and it diverges beyond 2.8; docs/observers.md).
 #include <Eigen/Core>
-#include <Eigen/Eigenvalues>
-#include <Eigen/SVD>
-#include <boost/numeric/odeint.hpp>
 #include <cmath>
 #include <complex>
 #include <functional>
@@ -39,10 +36,13 @@
 #include <string>
 #include <vector>
 
+#include "nlobs/models/catalogue.hpp"
 #include "nlobs/models/model.hpp"
+#include "nlobs/observers/high_gain_design.hpp"
 #include "nlobs/observers/model_derivatives.hpp"
 #include "nlobs/observers/observability_map.hpp"
 #include "nlobs/observers/observer.hpp"
+#include "nlobs/observers/rk4_stepper.hpp"
 #include "nlobs/observers/sample_interpolator.hpp"
 #include "nlobs/observers/smooth_saturation.hpp"
 #include "nlobs/observers/stiff_integrator.hpp"
@@ -121,32 +121,6 @@ struct HighGainOptions {
   int restart_every = 1;
 };
 
-// [l_0, …, l_{N−1}] of Π (s − p_j). Throws InvalidInput for a root that is not < 0.
-inline Eigen::VectorXd hurwitz_coefficients(const std::vector<double>& poles) {
-  Eigen::VectorXd c = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(poles.size()) + 1);
-  c[0] = 1.0;  // ascending powers
-  for (size_t j = 0; j < poles.size(); ++j) {
-    const double p = poles[j];
-    if (!(p < 0.0) || !std::isfinite(p)) {
-      std::ostringstream os;
-      os << "HighGainOptions::poles: " << p << " is not a finite negative real root (Hurwitz)";
-      throw InvalidInput(os.str());
-    }
-    for (Eigen::Index k = static_cast<Eigen::Index>(j) + 1; k > 0; --k) c[k] = c[k - 1] - p * c[k];
-    c[0] = -p * c[0];
-  }
-  return c.head(c.size() - 1);  // the leading 1 dropped
-}
-
-// The roots of s^N + l_{N−1}s^{N−1} + … + l_0 (eigenvalues of the companion matrix).
-inline Eigen::VectorXcd polynomial_roots(const Eigen::VectorXd& l) {
-  const Eigen::Index N = l.size();
-  Eigen::MatrixXd companion = Eigen::MatrixXd::Zero(N, N);
-  companion.bottomLeftCorner(N - 1, N - 1).setIdentity();
-  companion.col(N - 1) = -l;
-  return Eigen::EigenSolver<Eigen::MatrixXd>(companion, false).eigenvalues();
-}
-
 template <ContinuousModel Model>
 class HighGainObserver final : public Observer {
  public:
@@ -165,121 +139,7 @@ class HighGainObserver final : public Observer {
   // option for each invalid option, size or start.
   HighGainObserver(Model model, Design design, const Eigen::VectorXd& xhat0,
                    HighGainOptions options, std::optional<Eigen::VectorXd> zhat0 = {},
-                   std::string name = "high_gain")
-      : model_(std::move(model)),
-        design_(std::move(design)),
-        options_(std::move(options)),
-        name_(std::move(name)),
-        derivatives_(model_) {
-    const auto fail = [this](const std::string& what) { throw InvalidInput(name_ + ": " + what); };
-    if (!design_.map) fail("no observability map q_N given");
-    const ObservabilityMap& map = *design_.map;
-    N_ = map.dimension();
-    if (map.states() != n) {
-      fail("the map's state dimension " + std::to_string(map.states()) + " is not the model's " +
-           std::to_string(n));
-    }
-    if (N_ < n || N_ < 2) {
-      fail("N = " + std::to_string(N_) + " is smaller than the state dimension n = " +
-           std::to_string(n) + " (or 2): q_N cannot be injective");
-    }
-    if (!(options_.theta > 0.0) || !std::isfinite(options_.theta)) {
-      fail("HighGainOptions::theta must be finite and > 0 (got " + std::to_string(options_.theta) +
-           ")");
-    }
-    if (!(options_.sample_time > 0.0) || !std::isfinite(options_.sample_time)) {
-      fail("HighGainOptions::sample_time must be finite and > 0");
-    }
-    if (options_.substeps < 1) fail("HighGainOptions::substeps must be >= 1");
-    if (!(options_.absolute_tolerance > 0.0) || !(options_.relative_tolerance > 0.0)) {
-      fail("HighGainOptions::absolute_tolerance and relative_tolerance must be > 0");
-    }
-    if (!(options_.jump_threshold > 0.0)) fail("HighGainOptions::jump_threshold must be > 0");
-    if (options_.restart_every < 1) fail("HighGainOptions::restart_every must be >= 1");
-    if (!(options_.residual_scale > 0.0) || !std::isfinite(options_.residual_scale)) {
-      fail("HighGainOptions::residual_scale must be finite and > 0");
-    }
-    if (!(options_.restart_residual >= 0.0) || !std::isfinite(options_.restart_residual)) {
-      fail("HighGainOptions::restart_residual must be finite and >= 0 (0: never restart)");
-    }
-    if (vector_field_depends_on_time(model_)) {
-      fail("the model's vector field depends on t: this observer is for autonomous x' = f(x)");
-    }
-    if (!(options_.observability_floor >= 0.0)) {
-      fail("HighGainOptions::observability_floor must be >= 0");
-    }
-    set_coefficients();
-    if (options_.saturation) {
-      try {
-        options_.saturation->validate(N_);
-      } catch (const InvalidInput& e) {
-        fail(std::string("HighGainOptions::saturation: ") + e.what());
-      }
-    }
-    if (!design_.alpha.value && !map.has_next()) {
-      fail("no α given and the map '" + map.description() +
-           "' cannot evaluate L_f^N h (build it from the model: LieObservabilityMap)");
-    }
-    lie_alpha_ = !design_.alpha.value;
-    predict_ = true;  // x̄ serves α (lie), the warm start (predicted) and the jump test
-    if (xhat0.size() != n || !xhat0.allFinite()) {
-      fail("the initial estimate x̂(0) must be " + std::to_string(n) + " finite numbers");
-    }
-    xhat0_ = xhat0;
-    zhat0_.resize(N_);
-    if (zhat0) {
-      if (zhat0->size() != N_ || !zhat0->allFinite()) {
-        fail("ẑ(0) must be " + std::to_string(N_) + " finite numbers");
-      }
-      zhat0_ = *zhat0;
-    } else if (!map.value(xhat0_, zhat0_)) {
-      fail("q_N(x̂(0)) is not finite");
-    }
-    if (!design_.inverse) {
-      SolverOptions solver;
-      solver.stop.step_tolerance = 1e-12;
-      solver.stop.residual_tolerance = 1e-13;
-      solver.stop.max_iterations = 100;
-      engine_ = EngineRegistry<n>::global().create(options_.projection, solver);
-      problem_.emplace(RootProblem<n, Eigen::Dynamic>::with_jacobian(
-          [this](const Vector<n>& x, Eigen::VectorXd& r) {
-            x_ = x;
-            if (!design_.map->value(x_, z_))
-              z_.setConstant(std::numeric_limits<double>::quiet_NaN());
-            r = z_ - zhat_projected_;
-          },
-          [this](const Vector<n>& x, Matrix<Eigen::Dynamic, n>& jac) {
-            x_ = x;
-            if (design_.map->jacobian(x_, dq_)) {
-              jac = dq_;
-            } else {  // never the previous point's Jacobian
-              jac.setConstant(std::numeric_limits<double>::quiet_NaN());
-            }
-          },
-          n, N_));
-      if (!engine_->least_squares() && N_ != n) {
-        fail("projection engine '" + options_.projection +
-             "' solves square systems only (N = n); use ceres or nlopt");
-      }
-    }
-    integrator_ = options_.integrator;
-    if (integrator_ == HighGainIntegrator::kAuto) {
-      // Largest |root| of the scaled error dynamics times the step (see the header comment).
-      const double h = options_.sample_time / options_.substeps;
-      integrator_ = h * spectral_radius_ / options_.theta > 0.2 ? HighGainIntegrator::kCvode
-                                                                : HighGainIntegrator::kRk4;
-    }
-    if (integrator_ == HighGainIntegrator::kCvode && !ModelDerivatives<Model>::kAutoDiff &&
-        predict_) {
-      warnings_.push_back(name_ + ": ∂f for the implicit stepper by central differences");
-    }
-    for (Eigen::Index i = 0; i < N_; ++i) extra_names_.push_back("zhat" + std::to_string(i + 1));
-    extra_names_.push_back("projection_residual");
-    extra_names_.push_back("jumps");
-    extra_names_.push_back("alpha_weight");
-    allocate();
-    reset();
-  }
+                   std::string name = "high_gain");
   HighGainObserver(const HighGainObserver&) = delete;
   HighGainObserver& operator=(const HighGainObserver&) = delete;
 
@@ -304,89 +164,14 @@ class HighGainObserver final : public Observer {
   double projection_residual() const { return residual_; }
   long jumps() const { return jumps_; }
 
-  void reset() override {
-    zhat_ = zhat0_;
-    xhat_ = xhat0_;
-    samples_.clear();
-    started_ = false;
-    last_t_ = 0.0;
-    jumps_ = 0;
-    residual_ = 0.0;
-    weight_ = 1.0;
-    started_once_ = false;
-    samples_since_restart_ = 0;
-    xbar_ = xhat0_;
-  }
+  void reset() override;
 
-  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
-    if (y.size() != 1 || u.size() != Model::kInputs) {
-      throw InvalidInput(name_ + ": a sample must have 1 output and " +
-                         std::to_string(Model::kInputs) + " inputs");
-    }
-    const double t = static_cast<double>(k) * options_.sample_time;
-    step_.failure.clear();
-    step_.failure_message.clear();
-    step_.measurement_missing = !y.allFinite();
-    step_.ready = true;
-    if (!u.allFinite()) {
-      step_.failure = "non_finite";
-      step_.failure_message = name_ + ": u_k is not finite at t = " + std::to_string(t);
-      return publish();
-    }
-    if (started_ && !(t > last_t_)) {
-      throw InvalidInput(name_ + ": sample k = " + std::to_string(k) +
-                         " does not come after the last one: samples must arrive in order");
-    }
-    input_ = u;
-    if (step_.measurement_missing) return publish();  // hold; the next sample bridges the gap
-    const SampleInterpolator<1> before = samples_;
-    samples_.push(t, Eigen::Matrix<double, 1, 1>(y[0]));
-    if (started_ && !integrate(last_t_, t)) {
-      samples_ = before;  // the sample that broke the step does not shape the next ones
-      step_.failure = "non_finite";
-      step_.failure_message = failure_;
-      return publish();  // the last good state; the next sample integrates from last_t_
-    }
-    started_ = true;
-    last_t_ = t;
-    project(t);
-    return publish();
-  }
+  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override;
 
  private:
   // The observer's right-hand side at t for the state s = (ẑ, x̄) with y(t) given: METHODS §5.
   // False (derivatives zero) when α or f is not finite there.
-  bool derivatives(double t, const double* s, double y, double* ds) {
-    zs_ = Eigen::Map<const Eigen::VectorXd>(s, N_);
-    const double innovation = y - s[0];
-    double alpha = 0.0;
-    if (predict_) {
-      xbar_ = Eigen::Map<const State>(s + N_);
-      Eigen::Map<State>(ds + N_) = model_.vector_field(xbar_, input_, t);
-    }
-    if (lie_alpha_) {
-      xd_ = xbar_;
-      if (weight_ > 0.0 && !design_.map->next(xd_, alpha, nullptr)) return zero(ds);
-      alpha *= weight_;
-    } else {
-      alpha = design_.alpha.value(zs_);
-    }
-    if (options_.saturation) alpha *= options_.saturation->factor(zs_);
-    for (Eigen::Index i = 0; i + 1 < N_; ++i) ds[i] = s[i + 1] + gains_[i] * innovation;
-    ds[N_ - 1] = alpha + gains_[N_ - 1] * innovation;
-    for (Eigen::Index i = 0; i < N_; ++i) {
-      if (!std::isfinite(ds[i])) return zero(ds);
-    }
-    for (Eigen::Index i = N_; i < state_size(); ++i) {
-      if (std::isfinite(ds[i])) continue;
-      if (lie_alpha_) return zero(ds);
-      // With an explicit α, x̄ only warm-starts the projection: a prediction that blows up (x̂
-      // far off, f superlinear) is frozen instead of failing the observer.
-      for (Eigen::Index j = N_; j < state_size(); ++j) ds[j] = 0.0;
-      break;
-    }
-    return true;
-  }
+  bool derivatives(double t, const double* s, double y, double* ds);
 
   bool zero(double* ds) const {
     for (Eigen::Index i = 0; i < state_size(); ++i) ds[i] = 0.0;
@@ -394,257 +179,31 @@ class HighGainObserver final : public Observer {
   }
   Eigen::Index state_size() const { return N_ + (predict_ ? n : 0); }
 
-  void set_coefficients() {
-    if (options_.coefficients.size() && !options_.poles.empty()) {
-      throw InvalidInput(name_ + ": give HighGainOptions::poles or coefficients, not both");
-    }
-    if (options_.coefficients.size()) {
-      if (options_.coefficients.size() != N_ || !options_.coefficients.allFinite()) {
-        throw InvalidInput(name_ + ": HighGainOptions::coefficients must be N = " +
-                           std::to_string(N_) + " finite numbers [l_0, …, l_{N−1}]");
-      }
-      coefficients_ = options_.coefficients;
-      const Eigen::VectorXcd roots = polynomial_roots(coefficients_);
-      for (const auto& r : roots) {
-        if (!(r.real() < 0.0)) {
-          std::ostringstream os;
-          os << name_ << ": HighGainOptions::coefficients are not Hurwitz: s^N + … has the root "
-             << r.real() << (r.imag() >= 0 ? " + " : " - ") << std::abs(r.imag()) << "i";
-          throw InvalidInput(os.str());
-        }
-      }
-      spectral_radius_ = roots.cwiseAbs().maxCoeff();
-    } else {
-      std::vector<double> poles = options_.poles;
-      if (poles.empty()) poles.assign(static_cast<size_t>(N_), -1.0);
-      if (static_cast<Eigen::Index>(poles.size()) != N_) {
-        throw InvalidInput(name_ + ": HighGainOptions::poles must list N = " + std::to_string(N_) +
-                           " roots");
-      }
-      try {
-        coefficients_ = hurwitz_coefficients(poles);
-      } catch (const InvalidInput& e) {
-        throw InvalidInput(name_ + ": " + e.what());
-      }
-      spectral_radius_ = 0.0;
-      for (double p : poles) spectral_radius_ = std::max(spectral_radius_, std::abs(p));
-    }
-    gains_.resize(N_);
-    for (Eigen::Index i = 1; i <= N_; ++i) {
-      gains_[i - 1] = coefficients_[N_ - i] / std::pow(options_.theta, static_cast<double>(i));
-    }
-    if (!gains_.allFinite()) {
-      throw InvalidInput(name_ + ": HighGainOptions::theta = " + std::to_string(options_.theta) +
-                         " makes the gains l/θ^N overflow");
-    }
-  }
+  void set_coefficients();
 
-  void allocate() {
-    zhat_.resize(N_);
-    zs_.resize(N_);
-    z_.resize(N_);
-    zhat_projected_.resize(N_);
-    dq_.resize(N_, n);
-    x_.resize(n);
-    state_.assign(static_cast<size_t>(state_size()), 0.0);
-    step_.estimate.resize(n);
-    step_.extras.resize(static_cast<Eigen::Index>(extra_names_.size()));
-    if (integrator_ == HighGainIntegrator::kCvode) {
-      const Eigen::Index size = state_size();
-      stiff_ = std::make_unique<StiffIntegrator>(
-          static_cast<int>(size),
-          [this](double t, const double* s, double* ds) {
-            return derivatives(t, s, samples_.at(t)[0], ds);
-          },
-          [this, size](double t, const double* s, double* j) {
-            Eigen::Map<Eigen::MatrixXd> jac(j, size, size);
-            jacobian(t, s, jac);
-          },
-          options_.relative_tolerance, options_.absolute_tolerance);
-    }
-  }
+  void allocate();
 
   // [t0, t1]; false (state untouched) when the right-hand side turned non-finite.
-  bool integrate(double t0, double t1) {
-    namespace odeint = boost::numeric::odeint;
-    failure_.clear();
-    for (Eigen::Index i = 0; i < N_; ++i) state_[static_cast<size_t>(i)] = zhat_[i];
-    if (predict_) {
-      for (int i = 0; i < n; ++i) state_[static_cast<size_t>(N_ + i)] = xhat_[i];
-    }
-    bool finite = true;
-    const long intervals = std::max(1L, std::lround((t1 - t0) / options_.sample_time));
-    if (integrator_ == HighGainIntegrator::kRk4) {
-      const auto rhs = [this, &finite](const std::vector<double>& s, std::vector<double>& ds,
-                                       double t) {
-        finite = derivatives(t, s.data(), samples_.at(t)[0], ds.data()) && finite;
-      };
-      const long steps = intervals * options_.substeps;
-      const double h = (t1 - t0) / static_cast<double>(steps);
-      for (long i = 0; i < steps && finite; ++i) {
-        rk4_.do_step(rhs, state_, t0 + static_cast<double>(i) * h, h);
-      }
-    } else if (!stiff_->integrate(t0, t1, state_.data(), &failure_)) {
-      failure_ = name_ + ": " + failure_;
-      finite = false;
-    }
-    for (Eigen::Index i = 0; i < state_size(); ++i) {
-      if (std::isfinite(state_[static_cast<size_t>(i)])) continue;
-      if (i < N_ || lie_alpha_) {
-        finite = false;
-      } else {  // a blown-up prediction (explicit α): predict nothing this step
-        for (int j = 0; j < n; ++j) state_[static_cast<size_t>(N_ + j)] = xhat_[j];
-      }
-    }
-    if (!finite) {
-      if (failure_.empty()) {
-        std::ostringstream os;
-        os << name_ << ": the observer's right-hand side is not finite between t = " << t0
-           << " and " << t1 << " (ẑ = " << zhat_.transpose() << ")";
-        failure_ = os.str();
-      }
-      return false;
-    }
-    for (Eigen::Index i = 0; i < N_; ++i) zhat_[i] = state_[static_cast<size_t>(i)];
-    if (predict_) {
-      for (int i = 0; i < n; ++i) xbar_[i] = state_[static_cast<size_t>(N_ + i)];
-    } else {
-      xbar_ = xhat_;
-    }
-    return true;
-  }
+  bool integrate(double t0, double t1);
 
   // ∂(ẑ', x̄')/∂(ẑ, x̄) for the implicit integrator.
-  void jacobian(double t, const double* s, Eigen::Map<Eigen::MatrixXd>& j) {
-    j.setZero();
-    for (Eigen::Index i = 0; i < N_; ++i) {
-      if (i + 1 < N_) j(i, i + 1) = 1.0;
-      j(i, 0) -= gains_[i];
-    }
-    zs_ = Eigen::Map<const Eigen::VectorXd>(s, N_);
-    double sat = 1.0;
-    Eigen::VectorXd& grad_sat = grad_sat_;
-    grad_sat.setZero(N_);
-    if (options_.saturation) saturation_gradient(sat, grad_sat);
-    if (predict_) {
-      xbar_ = Eigen::Map<const State>(s + N_);
-      typename ModelDerivatives<Model>::Jacobian df;
-      derivatives_.jacobian(xbar_, input_, t, df);
-      for (int r = 0; r < n; ++r) {
-        for (int c = 0; c < n; ++c) j(N_ + r, N_ + c) = df(r, c);
-      }
-    }
-    if (lie_alpha_) {
-      xd_ = xbar_;
-      double alpha = 0.0;
-      if (weight_ > 0.0 && design_.map->next(xd_, alpha, &grad_alpha_)) {
-        for (int c = 0; c < n; ++c) j(N_ - 1, N_ + c) = sat * weight_ * grad_alpha_[c];
-        for (Eigen::Index c = 0; c < N_; ++c) j(N_ - 1, c) += weight_ * alpha * grad_sat[c];
-      }
-    } else {
-      const double alpha = design_.alpha.value(zs_);
-      if (design_.alpha.gradient) design_.alpha.gradient(zs_, grad_alpha_);
-      for (Eigen::Index c = 0; c < N_; ++c) {
-        j(N_ - 1, c) += sat * (design_.alpha.gradient ? grad_alpha_[c] : 0.0) + alpha * grad_sat[c];
-      }
-    }
-  }
+  void jacobian(double t, const double* s, Eigen::Map<Eigen::MatrixXd>& j);
 
   // s_{ρ²}(ẑᵀPẑ/R²) and its gradient in ẑ (by ceres::Jet through the smooth step).
-  void saturation_gradient(double& value, Eigen::VectorXd& gradient) const {
-    const SmoothSaturation& sat = *options_.saturation;
-    const double q = zs_.dot(sat.P * zs_) / (sat.R * sat.R);
-    using Jet = ceres::Jet<double, 1>;
-    const Jet s = smooth_step(Jet(q, 0), sat.rho * sat.rho);
-    value = s.a;
-    gradient = (s.v[0] * 2.0 / (sat.R * sat.R)) * (sat.P * zs_);
-  }
+  void saturation_gradient(double& value, Eigen::VectorXd& gradient) const;
 
   // x̂ from ẑ at t: the explicit inverse, or the least-squares projection.
-  void project(double t) {
-    const State previous = xhat_, predicted = xbar_;
-    State candidate;
-    if (design_.inverse) {
-      design_.inverse(zhat_, x_);
-      candidate = x_;
-    } else {
-      zhat_projected_ = zhat_;
-      candidate = solve_projection(
-          options_.start == ProjectionStart::kPredicted && xbar_.allFinite() ? xbar_ : previous);
-      // A poor local minimum: restart from x̂(0) and the origin, keep the best of all.
-      ++samples_since_restart_;
-      if (options_.restart_residual > 0.0 && samples_since_restart_ >= options_.restart_every &&
-          !(residual_at(candidate) <= options_.restart_residual * (1.0 + zhat_.norm()))) {
-        samples_since_restart_ = 0;
-        for (const State& start : {xhat0_, State(State::Zero())}) {
-          const State other = solve_projection(start);
-          if (residual_at(other) < residual_at(candidate)) candidate = other;
-        }
-      }
-    }
-    x_ = candidate;
-    const bool ok = candidate.allFinite() && design_.map->value(x_, z_);
-    if (!ok) {
-      step_.failure = "projection";
-      std::ostringstream os;
-      os << name_ << ": the projection of ẑ = [" << zhat_.transpose() << "] at t = " << t
-         << " failed (no finite x̂); x̂ kept";
-      step_.failure_message = os.str();
-      residual_ = std::numeric_limits<double>::quiet_NaN();  // no x̂ belongs to this ẑ
-      return;
-    }
-    residual_ = (z_ - zhat_).norm();
-    xhat_ = candidate;
-    // A jump: x̂ moved away from where the model carried the previous x̂.
-    if ((xhat_ - predicted).template lpNorm<Eigen::Infinity>() > options_.jump_threshold &&
-        started_once_) {
-      ++jumps_;
-    }
-    started_once_ = true;
-    if (lie_alpha_) update_weight();
-  }
+  void project(double t);
 
-  State solve_projection(Vector<n> x) {
-    try {
-      const Summary s = engine_->solve_least_squares(*problem_, x);
-      if (s.status == Status::kInvalidInput) throw InvalidInput(s.message);
-    } catch (const InvalidInput&) {
-      x.setConstant(std::nan(""));
-    }
-    return x;
-  }
+  State solve_projection(Vector<n> x);
 
   // ‖ẑ − q_N(x)‖ (infinite when not finite).
-  double residual_at(const State& x) {
-    x_ = x;
-    if (!x.allFinite() || !design_.map->value(x_, z_)) return HUGE_VAL;
-    return (z_ - zhat_).norm();
-  }
+  double residual_at(const State& x);
 
   // w = σ² / (σ² + ε²), σ = σ_min(∂q_N/∂x) at x̂: 0 on the non-observable set.
-  void update_weight() {
-    x_ = xhat_;
-    if (!design_.map->jacobian(x_, dq_)) {
-      weight_ = 0.0;
-      return;
-    }
-    const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(dq_).singularValues();
-    const double c = sv[sv.size() - 1];
-    const double eps = options_.observability_floor;
-    weight_ = eps > 0.0 ? c * c / (c * c + eps * eps) : 1.0;
-    // ẑ off the image of q_N (residual large against ‖ẑ‖): x̂ says little about ẑ's α.
-    const double r = residual_ / (options_.residual_scale * (1.0 + zhat_.norm()));
-    weight_ /= 1.0 + r * r;
-  }
+  void update_weight();
 
-  const ObserverStep& publish() {
-    step_.estimate = xhat_;
-    step_.extras.head(N_) = zhat_;
-    step_.extras[N_] = residual_;
-    step_.extras[N_ + 1] = static_cast<double>(jumps_);
-    step_.extras[N_ + 2] = lie_alpha_ ? weight_ : 1.0;
-    return step_;
-  }
+  const ObserverStep& publish();
 
   Model model_;
   Design design_;
@@ -672,8 +231,470 @@ class HighGainObserver final : public Observer {
   std::string failure_;
   std::vector<double> state_;
   std::unique_ptr<StiffIntegrator> stiff_;
-  boost::numeric::odeint::runge_kutta4<std::vector<double>> rk4_;
+  Rk4Stepper rk4_;
   ObserverStep step_;
 };
+
+template <ContinuousModel Model>
+HighGainObserver<Model>::HighGainObserver(Model model, Design design, const Eigen::VectorXd& xhat0,
+                                          HighGainOptions options,
+                                          std::optional<Eigen::VectorXd> zhat0, std::string name)
+    : model_(std::move(model)),
+      design_(std::move(design)),
+      options_(std::move(options)),
+      name_(std::move(name)),
+      derivatives_(model_) {
+  const auto fail = [this](const std::string& what) { throw InvalidInput(name_ + ": " + what); };
+  if (!design_.map) fail("no observability map q_N given");
+  const ObservabilityMap& map = *design_.map;
+  N_ = map.dimension();
+  if (map.states() != n) {
+    fail("the map's state dimension " + std::to_string(map.states()) + " is not the model's " +
+         std::to_string(n));
+  }
+  if (N_ < n || N_ < 2) {
+    fail("N = " + std::to_string(N_) + " is smaller than the state dimension n = " +
+         std::to_string(n) + " (or 2): q_N cannot be injective");
+  }
+  if (!(options_.theta > 0.0) || !std::isfinite(options_.theta)) {
+    fail("HighGainOptions::theta must be finite and > 0 (got " + std::to_string(options_.theta) +
+         ")");
+  }
+  if (!(options_.sample_time > 0.0) || !std::isfinite(options_.sample_time)) {
+    fail("HighGainOptions::sample_time must be finite and > 0");
+  }
+  if (options_.substeps < 1) fail("HighGainOptions::substeps must be >= 1");
+  if (!(options_.absolute_tolerance > 0.0) || !(options_.relative_tolerance > 0.0)) {
+    fail("HighGainOptions::absolute_tolerance and relative_tolerance must be > 0");
+  }
+  if (!(options_.jump_threshold > 0.0)) fail("HighGainOptions::jump_threshold must be > 0");
+  if (options_.restart_every < 1) fail("HighGainOptions::restart_every must be >= 1");
+  if (!(options_.residual_scale > 0.0) || !std::isfinite(options_.residual_scale)) {
+    fail("HighGainOptions::residual_scale must be finite and > 0");
+  }
+  if (!(options_.restart_residual >= 0.0) || !std::isfinite(options_.restart_residual)) {
+    fail("HighGainOptions::restart_residual must be finite and >= 0 (0: never restart)");
+  }
+  if (vector_field_depends_on_time(model_)) {
+    fail("the model's vector field depends on t: this observer is for autonomous x' = f(x)");
+  }
+  if (!(options_.observability_floor >= 0.0)) {
+    fail("HighGainOptions::observability_floor must be >= 0");
+  }
+  set_coefficients();
+  if (options_.saturation) {
+    try {
+      options_.saturation->validate(N_);
+    } catch (const InvalidInput& e) {
+      fail(std::string("HighGainOptions::saturation: ") + e.what());
+    }
+  }
+  if (!design_.alpha.value && !map.has_next()) {
+    fail("no α given and the map '" + map.description() +
+         "' cannot evaluate L_f^N h (build it from the model: LieObservabilityMap)");
+  }
+  lie_alpha_ = !design_.alpha.value;
+  predict_ = true;  // x̄ serves α (lie), the warm start (predicted) and the jump test
+  if (xhat0.size() != n || !xhat0.allFinite()) {
+    fail("the initial estimate x̂(0) must be " + std::to_string(n) + " finite numbers");
+  }
+  xhat0_ = xhat0;
+  zhat0_.resize(N_);
+  if (zhat0) {
+    if (zhat0->size() != N_ || !zhat0->allFinite()) {
+      fail("ẑ(0) must be " + std::to_string(N_) + " finite numbers");
+    }
+    zhat0_ = *zhat0;
+  } else if (!map.value(xhat0_, zhat0_)) {
+    fail("q_N(x̂(0)) is not finite");
+  }
+  if (!design_.inverse) {
+    SolverOptions solver;
+    solver.stop.step_tolerance = 1e-12;
+    solver.stop.residual_tolerance = 1e-13;
+    solver.stop.max_iterations = 100;
+    engine_ = EngineRegistry<n>::global().create(options_.projection, solver);
+    problem_.emplace(RootProblem<n, Eigen::Dynamic>::with_jacobian(
+        [this](const Vector<n>& x, Eigen::VectorXd& r) {
+          x_ = x;
+          if (!design_.map->value(x_, z_)) z_.setConstant(std::numeric_limits<double>::quiet_NaN());
+          r = z_ - zhat_projected_;
+        },
+        [this](const Vector<n>& x, Matrix<Eigen::Dynamic, n>& jac) {
+          x_ = x;
+          if (design_.map->jacobian(x_, dq_)) {
+            jac = dq_;
+          } else {  // never the previous point's Jacobian
+            jac.setConstant(std::numeric_limits<double>::quiet_NaN());
+          }
+        },
+        n, N_));
+    if (!engine_->least_squares() && N_ != n) {
+      fail("projection engine '" + options_.projection +
+           "' solves square systems only (N = n); use ceres or nlopt");
+    }
+  }
+  integrator_ = options_.integrator;
+  if (integrator_ == HighGainIntegrator::kAuto) {
+    // Largest |root| of the scaled error dynamics times the step (see the header comment).
+    const double h = options_.sample_time / options_.substeps;
+    integrator_ = h * spectral_radius_ / options_.theta > 0.2 ? HighGainIntegrator::kCvode
+                                                              : HighGainIntegrator::kRk4;
+  }
+  if (integrator_ == HighGainIntegrator::kCvode && !ModelDerivatives<Model>::kAutoDiff &&
+      predict_) {
+    warnings_.push_back(name_ + ": ∂f for the implicit stepper by central differences");
+  }
+  for (Eigen::Index i = 0; i < N_; ++i) extra_names_.push_back("zhat" + std::to_string(i + 1));
+  extra_names_.push_back("projection_residual");
+  extra_names_.push_back("jumps");
+  extra_names_.push_back("alpha_weight");
+  allocate();
+  reset();
+}
+
+template <ContinuousModel Model>
+void HighGainObserver<Model>::reset() {
+  zhat_ = zhat0_;
+  xhat_ = xhat0_;
+  samples_.clear();
+  started_ = false;
+  last_t_ = 0.0;
+  jumps_ = 0;
+  residual_ = 0.0;
+  weight_ = 1.0;
+  started_once_ = false;
+  samples_since_restart_ = 0;
+  xbar_ = xhat0_;
+}
+
+template <ContinuousModel Model>
+const ObserverStep& HighGainObserver<Model>::step(long k, const Eigen::VectorXd& y,
+                                                  const Eigen::VectorXd& u) {
+  if (y.size() != 1 || u.size() != Model::kInputs) {
+    throw InvalidInput(name_ + ": a sample must have 1 output and " +
+                       std::to_string(Model::kInputs) + " inputs");
+  }
+  const double t = static_cast<double>(k) * options_.sample_time;
+  step_.failure.clear();
+  step_.failure_message.clear();
+  step_.measurement_missing = !y.allFinite();
+  step_.ready = true;
+  if (!u.allFinite()) {
+    step_.failure = "non_finite";
+    step_.failure_message = name_ + ": u_k is not finite at t = " + std::to_string(t);
+    return publish();
+  }
+  if (started_ && !(t > last_t_)) {
+    throw InvalidInput(name_ + ": sample k = " + std::to_string(k) +
+                       " does not come after the last one: samples must arrive in order");
+  }
+  input_ = u;
+  if (step_.measurement_missing) return publish();  // hold; the next sample bridges the gap
+  const SampleInterpolator<1> before = samples_;
+  samples_.push(t, Eigen::Matrix<double, 1, 1>(y[0]));
+  if (started_ && !integrate(last_t_, t)) {
+    samples_ = before;  // the sample that broke the step does not shape the next ones
+    step_.failure = "non_finite";
+    step_.failure_message = failure_;
+    return publish();  // the last good state; the next sample integrates from last_t_
+  }
+  started_ = true;
+  last_t_ = t;
+  project(t);
+  return publish();
+}
+
+template <ContinuousModel Model>
+bool HighGainObserver<Model>::derivatives(double t, const double* s, double y, double* ds) {
+  zs_ = Eigen::Map<const Eigen::VectorXd>(s, N_);
+  const double innovation = y - s[0];
+  double alpha = 0.0;
+  if (predict_) {
+    xbar_ = Eigen::Map<const State>(s + N_);
+    Eigen::Map<State>(ds + N_) = model_.vector_field(xbar_, input_, t);
+  }
+  if (lie_alpha_) {
+    xd_ = xbar_;
+    if (weight_ > 0.0 && !design_.map->next(xd_, alpha, nullptr)) return zero(ds);
+    alpha *= weight_;
+  } else {
+    alpha = design_.alpha.value(zs_);
+  }
+  if (options_.saturation) alpha *= options_.saturation->factor(zs_);
+  for (Eigen::Index i = 0; i + 1 < N_; ++i) ds[i] = s[i + 1] + gains_[i] * innovation;
+  ds[N_ - 1] = alpha + gains_[N_ - 1] * innovation;
+  for (Eigen::Index i = 0; i < N_; ++i) {
+    if (!std::isfinite(ds[i])) return zero(ds);
+  }
+  for (Eigen::Index i = N_; i < state_size(); ++i) {
+    if (std::isfinite(ds[i])) continue;
+    if (lie_alpha_) return zero(ds);
+    // With an explicit α, x̄ only warm-starts the projection: a prediction that blows up (x̂
+    // far off, f superlinear) is frozen instead of failing the observer.
+    for (Eigen::Index j = N_; j < state_size(); ++j) ds[j] = 0.0;
+    break;
+  }
+  return true;
+}
+
+template <ContinuousModel Model>
+void HighGainObserver<Model>::set_coefficients() {
+  if (options_.coefficients.size() && !options_.poles.empty()) {
+    throw InvalidInput(name_ + ": give HighGainOptions::poles or coefficients, not both");
+  }
+  if (options_.coefficients.size()) {
+    if (options_.coefficients.size() != N_ || !options_.coefficients.allFinite()) {
+      throw InvalidInput(name_ + ": HighGainOptions::coefficients must be N = " +
+                         std::to_string(N_) + " finite numbers [l_0, …, l_{N−1}]");
+    }
+    coefficients_ = options_.coefficients;
+    const Eigen::VectorXcd roots = polynomial_roots(coefficients_);
+    for (const auto& r : roots) {
+      if (!(r.real() < 0.0)) {
+        std::ostringstream os;
+        os << name_ << ": HighGainOptions::coefficients are not Hurwitz: s^N + … has the root "
+           << r.real() << (r.imag() >= 0 ? " + " : " - ") << std::abs(r.imag()) << "i";
+        throw InvalidInput(os.str());
+      }
+    }
+    spectral_radius_ = roots.cwiseAbs().maxCoeff();
+  } else {
+    std::vector<double> poles = options_.poles;
+    if (poles.empty()) poles.assign(static_cast<size_t>(N_), -1.0);
+    if (static_cast<Eigen::Index>(poles.size()) != N_) {
+      throw InvalidInput(name_ + ": HighGainOptions::poles must list N = " + std::to_string(N_) +
+                         " roots");
+    }
+    try {
+      coefficients_ = hurwitz_coefficients(poles);
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(name_ + ": " + e.what());
+    }
+    spectral_radius_ = 0.0;
+    for (double p : poles) spectral_radius_ = std::max(spectral_radius_, std::abs(p));
+  }
+  gains_.resize(N_);
+  for (Eigen::Index i = 1; i <= N_; ++i) {
+    gains_[i - 1] = coefficients_[N_ - i] / std::pow(options_.theta, static_cast<double>(i));
+  }
+  if (!gains_.allFinite()) {
+    throw InvalidInput(name_ + ": HighGainOptions::theta = " + std::to_string(options_.theta) +
+                       " makes the gains l/θ^N overflow");
+  }
+}
+
+template <ContinuousModel Model>
+void HighGainObserver<Model>::allocate() {
+  zhat_.resize(N_);
+  zs_.resize(N_);
+  z_.resize(N_);
+  zhat_projected_.resize(N_);
+  dq_.resize(N_, n);
+  x_.resize(n);
+  state_.assign(static_cast<size_t>(state_size()), 0.0);
+  step_.estimate.resize(n);
+  step_.extras.resize(static_cast<Eigen::Index>(extra_names_.size()));
+  if (integrator_ == HighGainIntegrator::kCvode) {
+    const Eigen::Index size = state_size();
+    stiff_ = std::make_unique<StiffIntegrator>(
+        static_cast<int>(size),
+        [this](double t, const double* s, double* ds) {
+          return derivatives(t, s, samples_.at(t)[0], ds);
+        },
+        [this, size](double t, const double* s, double* j) {
+          Eigen::Map<Eigen::MatrixXd> jac(j, size, size);
+          jacobian(t, s, jac);
+        },
+        options_.relative_tolerance, options_.absolute_tolerance);
+  }
+}
+
+template <ContinuousModel Model>
+bool HighGainObserver<Model>::integrate(double t0, double t1) {
+  failure_.clear();
+  for (Eigen::Index i = 0; i < N_; ++i) state_[static_cast<size_t>(i)] = zhat_[i];
+  if (predict_) {
+    for (int i = 0; i < n; ++i) state_[static_cast<size_t>(N_ + i)] = xhat_[i];
+  }
+  bool finite = true;
+  const long intervals = std::max(1L, std::lround((t1 - t0) / options_.sample_time));
+  if (integrator_ == HighGainIntegrator::kRk4) {
+    const Rk4Stepper::Rhs rhs = [this, &finite](double t, const std::vector<double>& s,
+                                                std::vector<double>& ds) {
+      finite = derivatives(t, s.data(), samples_.at(t)[0], ds.data()) && finite;
+    };
+    const long steps = intervals * options_.substeps;
+    const double h = (t1 - t0) / static_cast<double>(steps);
+    for (long i = 0; i < steps && finite; ++i) {
+      rk4_.step(rhs, state_, t0 + static_cast<double>(i) * h, h);
+    }
+  } else if (!stiff_->integrate(t0, t1, state_.data(), &failure_)) {
+    failure_ = name_ + ": " + failure_;
+    finite = false;
+  }
+  for (Eigen::Index i = 0; i < state_size(); ++i) {
+    if (std::isfinite(state_[static_cast<size_t>(i)])) continue;
+    if (i < N_ || lie_alpha_) {
+      finite = false;
+    } else {  // a blown-up prediction (explicit α): predict nothing this step
+      for (int j = 0; j < n; ++j) state_[static_cast<size_t>(N_ + j)] = xhat_[j];
+    }
+  }
+  if (!finite) {
+    if (failure_.empty()) {
+      std::ostringstream os;
+      os << name_ << ": the observer's right-hand side is not finite between t = " << t0 << " and "
+         << t1 << " (ẑ = " << zhat_.transpose() << ")";
+      failure_ = os.str();
+    }
+    return false;
+  }
+  for (Eigen::Index i = 0; i < N_; ++i) zhat_[i] = state_[static_cast<size_t>(i)];
+  if (predict_) {
+    for (int i = 0; i < n; ++i) xbar_[i] = state_[static_cast<size_t>(N_ + i)];
+  } else {
+    xbar_ = xhat_;
+  }
+  return true;
+}
+
+template <ContinuousModel Model>
+void HighGainObserver<Model>::jacobian(double t, const double* s, Eigen::Map<Eigen::MatrixXd>& j) {
+  j.setZero();
+  for (Eigen::Index i = 0; i < N_; ++i) {
+    if (i + 1 < N_) j(i, i + 1) = 1.0;
+    j(i, 0) -= gains_[i];
+  }
+  zs_ = Eigen::Map<const Eigen::VectorXd>(s, N_);
+  double sat = 1.0;
+  Eigen::VectorXd& grad_sat = grad_sat_;
+  grad_sat.setZero(N_);
+  if (options_.saturation) saturation_gradient(sat, grad_sat);
+  if (predict_) {
+    xbar_ = Eigen::Map<const State>(s + N_);
+    typename ModelDerivatives<Model>::Jacobian df;
+    derivatives_.jacobian(xbar_, input_, t, df);
+    for (int r = 0; r < n; ++r) {
+      for (int c = 0; c < n; ++c) j(N_ + r, N_ + c) = df(r, c);
+    }
+  }
+  if (lie_alpha_) {
+    xd_ = xbar_;
+    double alpha = 0.0;
+    if (weight_ > 0.0 && design_.map->next(xd_, alpha, &grad_alpha_)) {
+      for (int c = 0; c < n; ++c) j(N_ - 1, N_ + c) = sat * weight_ * grad_alpha_[c];
+      for (Eigen::Index c = 0; c < N_; ++c) j(N_ - 1, c) += weight_ * alpha * grad_sat[c];
+    }
+  } else {
+    const double alpha = design_.alpha.value(zs_);
+    if (design_.alpha.gradient) design_.alpha.gradient(zs_, grad_alpha_);
+    for (Eigen::Index c = 0; c < N_; ++c) {
+      j(N_ - 1, c) += sat * (design_.alpha.gradient ? grad_alpha_[c] : 0.0) + alpha * grad_sat[c];
+    }
+  }
+}
+
+template <ContinuousModel Model>
+void HighGainObserver<Model>::saturation_gradient(double& value, Eigen::VectorXd& gradient) const {
+  const SmoothSaturation& sat = *options_.saturation;
+  const double q = zs_.dot(sat.P * zs_) / (sat.R * sat.R);
+  using Jet = ceres::Jet<double, 1>;
+  const Jet s = smooth_step(Jet(q, 0), sat.rho * sat.rho);
+  value = s.a;
+  gradient = (s.v[0] * 2.0 / (sat.R * sat.R)) * (sat.P * zs_);
+}
+
+template <ContinuousModel Model>
+void HighGainObserver<Model>::project(double t) {
+  const State previous = xhat_, predicted = xbar_;
+  State candidate;
+  if (design_.inverse) {
+    design_.inverse(zhat_, x_);
+    candidate = x_;
+  } else {
+    zhat_projected_ = zhat_;
+    candidate = solve_projection(
+        options_.start == ProjectionStart::kPredicted && xbar_.allFinite() ? xbar_ : previous);
+    // A poor local minimum: restart from x̂(0) and the origin, keep the best of all.
+    ++samples_since_restart_;
+    if (options_.restart_residual > 0.0 && samples_since_restart_ >= options_.restart_every &&
+        !(residual_at(candidate) <= options_.restart_residual * (1.0 + zhat_.norm()))) {
+      samples_since_restart_ = 0;
+      for (const State& start : {xhat0_, State(State::Zero())}) {
+        const State other = solve_projection(start);
+        if (residual_at(other) < residual_at(candidate)) candidate = other;
+      }
+    }
+  }
+  x_ = candidate;
+  const bool ok = candidate.allFinite() && design_.map->value(x_, z_);
+  if (!ok) {
+    step_.failure = "projection";
+    std::ostringstream os;
+    os << name_ << ": the projection of ẑ = [" << zhat_.transpose() << "] at t = " << t
+       << " failed (no finite x̂); x̂ kept";
+    step_.failure_message = os.str();
+    residual_ = std::numeric_limits<double>::quiet_NaN();  // no x̂ belongs to this ẑ
+    return;
+  }
+  residual_ = (z_ - zhat_).norm();
+  xhat_ = candidate;
+  // A jump: x̂ moved away from where the model carried the previous x̂.
+  if ((xhat_ - predicted).template lpNorm<Eigen::Infinity>() > options_.jump_threshold &&
+      started_once_) {
+    ++jumps_;
+  }
+  started_once_ = true;
+  if (lie_alpha_) update_weight();
+}
+
+template <ContinuousModel Model>
+auto HighGainObserver<Model>::solve_projection(Vector<n> x) -> State {
+  try {
+    const Summary s = engine_->solve_least_squares(*problem_, x);
+    if (s.status == Status::kInvalidInput) throw InvalidInput(s.message);
+  } catch (const InvalidInput&) {
+    x.setConstant(std::nan(""));
+  }
+  return x;
+}
+
+template <ContinuousModel Model>
+double HighGainObserver<Model>::residual_at(const State& x) {
+  x_ = x;
+  if (!x.allFinite() || !design_.map->value(x_, z_)) return HUGE_VAL;
+  return (z_ - zhat_).norm();
+}
+
+template <ContinuousModel Model>
+void HighGainObserver<Model>::update_weight() {
+  x_ = xhat_;
+  if (!design_.map->jacobian(x_, dq_)) {
+    weight_ = 0.0;
+    return;
+  }
+  const double c = smallest_singular_value(dq_);
+  const double eps = options_.observability_floor;
+  weight_ = eps > 0.0 ? c * c / (c * c + eps * eps) : 1.0;
+  // ẑ off the image of q_N (residual large against ‖ẑ‖): x̂ says little about ẑ's α.
+  const double r = residual_ / (options_.residual_scale * (1.0 + zhat_.norm()));
+  weight_ /= 1.0 + r * r;
+}
+
+template <ContinuousModel Model>
+const ObserverStep& HighGainObserver<Model>::publish() {
+  step_.estimate = xhat_;
+  step_.extras.head(N_) = zhat_;
+  step_.extras[N_] = residual_;
+  step_.extras[N_ + 1] = static_cast<double>(jumps_);
+  step_.extras[N_ + 2] = lie_alpha_ ? weight_ : 1.0;
+  return step_;
+}
+
+// Compiled once in the observers library for the catalogue's models (src/instances/).
+#define NLOBS_EXTERN_HIGH_GAIN_OBSERVER(M, lowest) extern template class HighGainObserver<M>;
+NLOBS_FOR_EACH_AUTONOMOUS_SINGLE_OUTPUT_CATALOGUE_MODEL(NLOBS_EXTERN_HIGH_GAIN_OBSERVER)
+#undef NLOBS_EXTERN_HIGH_GAIN_OBSERVER
 
 }  // namespace nlobs

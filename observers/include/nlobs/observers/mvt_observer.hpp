@@ -43,6 +43,7 @@
 #include <string>
 #include <vector>
 
+#include "nlobs/models/catalogue.hpp"
 #include "nlobs/observers/mvt_beta.hpp"
 #include "nlobs/observers/observer.hpp"
 #include "nlobs/observers/sample_interpolator.hpp"
@@ -79,45 +80,7 @@ class MvtObserver final : public Observer {
   // x̂(0) = xhat0, ê(0) = ehat0. Throws InvalidInput naming the option for invalid options,
   // sizes or non-finite starts, and when the model's output is not y = [I_m 0] x.
   MvtObserver(Model model, const Eigen::VectorXd& xhat0, const Eigen::VectorXd& ehat0,
-              MvtOptions options, std::string name = "mvt")
-      : model_(std::move(model)), options_(std::move(options)), name_(std::move(name)) {
-    const auto fail = [](const std::string& what) { throw InvalidInput("MvtObserver: " + what); };
-    const auto start = [&](const Eigen::VectorXd& v, const char* what) {
-      if (v.size() != N || !v.allFinite()) {
-        fail(std::string(what) + " must be " + std::to_string(N) + " finite numbers");
-      }
-      return State(v);
-    };
-    xhat0_ = start(xhat0, "the initial estimate x̂(0)");
-    ehat0_ = start(ehat0, "the initial error estimate ê(0)");
-    if (!(options_.sample_time > 0.0) || !std::isfinite(options_.sample_time)) {
-      fail("MvtOptions::sample_time must be finite and > 0");
-    }
-    if (!(options_.eta >= 1.0) || !std::isfinite(options_.eta)) {
-      fail("MvtOptions::eta must be finite and >= 1 (got " + std::to_string(options_.eta) + ")");
-    }
-    if (!(options_.injection_gain >= 0.0) || !std::isfinite(options_.injection_gain)) {
-      fail("MvtOptions::injection_gain must be finite and >= 0");
-    }
-    if (options_.substeps < 1) fail("MvtOptions::substeps must be >= 1");
-    if (!(options_.absolute_tolerance > 0.0) || !(options_.relative_tolerance > 0.0)) {
-      fail("MvtOptions::absolute_tolerance and relative_tolerance must be > 0");
-    }
-    check_output_map();
-    beta_solver_ = std::make_unique<MvtBetaSolver<Model>>(model_, options_.beta);
-    if constexpr (!ModelDerivatives<Model>::kAutoDiff) {
-      warnings_.push_back(name_ +
-                          ": the model's vector field does not accept ceres::Jet; ∂F by central "
-                          "differences (β and D are then accurate to ~1e-7 only)");
-    }
-    extra_names_.push_back("residual");
-    for (int i = 0; i < N; ++i) extra_names_.push_back("beta" + std::to_string(i + 1));
-    for (int i = 0; i < N; ++i) extra_names_.push_back("ehat" + std::to_string(i + 1));
-    for (int i = 0; i < N; ++i) extra_names_.push_back("gain" + std::to_string(i + 1));
-    step_.estimate.resize(N);
-    step_.extras.resize(static_cast<Eigen::Index>(extra_names_.size()));
-    reset();
-  }
+              MvtOptions options, std::string name = "mvt");
   MvtObserver(const MvtObserver&) = delete;
   MvtObserver& operator=(const MvtObserver&) = delete;
 
@@ -127,17 +90,7 @@ class MvtObserver final : public Observer {
   std::vector<std::string> warnings() const override { return warnings_; }
   const MvtOptions& options() const { return options_; }
 
-  void reset() override {
-    xhat_ = xhat0_;
-    ehat_ = ehat0_;
-    beta_.setConstant(0.5);
-    gains_.setZero();
-    started_ = false;
-    samples_.clear();
-    last_t_ = 0.0;
-    last_u_.setZero();
-    max_residual_ = 0.0;
-  }
+  void reset() override;
 
   // Why the last failed derivatives() call failed (empty if none since the last step()).
   const std::string& last_failure() const { return failure_; }
@@ -154,171 +107,20 @@ class MvtObserver final : public Observer {
   // step() is last_failure(). For continuous-time use without samples (an ODE solver of the
   // caller's choice).
   bool derivatives(double t, const State& xhat, const State& ehat, const Output& y, const Input& u,
-                   State& dxhat, State& dehat) {
-    const bool data_ok = y.allFinite() && u.allFinite();
-    if (!data_ok || !beta_solver_->set_pair(xhat, ehat, u, t)) {
-      dxhat.setZero();
-      dehat.setZero();
-      if (failure_.empty()) {
-        std::ostringstream os;
-        if (data_ok) {
-          os << name_ << ": F is not finite at t = " << t << " (x̂ = " << xhat.transpose()
-             << ", x̂ + ê = " << (xhat + ehat).transpose() << ")";
-        } else {
-          os << name_ << ": y or u is not finite at t = " << t;
-        }
-        failure_ = os.str();
-      }
-      return false;
-    }
-    const MvtBetaResult r = beta_solver_->solve(beta_);
-    // NaN-propagating maximum: an unsolvable β problem must show in the report.
-    if (!(r.residual_norm <= max_residual_)) max_residual_ = r.residual_norm;
-    beta_solver_->mvt_jacobian(beta_, d_);
-    if (!d_.allFinite()) {
-      dxhat.setZero();
-      dehat.setZero();
-      if (failure_.empty()) {
-        std::ostringstream os;
-        os << name_ << ": ∂F is not finite between x̂ and x̂ + ê at t = " << t
-           << " (x̂ = " << xhat.transpose() << ", ê = " << ehat.transpose() << ")";
-        failure_ = os.str();
-      }
-      return false;
-    }
-    const Jacobian abs = d_.cwiseAbs();
-    gains_ = options_.eta * (abs.rowwise().sum() + abs.colwise().sum().transpose());  // η α
-    const Output innovation = y - xhat.template head<P>();                            // y − C x̂
-    State e1 = ehat;
-    e1.template head<P>() = innovation;
-    dxhat = beta_solver_->f_xhat() + gains_.cwiseProduct(e1);
-    dehat = d_ * ehat - gains_.cwiseProduct(ehat);
-    if (options_.variant == MvtVariant::kOutputInjection && N > P) {
-      const Output nu = innovation - ehat.template head<P>();  // C (x − (x̂ + ê))
-      beta_solver_->derivatives().jacobian(State(xhat + ehat), u, t, j_w_);
-      // K_b ν = J_ba ν + γ J_abᵀ Ḡ_a ν
-      dehat.tail(N - P).noalias() +=
-          j_w_.bottomLeftCorner(N - P, P) * nu + options_.injection_gain *
-                                                     j_w_.topRightCorner(P, N - P).transpose() *
-                                                     gains_.template head<P>().cwiseProduct(nu);
-    }
-    return true;
-  }
+                   State& dxhat, State& dehat);
 
-  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
-    if (y.size() != P || u.size() != M) {
-      throw InvalidInput(name_ + ": a sample must have " + std::to_string(P) + " outputs and " +
-                         std::to_string(M) + " inputs");
-    }
-    const double t = static_cast<double>(k) * options_.sample_time;
-    step_.failure.clear();
-    step_.failure_message.clear();
-    step_.measurement_missing = !y.allFinite();
-    step_.ready = true;
-    max_residual_ = 0.0;
-    if (!u.allFinite()) {  // the plant's input is known by assumption: an error, state kept
-      step_.failure = "non_finite";
-      step_.failure_message = name_ + ": u_k is not finite at t = " + std::to_string(t);
-      return publish();
-    }
-    if (step_.measurement_missing) return publish();  // hold; the next sample bridges the gap
-    const SampleInterpolator<P> before = samples_;
-    samples_.push(t, Output(y));
-    if (!started_) {
-      // The first sample: the state is the initial condition; evaluate once to report β.
-      failure_.clear();
-      State dx, de;
-      if (!derivatives(t, xhat_, ehat_, Output(y), Input(u), dx, de)) {
-        step_.failure = "non_finite";
-        step_.failure_message = failure_;
-      }
-      started_ = true;
-    } else if (!integrate(last_t_, t)) {
-      samples_ = before;  // the sample that broke the step does not shape the next ones
-      step_.failure = "non_finite";
-      step_.failure_message = failure_;
-      return publish();  // the last good state; the next sample integrates from last_t_
-    }
-    last_t_ = t;
-    last_u_ = u;
-    return publish();
-  }
+  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override;
 
  private:
   using Augmented = std::array<double, 2 * N>;
 
   // y = C x with C = [I_m 0]: h(x) must equal the first m states at a few distinct points.
-  void check_output_map() const {
-    std::array<State, 3> points = {xhat0_, State(xhat0_ + ehat0_), State::LinSpaced(N, 1.0, 2.0)};
-    for (const State& x : points) {
-      const Output y = model_.h(x);
-      const double scale = 1.0 + x.template lpNorm<Eigen::Infinity>();
-      if (!((y - x.template head<P>()).template lpNorm<Eigen::Infinity>() <= 1e-12 * scale)) {
-        std::ostringstream os;
-        os << "MvtObserver: the output must be y = C x with C = [I_m 0] (the first " << P
-           << " states measured); at x = [" << x.transpose() << "] the model gives y = ["
-           << y.transpose() << "]";
-        throw InvalidInput(os.str());
-      }
-    }
-  }
+  void check_output_map() const;
 
   // [t0, t1] with Boost.Odeint; false (state untouched) when F turned non-finite.
-  bool integrate(double t0, double t1) {
-    namespace odeint = boost::numeric::odeint;
-    failure_.clear();
-    const State beta0 = beta_, gains0 = gains_;
-    const Jacobian d0 = d_;
-    Augmented s;
-    Eigen::Map<State>(s.data()) = xhat_;
-    Eigen::Map<State>(s.data() + N) = ehat_;
-    bool finite = true;
-    const auto rhs = [this, &finite](const Augmented& z, Augmented& dz, double t) {
-      State dx, de;
-      finite =
-          derivatives(t, Eigen::Map<const State>(z.data()), Eigen::Map<const State>(z.data() + N),
-                      samples_.at(t), last_u_, dx, de) &&
-          finite;
-      Eigen::Map<State>(dz.data()) = dx;
-      Eigen::Map<State>(dz.data() + N) = de;
-    };
-    // After missing samples the interval spans several sample times: keep the step length.
-    const long intervals = std::max(1L, std::lround((t1 - t0) / options_.sample_time));
-    if (options_.integrator == MvtIntegrator::kRk4) {
-      const long steps = intervals * options_.substeps;
-      const double h = (t1 - t0) / static_cast<double>(steps);
-      for (long i = 0; i < steps && finite; ++i) {
-        rk4_.do_step(rhs, s, t0 + static_cast<double>(i) * h, h);
-      }
-    } else {
-      auto stepper = odeint::make_controlled<odeint::runge_kutta_dopri5<Augmented>>(
-          options_.absolute_tolerance, options_.relative_tolerance);
-      try {
-        odeint::integrate_adaptive(stepper, rhs, s, t0, t1,
-                                   options_.sample_time / options_.substeps);
-      } catch (const odeint::step_adjustment_error&) {
-        finite = false;
-      }
-    }
-    const State x = Eigen::Map<const State>(s.data()), e = Eigen::Map<const State>(s.data() + N);
-    if (!finite || !x.allFinite() || !e.allFinite()) {
-      if (failure_.empty()) failure_ = name_ + ": the state is not finite after the step";
-      beta_ = beta0, gains_ = gains0, d_ = d0;  // all that is published stays the last good step's
-      return false;
-    }
-    xhat_ = x;
-    ehat_ = e;
-    return true;
-  }
+  bool integrate(double t0, double t1);
 
-  const ObserverStep& publish() {
-    step_.estimate = xhat_;
-    step_.extras[0] = max_residual_;
-    step_.extras.segment(1, N) = beta_;
-    step_.extras.segment(1 + N, N) = ehat_;
-    step_.extras.segment(1 + 2 * N, N) = gains_;
-    return step_;
-  }
+  const ObserverStep& publish();
 
   Model model_;  // before beta_solver_, which points to it
   MvtOptions options_;
@@ -336,5 +138,231 @@ class MvtObserver final : public Observer {
   boost::numeric::odeint::runge_kutta4<Augmented> rk4_;
   ObserverStep step_;
 };
+
+template <ContinuousModel Model>
+MvtObserver<Model>::MvtObserver(Model model, const Eigen::VectorXd& xhat0,
+                                const Eigen::VectorXd& ehat0, MvtOptions options, std::string name)
+    : model_(std::move(model)), options_(std::move(options)), name_(std::move(name)) {
+  const auto fail = [](const std::string& what) { throw InvalidInput("MvtObserver: " + what); };
+  const auto start = [&](const Eigen::VectorXd& v, const char* what) {
+    if (v.size() != N || !v.allFinite()) {
+      fail(std::string(what) + " must be " + std::to_string(N) + " finite numbers");
+    }
+    return State(v);
+  };
+  xhat0_ = start(xhat0, "the initial estimate x̂(0)");
+  ehat0_ = start(ehat0, "the initial error estimate ê(0)");
+  if (!(options_.sample_time > 0.0) || !std::isfinite(options_.sample_time)) {
+    fail("MvtOptions::sample_time must be finite and > 0");
+  }
+  if (!(options_.eta >= 1.0) || !std::isfinite(options_.eta)) {
+    fail("MvtOptions::eta must be finite and >= 1 (got " + std::to_string(options_.eta) + ")");
+  }
+  if (!(options_.injection_gain >= 0.0) || !std::isfinite(options_.injection_gain)) {
+    fail("MvtOptions::injection_gain must be finite and >= 0");
+  }
+  if (options_.substeps < 1) fail("MvtOptions::substeps must be >= 1");
+  if (!(options_.absolute_tolerance > 0.0) || !(options_.relative_tolerance > 0.0)) {
+    fail("MvtOptions::absolute_tolerance and relative_tolerance must be > 0");
+  }
+  check_output_map();
+  beta_solver_ = std::make_unique<MvtBetaSolver<Model>>(model_, options_.beta);
+  if constexpr (!ModelDerivatives<Model>::kAutoDiff) {
+    warnings_.push_back(name_ +
+                        ": the model's vector field does not accept ceres::Jet; ∂F by central "
+                        "differences (β and D are then accurate to ~1e-7 only)");
+  }
+  extra_names_.push_back("residual");
+  for (int i = 0; i < N; ++i) extra_names_.push_back("beta" + std::to_string(i + 1));
+  for (int i = 0; i < N; ++i) extra_names_.push_back("ehat" + std::to_string(i + 1));
+  for (int i = 0; i < N; ++i) extra_names_.push_back("gain" + std::to_string(i + 1));
+  step_.estimate.resize(N);
+  step_.extras.resize(static_cast<Eigen::Index>(extra_names_.size()));
+  reset();
+}
+
+template <ContinuousModel Model>
+void MvtObserver<Model>::reset() {
+  xhat_ = xhat0_;
+  ehat_ = ehat0_;
+  beta_.setConstant(0.5);
+  gains_.setZero();
+  started_ = false;
+  samples_.clear();
+  last_t_ = 0.0;
+  last_u_.setZero();
+  max_residual_ = 0.0;
+}
+
+template <ContinuousModel Model>
+bool MvtObserver<Model>::derivatives(double t, const State& xhat, const State& ehat,
+                                     const Output& y, const Input& u, State& dxhat, State& dehat) {
+  const bool data_ok = y.allFinite() && u.allFinite();
+  if (!data_ok || !beta_solver_->set_pair(xhat, ehat, u, t)) {
+    dxhat.setZero();
+    dehat.setZero();
+    if (failure_.empty()) {
+      std::ostringstream os;
+      if (data_ok) {
+        os << name_ << ": F is not finite at t = " << t << " (x̂ = " << xhat.transpose()
+           << ", x̂ + ê = " << (xhat + ehat).transpose() << ")";
+      } else {
+        os << name_ << ": y or u is not finite at t = " << t;
+      }
+      failure_ = os.str();
+    }
+    return false;
+  }
+  const MvtBetaResult r = beta_solver_->solve(beta_);
+  // NaN-propagating maximum: an unsolvable β problem must show in the report.
+  if (!(r.residual_norm <= max_residual_)) max_residual_ = r.residual_norm;
+  beta_solver_->mvt_jacobian(beta_, d_);
+  if (!d_.allFinite()) {
+    dxhat.setZero();
+    dehat.setZero();
+    if (failure_.empty()) {
+      std::ostringstream os;
+      os << name_ << ": ∂F is not finite between x̂ and x̂ + ê at t = " << t
+         << " (x̂ = " << xhat.transpose() << ", ê = " << ehat.transpose() << ")";
+      failure_ = os.str();
+    }
+    return false;
+  }
+  const Jacobian abs = d_.cwiseAbs();
+  gains_ = options_.eta * (abs.rowwise().sum() + abs.colwise().sum().transpose());  // η α
+  const Output innovation = y - xhat.template head<P>();                            // y − C x̂
+  State e1 = ehat;
+  e1.template head<P>() = innovation;
+  dxhat = beta_solver_->f_xhat() + gains_.cwiseProduct(e1);
+  dehat = d_ * ehat - gains_.cwiseProduct(ehat);
+  if (options_.variant == MvtVariant::kOutputInjection && N > P) {
+    const Output nu = innovation - ehat.template head<P>();  // C (x − (x̂ + ê))
+    beta_solver_->derivatives().jacobian(State(xhat + ehat), u, t, j_w_);
+    // K_b ν = J_ba ν + γ J_abᵀ Ḡ_a ν
+    dehat.tail(N - P).noalias() +=
+        j_w_.bottomLeftCorner(N - P, P) * nu + options_.injection_gain *
+                                                   j_w_.topRightCorner(P, N - P).transpose() *
+                                                   gains_.template head<P>().cwiseProduct(nu);
+  }
+  return true;
+}
+
+template <ContinuousModel Model>
+const ObserverStep& MvtObserver<Model>::step(long k, const Eigen::VectorXd& y,
+                                             const Eigen::VectorXd& u) {
+  if (y.size() != P || u.size() != M) {
+    throw InvalidInput(name_ + ": a sample must have " + std::to_string(P) + " outputs and " +
+                       std::to_string(M) + " inputs");
+  }
+  const double t = static_cast<double>(k) * options_.sample_time;
+  step_.failure.clear();
+  step_.failure_message.clear();
+  step_.measurement_missing = !y.allFinite();
+  step_.ready = true;
+  max_residual_ = 0.0;
+  if (!u.allFinite()) {  // the plant's input is known by assumption: an error, state kept
+    step_.failure = "non_finite";
+    step_.failure_message = name_ + ": u_k is not finite at t = " + std::to_string(t);
+    return publish();
+  }
+  if (step_.measurement_missing) return publish();  // hold; the next sample bridges the gap
+  const SampleInterpolator<P> before = samples_;
+  samples_.push(t, Output(y));
+  if (!started_) {
+    // The first sample: the state is the initial condition; evaluate once to report β.
+    failure_.clear();
+    State dx, de;
+    if (!derivatives(t, xhat_, ehat_, Output(y), Input(u), dx, de)) {
+      step_.failure = "non_finite";
+      step_.failure_message = failure_;
+    }
+    started_ = true;
+  } else if (!integrate(last_t_, t)) {
+    samples_ = before;  // the sample that broke the step does not shape the next ones
+    step_.failure = "non_finite";
+    step_.failure_message = failure_;
+    return publish();  // the last good state; the next sample integrates from last_t_
+  }
+  last_t_ = t;
+  last_u_ = u;
+  return publish();
+}
+
+template <ContinuousModel Model>
+void MvtObserver<Model>::check_output_map() const {
+  std::array<State, 3> points = {xhat0_, State(xhat0_ + ehat0_), State::LinSpaced(N, 1.0, 2.0)};
+  for (const State& x : points) {
+    const Output y = model_.h(x);
+    const double scale = 1.0 + x.template lpNorm<Eigen::Infinity>();
+    if (!((y - x.template head<P>()).template lpNorm<Eigen::Infinity>() <= 1e-12 * scale)) {
+      std::ostringstream os;
+      os << "MvtObserver: the output must be y = C x with C = [I_m 0] (the first " << P
+         << " states measured); at x = [" << x.transpose() << "] the model gives y = ["
+         << y.transpose() << "]";
+      throw InvalidInput(os.str());
+    }
+  }
+}
+
+template <ContinuousModel Model>
+bool MvtObserver<Model>::integrate(double t0, double t1) {
+  namespace odeint = boost::numeric::odeint;
+  failure_.clear();
+  const State beta0 = beta_, gains0 = gains_;
+  const Jacobian d0 = d_;
+  Augmented s;
+  Eigen::Map<State>(s.data()) = xhat_;
+  Eigen::Map<State>(s.data() + N) = ehat_;
+  bool finite = true;
+  const auto rhs = [this, &finite](const Augmented& z, Augmented& dz, double t) {
+    State dx, de;
+    finite = derivatives(t, Eigen::Map<const State>(z.data()),
+                         Eigen::Map<const State>(z.data() + N), samples_.at(t), last_u_, dx, de) &&
+             finite;
+    Eigen::Map<State>(dz.data()) = dx;
+    Eigen::Map<State>(dz.data() + N) = de;
+  };
+  // After missing samples the interval spans several sample times: keep the step length.
+  const long intervals = std::max(1L, std::lround((t1 - t0) / options_.sample_time));
+  if (options_.integrator == MvtIntegrator::kRk4) {
+    const long steps = intervals * options_.substeps;
+    const double h = (t1 - t0) / static_cast<double>(steps);
+    for (long i = 0; i < steps && finite; ++i) {
+      rk4_.do_step(rhs, s, t0 + static_cast<double>(i) * h, h);
+    }
+  } else {
+    auto stepper = odeint::make_controlled<odeint::runge_kutta_dopri5<Augmented>>(
+        options_.absolute_tolerance, options_.relative_tolerance);
+    try {
+      odeint::integrate_adaptive(stepper, rhs, s, t0, t1, options_.sample_time / options_.substeps);
+    } catch (const odeint::step_adjustment_error&) {
+      finite = false;
+    }
+  }
+  const State x = Eigen::Map<const State>(s.data()), e = Eigen::Map<const State>(s.data() + N);
+  if (!finite || !x.allFinite() || !e.allFinite()) {
+    if (failure_.empty()) failure_ = name_ + ": the state is not finite after the step";
+    beta_ = beta0, gains_ = gains0, d_ = d0;  // all that is published stays the last good step's
+    return false;
+  }
+  xhat_ = x;
+  ehat_ = e;
+  return true;
+}
+
+template <ContinuousModel Model>
+const ObserverStep& MvtObserver<Model>::publish() {
+  step_.estimate = xhat_;
+  step_.extras[0] = max_residual_;
+  step_.extras.segment(1, N) = beta_;
+  step_.extras.segment(1 + N, N) = ehat_;
+  step_.extras.segment(1 + 2 * N, N) = gains_;
+  return step_;
+}
+
+// Compiled once in the observers library for the catalogue's models (src/instances/).
+#define NLOBS_EXTERN_MVT_OBSERVER(M) extern template class MvtObserver<M>;
+NLOBS_FOR_EACH_CATALOGUE_MODEL(NLOBS_EXTERN_MVT_OBSERVER)
+#undef NLOBS_EXTERN_MVT_OBSERVER
 
 }  // namespace nlobs

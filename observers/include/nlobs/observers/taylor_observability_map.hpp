@@ -26,6 +26,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "nlobs/models/catalogue.hpp"
 #include "nlobs/models/model.hpp"
 #include "nlobs/observers/observability_map.hpp"
 
@@ -53,43 +54,13 @@ class TaylorObservabilityMap final : public ObservabilityMap {
   Eigen::Index dimension() const override { return N; }
   std::string description() const override { return description_; }
 
-  bool value(const Eigen::VectorXd& x, Eigen::VectorXd& z) const override {
-    check_states(x);
-    if (!x.allFinite()) return false;
-    const auto c = series<N - 1>(Eigen::Matrix<double, n, 1>(x));
-    z.resize(N);
-    for (int k = 0; k < N; ++k) z[k] = c[static_cast<size_t>(k)];
-    return z.allFinite();
-  }
+  bool value(const Eigen::VectorXd& x, Eigen::VectorXd& z) const override;
 
-  bool jacobian(const Eigen::VectorXd& x, Eigen::MatrixXd& dq) const override {
-    check_states(x);
-    dq.resize(N, n);
-    if (!x.allFinite()) return false;
-    for (int j = 0; j < n; ++j) {
-      const auto c = series<N - 1>(seeded(x, j));
-      for (int k = 0; k < N; ++k) dq(k, j) = c[static_cast<size_t>(k)][1];
-    }
-    return dq.allFinite();
-  }
+  bool jacobian(const Eigen::VectorXd& x, Eigen::MatrixXd& dq) const override;
 
   bool has_next() const override { return true; }
 
-  bool next(const Eigen::VectorXd& x, double& value, Eigen::VectorXd* gradient) const override {
-    check_states(x);
-    if (!x.allFinite()) return false;
-    if (!gradient) {
-      value = series<N>(Eigen::Matrix<double, n, 1>(x))[N];
-      return std::isfinite(value);
-    }
-    gradient->resize(n);
-    for (int j = 0; j < n; ++j) {
-      const auto c = series<N>(seeded(x, j));
-      value = c[N][0];
-      (*gradient)[j] = c[N][1];
-    }
-    return std::isfinite(value) && gradient->allFinite();
-  }
+  bool next(const Eigen::VectorXd& x, double& value, Eigen::VectorXd* gradient) const override;
 
   const Model& model() const { return model_; }
 
@@ -178,6 +149,47 @@ class TaylorObservabilityMap final : public ObservabilityMap {
   std::string description_;
 };
 
+template <ContinuousModel Model, int N>
+bool TaylorObservabilityMap<Model, N>::value(const Eigen::VectorXd& x, Eigen::VectorXd& z) const {
+  check_states(x);
+  if (!x.allFinite()) return false;
+  const auto c = series<N - 1>(Eigen::Matrix<double, n, 1>(x));
+  z.resize(N);
+  for (int k = 0; k < N; ++k) z[k] = c[static_cast<size_t>(k)];
+  return z.allFinite();
+}
+
+template <ContinuousModel Model, int N>
+bool TaylorObservabilityMap<Model, N>::jacobian(const Eigen::VectorXd& x,
+                                                Eigen::MatrixXd& dq) const {
+  check_states(x);
+  dq.resize(N, n);
+  if (!x.allFinite()) return false;
+  for (int j = 0; j < n; ++j) {
+    const auto c = series<N - 1>(seeded(x, j));
+    for (int k = 0; k < N; ++k) dq(k, j) = c[static_cast<size_t>(k)][1];
+  }
+  return dq.allFinite();
+}
+
+template <ContinuousModel Model, int N>
+bool TaylorObservabilityMap<Model, N>::next(const Eigen::VectorXd& x, double& value,
+                                            Eigen::VectorXd* gradient) const {
+  check_states(x);
+  if (!x.allFinite()) return false;
+  if (!gradient) {
+    value = series<N>(Eigen::Matrix<double, n, 1>(x))[N];
+    return std::isfinite(value);
+  }
+  gradient->resize(n);
+  for (int j = 0; j < n; ++j) {
+    const auto c = series<N>(seeded(x, j));
+    value = c[N][0];
+    (*gradient)[j] = c[N][1];
+  }
+  return std::isfinite(value) && gradient->allFinite();
+}
+
 // The largest N make_taylor_observability_map instantiates: each N is a separate type, compiled
 // for every model the CLI knows (+27 s of build for 2..8). Past it, LieObservabilityMap.
 inline constexpr int kMaxTaylorObservabilityOrder = 8;
@@ -206,5 +218,21 @@ std::shared_ptr<ObservabilityMap> make_taylor_observability_map(
   }
   return map;
 }
+
+// X(Model, N) for every order make_taylor_observability_map builds, from `lowest` = max(2, n).
+#define NLOBS_TAYLOR_ORDERS_FROM_3(X, M) X(M, 3) X(M, 4) X(M, 5) X(M, 6) X(M, 7) X(M, 8)
+#define NLOBS_TAYLOR_ORDERS_FROM(X, M, lowest) NLOBS_TAYLOR_ORDERS_FROM_##lowest(X, M)
+#define NLOBS_TAYLOR_ORDERS_FROM_2(X, M) X(M, 2) NLOBS_TAYLOR_ORDERS_FROM_3(X, M)
+static_assert(kMaxTaylorObservabilityOrder == 8, "NLOBS_TAYLOR_ORDERS_FROM_3 stops at 8");
+
+// Compiled once in the observers library for the catalogue's models (src/instances/).
+#define NLOBS_EXTERN_TAYLOR_MAP(M, N) extern template class TaylorObservabilityMap<M, N>;
+#define NLOBS_EXTERN_TAYLOR_MAPS(M, lowest)                                           \
+  extern template std::shared_ptr<ObservabilityMap> make_taylor_observability_map<M>( \
+      const M&, int, std::string);                                                    \
+  NLOBS_TAYLOR_ORDERS_FROM(NLOBS_EXTERN_TAYLOR_MAP, M, lowest)
+NLOBS_FOR_EACH_AUTONOMOUS_SINGLE_OUTPUT_CATALOGUE_MODEL(NLOBS_EXTERN_TAYLOR_MAPS)
+#undef NLOBS_EXTERN_TAYLOR_MAPS
+#undef NLOBS_EXTERN_TAYLOR_MAP
 
 }  // namespace nlobs

@@ -58,81 +58,85 @@ class AcceleratedEngine : public Engine<N> {
   std::string_view name() const override { return accelerator_.name(); }
   Accelerator& accelerator() { return accelerator_; }
 
-  Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override {
-    detail::check_initial_guess(name(), problem, x);
-    const SolverOptions& opt = this->options_;
-    Summary summary;
-    summary.engine = name();
-
-    if constexpr (N == Dynamic) {  // allocates only when n changes
-      const Index n = x.size();
-      point_.resize(n), gx_.resize(n), next_.resize(n), estimate_.resize(n), last_.resize(n);
-    }
-    StopMonitor monitor(opt.stop, x.template lpNorm<Eigen::Infinity>(),
-                        has_picard_steps<Accelerator>());
-    accelerator_.start(x);
-    point_ = x;
-    last_ = x;
-    int evaluations = 0;
-    std::optional<Status> status;
-    while (!status) {
-      if (evaluations >= opt.stop.max_evaluations) {
-        status = Status::kMaxEvaluations;
-        break;
-      }
-      problem.evaluate(point_, gx_);
-      ++evaluations;
-      detail::check_output_size(problem, gx_);
-      if (!gx_.allFinite()) {
-        status = Status::kNonFinite;
-        break;
-      }
-      if constexpr (has_picard_steps<Accelerator>()) {
-        // Plain Picard: the step is the residual at the previous point; no copies needed.
-        const double step = (gx_ - point_).template lpNorm<Eigen::Infinity>();
-        point_.swap(gx_);
-        status = monitor.update(step, step, point_.template lpNorm<Eigen::Infinity>());
-        if (opt.record_trace) {
-          summary.trace.push_back({monitor.iterations(), step, step, point_});
-        }
-        continue;
-      } else {
-        const double residual = (gx_ - point_).template lpNorm<Eigen::Infinity>();
-        const bool completed = accelerator_.propose(point_, gx_, next_, estimate_);
-        if (completed) {
-          if (!estimate_.allFinite()) {
-            status = Status::kNonFinite;
-            break;
-          }
-          const double step = (estimate_ - last_).template lpNorm<Eigen::Infinity>();
-          last_ = estimate_;
-          status = monitor.update(step, residual, last_.template lpNorm<Eigen::Infinity>());
-          if (opt.record_trace) {
-            summary.trace.push_back({monitor.iterations(), step, residual, last_});
-          }
-        }
-        point_.swap(next_);
-      }
-    }
-    if constexpr (has_picard_steps<Accelerator>()) last_ = point_;
-
-    // Report the residual at the point returned: one more evaluation, counted.
-    x = last_;
-    problem.evaluate(x, gx_);
-    ++evaluations;
-    detail::check_output_size(problem, gx_);
-    const double residual = gx_.allFinite() ? (gx_ - x).template lpNorm<Eigen::Infinity>()
-                                            : std::numeric_limits<double>::infinity();
-    summary.status = *status;
-    summary.function_evaluations = evaluations;
-    monitor.fill(summary, residual);
-    return summary;
-  }
+  Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
 
  private:
   Accelerator accelerator_;
   Vector<N> point_ = zero_vector<N>(), gx_ = zero_vector<N>(), next_ = zero_vector<N>(),
             estimate_ = zero_vector<N>(), last_ = zero_vector<N>();
 };
+
+template <int N, FixedPointAccelerator<N> Accelerator>
+Summary AcceleratedEngine<N, Accelerator>::solve(const FixedPointProblem<N>& problem,
+                                                 Vector<N>& x) {
+  detail::check_initial_guess(name(), problem, x);
+  const SolverOptions& opt = this->options_;
+  Summary summary;
+  summary.engine = name();
+
+  if constexpr (N == Dynamic) {  // allocates only when n changes
+    const Index n = x.size();
+    point_.resize(n), gx_.resize(n), next_.resize(n), estimate_.resize(n), last_.resize(n);
+  }
+  StopMonitor monitor(opt.stop, x.template lpNorm<Eigen::Infinity>(),
+                      has_picard_steps<Accelerator>());
+  accelerator_.start(x);
+  point_ = x;
+  last_ = x;
+  int evaluations = 0;
+  std::optional<Status> status;
+  while (!status) {
+    if (evaluations >= opt.stop.max_evaluations) {
+      status = Status::kMaxEvaluations;
+      break;
+    }
+    problem.evaluate(point_, gx_);
+    ++evaluations;
+    detail::check_output_size(problem, gx_);
+    if (!gx_.allFinite()) {
+      status = Status::kNonFinite;
+      break;
+    }
+    if constexpr (has_picard_steps<Accelerator>()) {
+      // Plain Picard: the step is the residual at the previous point; no copies needed.
+      const double step = (gx_ - point_).template lpNorm<Eigen::Infinity>();
+      point_.swap(gx_);
+      status = monitor.update(step, step, point_.template lpNorm<Eigen::Infinity>());
+      if (opt.record_trace) {
+        summary.trace.push_back({monitor.iterations(), step, step, point_});
+      }
+      continue;
+    } else {
+      const double residual = (gx_ - point_).template lpNorm<Eigen::Infinity>();
+      const bool completed = accelerator_.propose(point_, gx_, next_, estimate_);
+      if (completed) {
+        if (!estimate_.allFinite()) {
+          status = Status::kNonFinite;
+          break;
+        }
+        const double step = (estimate_ - last_).template lpNorm<Eigen::Infinity>();
+        last_ = estimate_;
+        status = monitor.update(step, residual, last_.template lpNorm<Eigen::Infinity>());
+        if (opt.record_trace) {
+          summary.trace.push_back({monitor.iterations(), step, residual, last_});
+        }
+      }
+      point_.swap(next_);
+    }
+  }
+  if constexpr (has_picard_steps<Accelerator>()) last_ = point_;
+
+  // Report the residual at the point returned: one more evaluation, counted.
+  x = last_;
+  problem.evaluate(x, gx_);
+  ++evaluations;
+  detail::check_output_size(problem, gx_);
+  const double residual = gx_.allFinite() ? (gx_ - x).template lpNorm<Eigen::Infinity>()
+                                          : std::numeric_limits<double>::infinity();
+  summary.status = *status;
+  summary.function_evaluations = evaluations;
+  monitor.fill(summary, residual);
+  return summary;
+}
 
 }  // namespace nlobs

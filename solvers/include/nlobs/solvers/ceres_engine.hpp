@@ -24,6 +24,7 @@
 
 #include "nlobs/solvers/box_bounds.hpp"
 #include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/library_sizes.hpp"
 #include "nlobs/solvers/residual_source.hpp"
 
 namespace nlobs {
@@ -83,20 +84,10 @@ class CeresEngine : public Engine<N> {
   const ceres::Solver::Summary& ceres_summary() const { return ceres_summary_; }
 
   // Square system F = G − x.
-  Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override {
-    detail::check_initial_guess(name(), problem, x);
-    Summary s = run<N>(detail::ResidualSource<N, N>(problem), x);
-    if (const auto& l = this->options_.stop.lipschitz_constant) {  // F = G − x: METHODS §1
-      s.lipschitz_constant = l;
-      s.error_bound = s.residual_norm / (1.0 - *l);
-    }
-    return s;
-  }
+  Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
 
   bool least_squares() const override { return true; }
-  Summary solve_least_squares(const RootProblem<N, Dynamic>& problem, Vector<N>& x) override {
-    return solve<Dynamic>(problem, x);
-  }
+  Summary solve_least_squares(const RootProblem<N, Dynamic>& problem, Vector<N>& x) override;
 
   // Least squares on F: Rⁿ → Rᵐ.
   template <int M>
@@ -352,5 +343,28 @@ class CeresEngine : public Engine<N> {
   int prepared_n_ = -1, prepared_m_ = -1;
   ceres::Solver::Summary ceres_summary_;
 };
+
+// Out of the class body, so that the library's explicit instantiations (below) are all an
+// includer of a library size compiles: in-class bodies are inline and GCC instantiates them
+// anyway, to inline them.
+template <int N>
+Summary CeresEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
+  detail::check_initial_guess(name(), problem, x);
+  Summary s = run<N>(detail::ResidualSource<N, N>(problem), x);
+  if (const auto& l = this->options_.stop.lipschitz_constant) {  // F = G − x: METHODS §1
+    s.lipschitz_constant = l;
+    s.error_bound = s.residual_norm / (1.0 - *l);
+  }
+  return s;
+}
+
+template <int N>
+Summary CeresEngine<N>::solve_least_squares(const RootProblem<N, Dynamic>& problem, Vector<N>& x) {
+  return solve<Dynamic>(problem, x);
+}
+
+#define NLOBS_EXTERN_CERES_ENGINE(n) extern template class CeresEngine<n>;
+NLOBS_FOR_EACH_LIBRARY_SIZE(NLOBS_EXTERN_CERES_ENGINE)
+#undef NLOBS_EXTERN_CERES_ENGINE
 
 }  // namespace nlobs

@@ -5,6 +5,7 @@
 #include <sstream>
 #include <string_view>
 
+#include "nlobs/solvers/library_sizes.hpp"
 #include "nlobs/solvers/problem.hpp"
 #include "nlobs/solvers/stop_criteria.hpp"
 #include "nlobs/solvers/summary.hpp"
@@ -28,30 +29,7 @@ class Engine {
   // F(x) = 0 for F: Rⁿ → Rᵐ in the least-squares sense. Engines for square systems (the
   // fixed-point engines, Newton) accept m = n — through G(x) = x + F(x), built per call — and
   // refuse m ≠ n; the Ceres and NLopt engines override this for any m.
-  virtual Summary solve_least_squares(const RootProblem<N, Dynamic>& problem, Vector<N>& x) {
-    if (problem.residual_size() != problem.size()) {
-      std::ostringstream os;
-      os << name() << " solves square systems only: F maps R^" << problem.size() << " to R^"
-         << problem.residual_size() << "; use a least-squares engine (ceres, nlopt)";
-      throw InvalidInput(os.str());
-    }
-    const auto g = [&problem](const Vector<N>& v, Vector<N>& out) {
-      Vector<Dynamic> f(problem.residual_size());
-      problem.evaluate(v, f);
-      out = v + f;
-    };
-    if (!problem.has_jacobian()) {
-      return solve(FixedPointProblem<N>::from_map(g, problem.size()), x);
-    }
-    const auto dg = [&problem](const Vector<N>& v, Matrix<N, N>& j) {
-      Matrix<Dynamic, N> df(problem.residual_size(), problem.size());
-      problem.jacobian(v, df);
-      j = df;
-      j.diagonal().array() += 1.0;
-    };
-    return solve(
-        FixedPointProblem<N>::with_jacobian(g, dg, problem.size(), problem.jacobian_source()), x);
-  }
+  virtual Summary solve_least_squares(const RootProblem<N, Dynamic>& problem, Vector<N>& x);
 
   // True for engines that solve m > n (Ceres, NLopt).
   virtual bool least_squares() const { return false; }
@@ -62,6 +40,32 @@ class Engine {
   explicit Engine(SolverOptions options) : options_(std::move(options)) { validate(options_.stop); }
   SolverOptions options_;
 };
+
+template <int N>
+Summary Engine<N>::solve_least_squares(const RootProblem<N, Dynamic>& problem, Vector<N>& x) {
+  if (problem.residual_size() != problem.size()) {
+    std::ostringstream os;
+    os << name() << " solves square systems only: F maps R^" << problem.size() << " to R^"
+       << problem.residual_size() << "; use a least-squares engine (ceres, nlopt)";
+    throw InvalidInput(os.str());
+  }
+  const auto g = [&problem](const Vector<N>& v, Vector<N>& out) {
+    Vector<Dynamic> f(problem.residual_size());
+    problem.evaluate(v, f);
+    out = v + f;
+  };
+  if (!problem.has_jacobian()) {
+    return solve(FixedPointProblem<N>::from_map(g, problem.size()), x);
+  }
+  const auto dg = [&problem](const Vector<N>& v, Matrix<N, N>& j) {
+    Matrix<Dynamic, N> df(problem.residual_size(), problem.size());
+    problem.jacobian(v, df);
+    j = df;
+    j.diagonal().array() += 1.0;
+  };
+  return solve(
+      FixedPointProblem<N>::with_jacobian(g, dg, problem.size(), problem.jacobian_source()), x);
+}
 
 // For batch drivers (CLI, benchmarks): invalid input becomes status invalid_input with the
 // message in Summary::message instead of an exception.
@@ -127,4 +131,9 @@ void check_output_size(const FixedPointProblem<N>& problem, const Vector<N>& g) 
 }
 
 }  // namespace detail
+// Compiled once in the library for its sizes (nlobs/solvers/library_sizes.hpp).
+#define NLOBS_EXTERN_ENGINE(n) extern template class Engine<n>;
+NLOBS_FOR_EACH_LIBRARY_SIZE(NLOBS_EXTERN_ENGINE)
+#undef NLOBS_EXTERN_ENGINE
+
 }  // namespace nlobs

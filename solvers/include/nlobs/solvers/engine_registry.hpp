@@ -3,20 +3,38 @@
 // Every built-in engine is registered; a user registers their own under its own name with
 // add(). Options common to all engines: tol (step tolerance), ftol (residual tolerance),
 // max_iter, max_evals.
+//
+// One registration serves every size: a fixed-size registry EngineRegistry<N> that has no entry
+// of a name uses the entry of EngineRegistry<Dynamic> through DynamicSizeEngine<N>. An entry
+// added at a fixed size N shadows it there (allocation-free engines for that size). The
+// built-in engines have their own entries at the library's sizes (library_sizes.hpp); at
+// other sizes they come through the fallback, or as fixed-size engines after
+// add_builtin_engines<N>(EngineRegistry<N>::global()) from builtin_engines.hpp.
+//
+// This header names no engine: the engines are compiled once, in the solvers library.
 #include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
-#include "nlobs/solvers/ceres_engine.hpp"
+#include "nlobs/solvers/dynamic_size_engine.hpp"
+#include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/engine_spec.hpp"
-#include "nlobs/solvers/fixed_point_engines.hpp"
-#include "nlobs/solvers/newton_engine.hpp"
-#include "nlobs/solvers/nlopt_engine.hpp"
+#include "nlobs/solvers/library_sizes.hpp"
 
 namespace nlobs {
+
+template <int N>
+class EngineRegistry;
+
+// Adds the built-in engines (picard, aitken, steffensen, anderson, newton, ceres, nlopt) to
+// `registry`. Defined in builtin_engines.hpp; compiled in the library for its sizes.
+template <int N>
+void add_builtin_engines(EngineRegistry<N>& registry);
 
 template <int N = Dynamic>
 class EngineRegistry {
@@ -32,7 +50,11 @@ class EngineRegistry {
 
   // The process-wide registry, with every built-in engine.
   static EngineRegistry& global() {
-    static EngineRegistry registry = with_builtins();
+    static EngineRegistry registry = [] {
+      EngineRegistry r;
+      if constexpr (is_library_size(N)) add_builtin_engines<N>(r);
+      return r;
+    }();
     return registry;
   }
 
@@ -59,22 +81,31 @@ class EngineRegistry {
     entries_.emplace(name, std::move(entry));
   }
 
-  bool contains(const std::string& name) const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return entries_.count(name) > 0;
-  }
+  // Whether create() knows the name (here or, for a fixed N, at Dynamic).
+  bool contains(const std::string& name) const { return find(name).has_value(); }
 
+  // This registry's entries and, for a fixed N, those of EngineRegistry<Dynamic> it does not
+  // shadow (their factories adapt the Dynamic engine); sorted by name.
   std::vector<Entry> entries() const {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::map<std::string, Entry> all;
+    if constexpr (N != Dynamic) {
+      for (auto& e : EngineRegistry<Dynamic>::global().entries()) {
+        std::string name = e.name;
+        all.emplace(std::move(name), adapt(std::move(e)));
+      }
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (const auto& [name, e] : entries_) all.insert_or_assign(name, e);
+    }
     std::vector<Entry> out;
-    for (const auto& [name, e] : entries_) out.push_back(e);
+    for (auto& [name, e] : all) out.push_back(std::move(e));
     return out;
   }
 
   std::vector<std::string> names() const {
-    std::lock_guard<std::mutex> lock(mutex_);
     std::vector<std::string> out;
-    for (const auto& [name, e] : entries_) out.push_back(name);
+    for (const auto& e : entries()) out.push_back(e.name);
     return out;
   }
 
@@ -82,126 +113,51 @@ class EngineRegistry {
   // Throws InvalidInput for an unknown name (listing the valid ones) or option.
   std::unique_ptr<Engine<N>> create(std::string_view spec_text, SolverOptions base = {}) const {
     const EngineSpec spec = parse_engine_spec(spec_text);
-    Factory make;
-    std::vector<EngineOptionInfo> valid;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      auto it = entries_.find(spec.name);
-      if (it == entries_.end()) {
-        std::string list;
-        for (const auto& [name, e] : entries_) list += (list.empty() ? "" : ", ") + name;
-        throw InvalidInput("unknown engine '" + spec.name + "'; valid engines: " + list);
-      }
-      make = it->second.make;
-      valid = it->second.options;
+    std::optional<Entry> entry = find(spec.name);
+    if (!entry) {
+      std::string list;
+      for (const auto& name : names()) list += (list.empty() ? "" : ", ") + name;
+      throw InvalidInput("unknown engine '" + spec.name + "'; valid engines: " + list);
     }
+    std::vector<EngineOptionInfo> valid = entry->options;
     valid.insert(valid.end(), common_options().begin(), common_options().end());
     EngineSpecReader reader(spec, valid);
     if (auto v = reader.number("tol")) base.stop.step_tolerance = *v;
     if (auto v = reader.number("ftol")) base.stop.residual_tolerance = *v;
     if (auto v = reader.integer("max_iter")) base.stop.max_iterations = *v;
     if (auto v = reader.integer("max_evals")) base.stop.max_evaluations = *v;
-    std::unique_ptr<Engine<N>> engine = make(reader, std::move(base));
+    std::unique_ptr<Engine<N>> engine = entry->make(reader, std::move(base));
     reader.finish();
+    if (!engine) throw InvalidInput("engine '" + spec.name + "': its factory returned no engine");
     return engine;
   }
 
  private:
-  static EngineRegistry with_builtins() {
-    EngineRegistry r;
-    r.add({"picard", "x <- G(x)", {}, {"picard"}, [](EngineSpecReader&, SolverOptions o) {
-             return std::make_unique<PicardEngine<N>>(std::move(o));
-           }});
-    r.add({"aitken",
-           "component-wise Aitken delta^2 of the Picard sequence",
-           {},
-           {"aitken"},
-           [](EngineSpecReader&, SolverOptions o) {
-             return std::make_unique<AitkenEngine<N>>(std::move(o));
-           }});
-    r.add({"steffensen",
-           "Aitken restarted every three iterates",
-           {},
-           {"steffensen"},
-           [](EngineSpecReader&, SolverOptions o) {
-             return std::make_unique<SteffensenEngine<N>>(std::move(o));
-           }});
-    r.add({"anderson",
-           "Anderson acceleration (type II)",
-           {{"m", "depth >= 0; default 3"},
-            {"damping", "beta in (0, 1]; default 1"},
-            {"cond", "drop old columns above this condition estimate; default 1e8"}},
-           {"anderson", "anderson:m=3,damping=0.5"},
-           [](EngineSpecReader& s, SolverOptions o) {
-             AndersonOptions a;
-             if (auto v = s.integer("m")) a.depth = *v;
-             if (auto v = s.number("damping")) a.damping = *v;
-             if (auto v = s.number("cond")) a.condition_limit = *v;
-             return std::make_unique<AndersonEngine<N>>(a, std::move(o));
-           }});
-    r.add({"newton",
-           "Newton on F = G - x, any Jacobian source",
-           {{"linesearch", "0/1 Armijo backtracking; default 0"},
-            {"fd", "forward|central differences when no Jacobian; default central"}},
-           {"newton", "newton:linesearch=1"},
-           [](EngineSpecReader& s, SolverOptions o) {
-             NewtonOptions n;
-             if (auto v = s.boolean("linesearch")) n.line_search = *v;
-             if (auto v = s.text("fd")) n.finite_difference = parse_fd(*v);
-             return std::make_unique<NewtonEngine<N>>(n, std::move(o));
-           }});
-    r.add({"ceres",
-           "Ceres least squares, Levenberg-Marquardt or dogleg",
-           {{"<lm|dogleg>", "trust-region strategy; default lm"},
-            {"backend", "auto|tiny|solver; default auto"},
-            {"function_tol", "relative cost change; default 1e-10"},
-            {"gradient_tol", "default 1e-12"},
-            {"jacobi", "0/1 Jacobi scaling (solver backend); default 0"},
-            {"nonmonotonic", "0/1 non-monotonic steps (solver backend); default 1"}},
-           {"ceres", "ceres:dogleg", "ceres:lm,backend=solver"},
-           [](EngineSpecReader& s, SolverOptions o) {
-             CeresOptions c;
-             if (auto w = s.word({"lm", "dogleg"}); w && *w == "dogleg") {
-               c.method = CeresOptions::Method::kDogleg;
-             }
-             if (auto v = s.text("backend")) {
-               if (*v == "auto")
-                 c.backend = CeresOptions::Backend::kAuto;
-               else if (*v == "tiny")
-                 c.backend = CeresOptions::Backend::kTinySolver;
-               else if (*v == "solver")
-                 c.backend = CeresOptions::Backend::kSolver;
-               else
-                 throw InvalidInput("ceres: backend=" + *v + " is not auto, tiny or solver");
-             }
-             if (auto v = s.number("function_tol")) c.function_tolerance = *v;
-             if (auto v = s.number("gradient_tol")) c.gradient_tolerance = *v;
-             if (auto v = s.boolean("jacobi")) c.jacobi_scaling = *v;
-             if (auto v = s.boolean("nonmonotonic")) c.nonmonotonic_steps = *v;
-             return std::make_unique<CeresEngine<N>>(c, std::move(o));
-           }});
-    r.add({"nlopt",
-           "NLopt minimisation of 1/2 |F|^2 (bounds through the C++ API)",
-           {{"<ALGORITHM>",
-             "any NLopt name, e.g. LN_BOBYQA (default), LN_COBYLA, LD_SLSQP, "
-             "LD_LBFGS, GN_DIRECT_L"},
-            {"xtol_rel", "relative step tolerance; default off"},
-            {"initial_step", "first step of derivative-free algorithms"}},
-           {"nlopt:LN_BOBYQA", "nlopt:LD_SLSQP"},
-           [](EngineSpecReader& s, SolverOptions o) {
-             NloptOptions n;
-             if (auto w = s.word()) n.algorithm = *w;
-             if (auto v = s.number("xtol_rel")) n.relative_step_tolerance = *v;
-             if (auto v = s.number("initial_step")) n.initial_step = *v;
-             return std::make_unique<NloptEngine<N>>(n, std::move(o));
-           }});
-    return r;
+  std::optional<Entry> find(const std::string& name) const {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (auto it = entries_.find(name); it != entries_.end()) return it->second;
+    }
+    if constexpr (N != Dynamic) {
+      for (auto& e : EngineRegistry<Dynamic>::global().entries()) {
+        if (e.name == name) return adapt(std::move(e));
+      }
+    }
+    return std::nullopt;
   }
 
-  static FiniteDifference parse_fd(const std::string& v) {
-    if (v == "central") return FiniteDifference::kCentral;
-    if (v == "forward") return FiniteDifference::kForward;
-    throw InvalidInput("newton: fd=" + v + " is not forward or central");
+  // An entry of EngineRegistry<Dynamic> seen at size N.
+  template <typename DynamicEntry>
+  static Entry adapt(DynamicEntry e) {
+    auto make = std::move(e.make);
+    return {std::move(e.name), std::move(e.description), std::move(e.options),
+            std::move(e.examples),
+            [make = std::move(make)](EngineSpecReader& s,
+                                     SolverOptions o) -> std::unique_ptr<Engine<N>> {
+              auto engine = make(s, std::move(o));
+              if (!engine) return nullptr;
+              return std::make_unique<DynamicSizeEngine<N>>(std::move(engine));
+            }};
   }
 
   EngineRegistry() = default;
@@ -210,5 +166,12 @@ class EngineRegistry {
   mutable std::mutex mutex_;
   std::map<std::string, Entry> entries_;
 };
+
+// Compiled once in the library for its sizes (nlobs/solvers/library_sizes.hpp).
+#define NLOBS_EXTERN_ENGINE_REGISTRY(n)    \
+  extern template class EngineRegistry<n>; \
+  extern template void add_builtin_engines<n>(EngineRegistry<n>&);
+NLOBS_FOR_EACH_LIBRARY_SIZE(NLOBS_EXTERN_ENGINE_REGISTRY)
+#undef NLOBS_EXTERN_ENGINE_REGISTRY
 
 }  // namespace nlobs

@@ -5,6 +5,7 @@
 #include "nlobs/solvers/accelerators/anderson.hpp"
 #include "nlobs/solvers/accelerators/picard_step.hpp"
 #include "nlobs/solvers/accelerators/steffensen.hpp"
+#include "nlobs/solvers/library_sizes.hpp"
 
 namespace nlobs {
 
@@ -39,5 +40,18 @@ class AndersonEngine : public AcceleratedEngine<N, AndersonMixing<N>> {
   explicit AndersonEngine(AndersonOptions anderson = {}, SolverOptions options = {})
       : AcceleratedEngine<N, AndersonMixing<N>>(std::move(options), AndersonMixing<N>(anderson)) {}
 };
+
+// Compiled once in the library for its sizes (nlobs/solvers/library_sizes.hpp).
+#define NLOBS_EXTERN_FIXED_POINT_ENGINES(n)                         \
+  extern template class AcceleratedEngine<n, PicardStep<n>>;        \
+  extern template class AcceleratedEngine<n, AitkenTransform<n>>;   \
+  extern template class AcceleratedEngine<n, SteffensenRestart<n>>; \
+  extern template class AcceleratedEngine<n, AndersonMixing<n>>;    \
+  extern template class PicardEngine<n>;                            \
+  extern template class AitkenEngine<n>;                            \
+  extern template class SteffensenEngine<n>;                        \
+  extern template class AndersonEngine<n>;
+NLOBS_FOR_EACH_LIBRARY_SIZE(NLOBS_EXTERN_FIXED_POINT_ENGINES)
+#undef NLOBS_EXTERN_FIXED_POINT_ENGINES
 
 }  // namespace nlobs

@@ -16,6 +16,7 @@
 
 #include "nlobs/solvers/box_bounds.hpp"
 #include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/library_sizes.hpp"
 #include "nlobs/solvers/objective_problem.hpp"
 #include "nlobs/solvers/residual_source.hpp"
 
@@ -74,14 +75,9 @@ class NloptEngine : public Engine<N> {
   bool is_global() const { return !nlopt_.algorithm.empty() && nlopt_.algorithm[0] == 'G'; }
 
   // min ½‖G(x) − x‖₂².
-  Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override {
-    detail::check_initial_guess(name(), problem, x);
-    return run_residual<N>(detail::ResidualSource<N, N>(problem), x);
-  }
+  Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
   bool least_squares() const override { return true; }
-  Summary solve_least_squares(const RootProblem<N, Dynamic>& problem, Vector<N>& x) override {
-    return solve<Dynamic>(problem, x);
-  }
+  Summary solve_least_squares(const RootProblem<N, Dynamic>& problem, Vector<N>& x) override;
 
   // min ½‖F(x)‖₂².
   template <int M>
@@ -90,33 +86,7 @@ class NloptEngine : public Engine<N> {
     return run_residual<M>(detail::ResidualSource<N, M>(problem), x);
   }
   // min f(x).
-  Summary minimize(const ObjectiveProblem<N>& problem, Vector<N>& x) {
-    detail::check_initial_guess(name(), problem.size(), x);
-    struct Context {
-      NloptEngine* engine;
-      const ObjectiveProblem<N>* problem;
-    } ctx{this, &problem};
-    const double stop = nlopt_.stop_value.value_or(-std::numeric_limits<double>::infinity());
-    Summary s = run(
-        x, stop,
-        +[](void* data, const Vector<N>& at, Vector<N>* grad) {
-          auto* c = static_cast<Context*>(data);
-          const double f = c->problem->evaluate(at);
-          ++c->engine->evaluations_;
-          if (grad != nullptr) {
-            if (c->problem->has_gradient()) {
-              c->problem->gradient(at, *grad);
-            } else {
-              c->engine->evaluations_ += c->engine->scalar_gradient(*c->problem, at, f, *grad);
-            }
-            ++c->engine->jacobians_;
-          }
-          return f;
-        },
-        &ctx);
-    s.residual_norm = std::numeric_limits<double>::quiet_NaN();  // not a residual problem
-    return s;
-  }
+  Summary minimize(const ObjectiveProblem<N>& problem, Vector<N>& x);
 
  private:
   using ObjectiveThunk = double (*)(void*, const Vector<N>&, Vector<N>*);
@@ -194,89 +164,9 @@ class NloptEngine : public Engine<N> {
     return f;
   }
 
-  void prepare(Index n) {
-    opt_.emplace(static_cast<nlopt::algorithm>(algorithm_), static_cast<unsigned>(n));
-    auto bounds = [n](const Eigen::VectorXd& b, double fill) {
-      std::vector<double> v(static_cast<size_t>(n), fill);
-      for (Index i = 0; i < b.size(); ++i) v[static_cast<size_t>(i)] = b[i];
-      return v;
-    };
-    const double inf = std::numeric_limits<double>::infinity();
-    opt_->set_lower_bounds(bounds(nlopt_.lower_bounds, -inf));
-    opt_->set_upper_bounds(bounds(nlopt_.upper_bounds, inf));
-    const StopCriteria& stop = this->options_.stop;
-    if (stop.step_tolerance) opt_->set_xtol_abs(*stop.step_tolerance);
-    if (nlopt_.relative_step_tolerance > 0.0) opt_->set_xtol_rel(nlopt_.relative_step_tolerance);
-    opt_->set_maxeval(stop.max_evaluations);
-    if (nlopt_.initial_step) opt_->set_initial_step(*nlopt_.initial_step);
-    opt_->set_min_objective(&NloptEngine::trampoline, this);
-    xv_.assign(static_cast<size_t>(n), 0.0);
-    prepared_n_ = n;
-  }
+  void prepare(Index n);
 
-  Summary run(Vector<N>& x, double stop_value, ObjectiveThunk thunk, void* context) {
-    detail::require_inside_box<N>("nlopt", nlopt_.lower_bounds, nlopt_.upper_bounds, x);
-    const Index n = x.size();
-    if (!opt_ || prepared_n_ != n) prepare(n);
-    if constexpr (N == Dynamic) x_.resize(n), grad_.resize(n);
-    opt_->set_stopval(stop_value);
-    thunk_ = thunk;
-    context_ = context;
-    evaluations_ = jacobians_ = 0;
-    non_finite_ = false;
-    for (Index i = 0; i < n; ++i) xv_[static_cast<size_t>(i)] = x[i];
-
-    Summary s;
-    s.engine = name();
-    double f = std::numeric_limits<double>::quiet_NaN();
-    nlopt::result result = nlopt::FAILURE;
-    try {
-      result = opt_->optimize(xv_, f);
-    } catch (const nlopt::roundoff_limited&) {
-      result = nlopt::ROUNDOFF_LIMITED;
-    } catch (const nlopt::forced_stop&) {
-      result = nlopt::FORCED_STOP;
-    } catch (const std::exception& e) {
-      result = opt_->last_optimize_result();
-      s.message = e.what();
-    }
-    switch (result) {
-      case nlopt::SUCCESS:
-      case nlopt::STOPVAL_REACHED:
-      case nlopt::FTOL_REACHED:
-      case nlopt::XTOL_REACHED:
-        s.status = Status::kConverged;
-        break;
-      case nlopt::MAXEVAL_REACHED:
-        s.status = Status::kMaxEvaluations;
-        break;
-      case nlopt::MAXTIME_REACHED:
-        s.status = Status::kMaxIterations;
-        s.message = "NLopt time limit reached";
-        break;
-      case nlopt::ROUNDOFF_LIMITED:
-        s.status = Status::kStagnated;
-        s.message = "NLopt: roundoff limited";
-        break;
-      case nlopt::FORCED_STOP:
-        s.status = non_finite_ ? Status::kNonFinite : Status::kSolverFailure;
-        break;
-      default:
-        s.status = Status::kSolverFailure;
-        if (s.message.empty()) s.message = "NLopt failed (result " + std::to_string(result) + ")";
-        break;
-    }
-    const Vector<N> best = Eigen::Map<const Vector<N>>(xv_.data(), n);
-    if (best.allFinite()) {
-      s.step_norm = (best - x).template lpNorm<Eigen::Infinity>();  // from x0: NLopt hides steps
-      x = best;
-    }
-    s.iterations = opt_->get_numevals();  // NLopt counts objective evaluations, not iterations
-    s.function_evaluations = evaluations_;
-    s.jacobian_evaluations = jacobians_;
-    if (std::isfinite(f)) s.objective = f;
-    return s;
-  }
+  Summary run(Vector<N>& x, double stop_value, ObjectiveThunk thunk, void* context);
 
   NloptOptions nlopt_;
   nlopt_algorithm algorithm_;
@@ -289,5 +179,136 @@ class NloptEngine : public Engine<N> {
   int evaluations_ = 0, jacobians_ = 0;
   bool non_finite_ = false;
 };
+
+template <int N>
+Summary NloptEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
+  detail::check_initial_guess(name(), problem, x);
+  return run_residual<N>(detail::ResidualSource<N, N>(problem), x);
+}
+
+template <int N>
+Summary NloptEngine<N>::solve_least_squares(const RootProblem<N, Dynamic>& problem, Vector<N>& x) {
+  return solve<Dynamic>(problem, x);
+}
+
+template <int N>
+Summary NloptEngine<N>::minimize(const ObjectiveProblem<N>& problem, Vector<N>& x) {
+  detail::check_initial_guess(name(), problem.size(), x);
+  struct Context {
+    NloptEngine* engine;
+    const ObjectiveProblem<N>* problem;
+  } ctx{this, &problem};
+  const double stop = nlopt_.stop_value.value_or(-std::numeric_limits<double>::infinity());
+  Summary s = run(
+      x, stop,
+      +[](void* data, const Vector<N>& at, Vector<N>* grad) {
+        auto* c = static_cast<Context*>(data);
+        const double f = c->problem->evaluate(at);
+        ++c->engine->evaluations_;
+        if (grad != nullptr) {
+          if (c->problem->has_gradient()) {
+            c->problem->gradient(at, *grad);
+          } else {
+            c->engine->evaluations_ += c->engine->scalar_gradient(*c->problem, at, f, *grad);
+          }
+          ++c->engine->jacobians_;
+        }
+        return f;
+      },
+      &ctx);
+  s.residual_norm = std::numeric_limits<double>::quiet_NaN();  // not a residual problem
+  return s;
+}
+
+template <int N>
+Summary NloptEngine<N>::run(Vector<N>& x, double stop_value, ObjectiveThunk thunk, void* context) {
+  detail::require_inside_box<N>("nlopt", nlopt_.lower_bounds, nlopt_.upper_bounds, x);
+  const Index n = x.size();
+  if (!opt_ || prepared_n_ != n) prepare(n);
+  if constexpr (N == Dynamic) x_.resize(n), grad_.resize(n);
+  opt_->set_stopval(stop_value);
+  thunk_ = thunk;
+  context_ = context;
+  evaluations_ = jacobians_ = 0;
+  non_finite_ = false;
+  for (Index i = 0; i < n; ++i) xv_[static_cast<size_t>(i)] = x[i];
+
+  Summary s;
+  s.engine = name();
+  double f = std::numeric_limits<double>::quiet_NaN();
+  nlopt::result result = nlopt::FAILURE;
+  try {
+    result = opt_->optimize(xv_, f);
+  } catch (const nlopt::roundoff_limited&) {
+    result = nlopt::ROUNDOFF_LIMITED;
+  } catch (const nlopt::forced_stop&) {
+    result = nlopt::FORCED_STOP;
+  } catch (const std::exception& e) {
+    result = opt_->last_optimize_result();
+    s.message = e.what();
+  }
+  switch (result) {
+    case nlopt::SUCCESS:
+    case nlopt::STOPVAL_REACHED:
+    case nlopt::FTOL_REACHED:
+    case nlopt::XTOL_REACHED:
+      s.status = Status::kConverged;
+      break;
+    case nlopt::MAXEVAL_REACHED:
+      s.status = Status::kMaxEvaluations;
+      break;
+    case nlopt::MAXTIME_REACHED:
+      s.status = Status::kMaxIterations;
+      s.message = "NLopt time limit reached";
+      break;
+    case nlopt::ROUNDOFF_LIMITED:
+      s.status = Status::kStagnated;
+      s.message = "NLopt: roundoff limited";
+      break;
+    case nlopt::FORCED_STOP:
+      s.status = non_finite_ ? Status::kNonFinite : Status::kSolverFailure;
+      break;
+    default:
+      s.status = Status::kSolverFailure;
+      if (s.message.empty()) s.message = "NLopt failed (result " + std::to_string(result) + ")";
+      break;
+  }
+  const Vector<N> best = Eigen::Map<const Vector<N>>(xv_.data(), n);
+  if (best.allFinite()) {
+    s.step_norm = (best - x).template lpNorm<Eigen::Infinity>();  // from x0: NLopt hides steps
+    x = best;
+  }
+  s.iterations = opt_->get_numevals();  // NLopt counts objective evaluations, not iterations
+  s.function_evaluations = evaluations_;
+  s.jacobian_evaluations = jacobians_;
+  if (std::isfinite(f)) s.objective = f;
+  return s;
+}
+
+template <int N>
+void NloptEngine<N>::prepare(Index n) {
+  opt_.emplace(static_cast<nlopt::algorithm>(algorithm_), static_cast<unsigned>(n));
+  auto bounds = [n](const Eigen::VectorXd& b, double fill) {
+    std::vector<double> v(static_cast<size_t>(n), fill);
+    for (Index i = 0; i < b.size(); ++i) v[static_cast<size_t>(i)] = b[i];
+    return v;
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  opt_->set_lower_bounds(bounds(nlopt_.lower_bounds, -inf));
+  opt_->set_upper_bounds(bounds(nlopt_.upper_bounds, inf));
+  const StopCriteria& stop = this->options_.stop;
+  if (stop.step_tolerance) opt_->set_xtol_abs(*stop.step_tolerance);
+  if (nlopt_.relative_step_tolerance > 0.0) opt_->set_xtol_rel(nlopt_.relative_step_tolerance);
+  opt_->set_maxeval(stop.max_evaluations);
+  if (nlopt_.initial_step) opt_->set_initial_step(*nlopt_.initial_step);
+  opt_->set_min_objective(&NloptEngine::trampoline, this);
+  xv_.assign(static_cast<size_t>(n), 0.0);
+  prepared_n_ = n;
+}
+
+// Compiled once in the library for its sizes (nlobs/solvers/library_sizes.hpp).
+#define NLOBS_EXTERN_NLOPT_ENGINE(n) extern template class NloptEngine<n>;
+NLOBS_FOR_EACH_LIBRARY_SIZE(NLOBS_EXTERN_NLOPT_ENGINE)
+#undef NLOBS_EXTERN_NLOPT_ENGINE
 
 }  // namespace nlobs

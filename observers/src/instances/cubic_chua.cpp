@@ -1,0 +1,23 @@
+// The observers the CLI builds for CubicChua, compiled once (their headers declare them extern):
+// the MVT observer, the high-gain observer and its Taylor-mode observability maps.
+#include "nlobs/observers/high_gain_observer.hpp"
+#include "nlobs/observers/mvt_observer.hpp"
+#include "nlobs/observers/taylor_observability_map.hpp"
+
+namespace nlobs {
+
+static_assert(3 == (CubicChua::kStates > 2 ? CubicChua::kStates : 2),
+              "catalogue.hpp's lowest order for CubicChua must be max(2, n)");
+
+template class MvtObserver<CubicChua>;
+template class HighGainObserver<CubicChua>;
+template std::shared_ptr<ObservabilityMap> make_taylor_observability_map<CubicChua>(
+    const CubicChua&, int, std::string);
+template class TaylorObservabilityMap<CubicChua, 3>;
+template class TaylorObservabilityMap<CubicChua, 4>;
+template class TaylorObservabilityMap<CubicChua, 5>;
+template class TaylorObservabilityMap<CubicChua, 6>;
+template class TaylorObservabilityMap<CubicChua, 7>;
+template class TaylorObservabilityMap<CubicChua, 8>;
+
+}  // namespace nlobs

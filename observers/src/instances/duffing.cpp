@@ -1,0 +1,24 @@
+// The observers the CLI builds for Duffing, compiled once (their headers declare them extern):
+// the MVT observer, the high-gain observer and its Taylor-mode observability maps.
+#include "nlobs/observers/high_gain_observer.hpp"
+#include "nlobs/observers/mvt_observer.hpp"
+#include "nlobs/observers/taylor_observability_map.hpp"
+
+namespace nlobs {
+
+static_assert(2 == (Duffing::kStates > 2 ? Duffing::kStates : 2),
+              "catalogue.hpp's lowest order for Duffing must be max(2, n)");
+
+template class MvtObserver<Duffing>;
+template class HighGainObserver<Duffing>;
+template std::shared_ptr<ObservabilityMap> make_taylor_observability_map<Duffing>(const Duffing&,
+                                                                                  int, std::string);
+template class TaylorObservabilityMap<Duffing, 2>;
+template class TaylorObservabilityMap<Duffing, 3>;
+template class TaylorObservabilityMap<Duffing, 4>;
+template class TaylorObservabilityMap<Duffing, 5>;
+template class TaylorObservabilityMap<Duffing, 6>;
+template class TaylorObservabilityMap<Duffing, 7>;
+template class TaylorObservabilityMap<Duffing, 8>;
+
+}  // namespace nlobs

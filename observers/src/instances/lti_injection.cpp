@@ -1,0 +1,24 @@
+// The observers the CLI builds for LtiOutputInjection, compiled once (their headers declare them
+// extern): the MVT observer, the high-gain observer and its Taylor-mode observability maps.
+#include "nlobs/observers/high_gain_observer.hpp"
+#include "nlobs/observers/mvt_observer.hpp"
+#include "nlobs/observers/taylor_observability_map.hpp"
+
+namespace nlobs {
+
+static_assert(2 == (LtiOutputInjection::kStates > 2 ? LtiOutputInjection::kStates : 2),
+              "catalogue.hpp's lowest order for LtiOutputInjection must be max(2, n)");
+
+template class MvtObserver<LtiOutputInjection>;
+template class HighGainObserver<LtiOutputInjection>;
+template std::shared_ptr<ObservabilityMap> make_taylor_observability_map<LtiOutputInjection>(
+    const LtiOutputInjection&, int, std::string);
+template class TaylorObservabilityMap<LtiOutputInjection, 2>;
+template class TaylorObservabilityMap<LtiOutputInjection, 3>;
+template class TaylorObservabilityMap<LtiOutputInjection, 4>;
+template class TaylorObservabilityMap<LtiOutputInjection, 5>;
+template class TaylorObservabilityMap<LtiOutputInjection, 6>;
+template class TaylorObservabilityMap<LtiOutputInjection, 7>;
+template class TaylorObservabilityMap<LtiOutputInjection, 8>;
+
+}  // namespace nlobs

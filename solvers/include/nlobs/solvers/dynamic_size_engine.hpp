@@ -1,0 +1,89 @@
+#pragma once
+// An engine built for nlobs::Dynamic sizes serving a compile-time size N: the problem's G (or F)
+// and Jacobian are seen through dynamic vectors and the answer copied back. The engine registry
+// uses it so that one registration at Dynamic serves every size (EngineRegistry<N>::create
+// falls back to it); it costs a copy of x per solve and of each point per evaluation, and the
+// inner engine's own allocations, so register a fixed-size entry where that matters.
+#include <algorithm>
+#include <memory>
+#include <utility>
+
+#include "nlobs/solvers/engine.hpp"
+
+namespace nlobs {
+
+template <int N>
+class DynamicSizeEngine final : public Engine<N> {
+  static_assert(N != Dynamic, "DynamicSizeEngine adapts a Dynamic engine to a fixed size");
+
+ public:
+  // Throws InvalidInput for a null engine.
+  explicit DynamicSizeEngine(std::unique_ptr<Engine<Dynamic>> engine)
+      : Engine<N>(engine ? engine->options() : SolverOptions{}), engine_(std::move(engine)) {
+    if (!engine_) throw InvalidInput("DynamicSizeEngine: the engine is null");
+  }
+
+  std::string_view name() const override { return engine_->name(); }
+  bool least_squares() const override { return engine_->least_squares(); }
+  Engine<Dynamic>& engine() { return *engine_; }
+
+  Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override {
+    detail::check_initial_guess(name(), problem, x);
+    const auto g = [&problem](const Vector<Dynamic>& at, Vector<Dynamic>& out) {
+      const Vector<N> point = at;
+      Vector<N> value = Vector<N>::Zero();
+      problem.evaluate(point, value);
+      out.resize(N);
+      std::copy(value.data(), value.data() + N, out.data());
+    };
+    Vector<Dynamic> xd = x;
+    Summary s;
+    if (problem.has_jacobian()) {
+      const auto dg = [&problem](const Vector<Dynamic>& at, Matrix<Dynamic, Dynamic>& jac) {
+        const Vector<N> point = at;
+        Matrix<N, N> j = Matrix<N, N>::Zero();
+        problem.jacobian(point, j);
+        // Element-wise: GCC 12 warns (-Warray-bounds) on Eigen's packet copy at N = 1.
+        jac.resize(N, N);
+        std::copy(j.data(), j.data() + N * N, jac.data());
+      };
+      s = engine_->solve(
+          FixedPointProblem<Dynamic>::with_jacobian(g, dg, N, problem.jacobian_source()), xd);
+    } else {
+      s = engine_->solve(FixedPointProblem<Dynamic>::from_map(g, N), xd);
+    }
+    if (xd.size() == N) x = xd;
+    return s;
+  }
+
+  Summary solve_least_squares(const RootProblem<N, Dynamic>& problem, Vector<N>& x) override {
+    detail::check_initial_guess(name(), problem.size(), x);
+    const Index m = problem.residual_size();
+    const auto f = [&problem, m](const Vector<Dynamic>& at, Vector<Dynamic>& out) {
+      const Vector<N> point = at;
+      out.resize(m);
+      problem.evaluate(point, out);
+    };
+    Vector<Dynamic> xd = x;
+    Summary s;
+    if (problem.has_jacobian()) {
+      const auto df = [&problem, m](const Vector<Dynamic>& at, Matrix<Dynamic, Dynamic>& jac) {
+        const Vector<N> point = at;
+        Matrix<Dynamic, N> j(m, N);
+        problem.jacobian(point, j);
+        jac = j;
+      };
+      s = engine_->solve_least_squares(RootProblem<Dynamic, Dynamic>::with_jacobian(f, df, N, m),
+                                       xd);
+    } else {
+      s = engine_->solve_least_squares(RootProblem<Dynamic, Dynamic>::from_map(f, N, m), xd);
+    }
+    if (xd.size() == N) x = xd;
+    return s;
+  }
+
+ private:
+  std::unique_ptr<Engine<Dynamic>> engine_;
+};
+
+}  // namespace nlobs
