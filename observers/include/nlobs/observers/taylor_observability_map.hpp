@@ -191,7 +191,8 @@ bool TaylorObservabilityMap<Model, N>::next(const Eigen::VectorXd& x, double& va
 }
 
 // The largest N make_taylor_observability_map instantiates: each N is a separate type, compiled
-// for every model the CLI knows (+27 s of build for 2..8). Past it, LieObservabilityMap.
+// once per catalogue model in the observers library (src/instances/). Past it,
+// LieObservabilityMap.
 inline constexpr int kMaxTaylorObservabilityOrder = 8;
 
 // TaylorObservabilityMap<Model, N> for a run-time N in [max(2, n), kMaxTaylorObservabilityOrder].
