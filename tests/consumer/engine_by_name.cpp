@@ -6,8 +6,8 @@
 
 int main() {
   // G(x) = 0.5 cos(x) + c componentwise: a contraction with one fixed point.
-  const auto problem = nlobs::FixedPointProblem<3>::from_map(
-      [](const nlobs::Vector<3>& x, nlobs::Vector<3>& g) {
+  const auto problem =
+      nlobs::FixedPointProblem<3>::from_map([](const nlobs::Vector<3>& x, nlobs::Vector<3>& g) {
         for (int i = 0; i < 3; ++i) g[i] = 0.5 * std::cos(x[i]) + 0.1 * i;
       });
   int failures = 0;
