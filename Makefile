@@ -1,7 +1,7 @@
 # nlobs — two commands: `make demo` (the main job) and `make test`.
 # Both install missing Debian packages (scripts/ensure-deps.sh), configure (Release), build, run.
 # `make demo` builds only the CLI and the libraries it links; `make test` builds everything.
-# ccache is used when installed (NLOBS_CCACHE=OFF in CMAKE_ARGS turns it off).
+# ccache is used when installed (`make demo CMAKE_ARGS=-DNLOBS_CCACHE=OFF` turns it off).
 BUILD      ?= build
 BUILD_TYPE ?= Release
 WERROR     ?= OFF
@@ -49,7 +49,7 @@ format-check: deps
 
 # Per-translation-unit wall time and peak memory of a from-scratch build (docs/architecture.md).
 compile-cost: deps
-	./scripts/compile-cost
+	./scripts/compile-cost --jobs $(JOBS)
 
 clean:
 	rm -rf $(BUILD) build-asan build-cost

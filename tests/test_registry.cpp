@@ -267,11 +267,16 @@ TEST(EngineRegistry, AFixedSizeEntryShadowsTheDynamicOne) {
   }
   auto engine = fixed.create("shadowed");
   EXPECT_NE(dynamic_cast<Relaxed<6>*>(engine.get()), nullptr);
+  EXPECT_TRUE(fixed.has_entry("shadowed"));
+  EXPECT_FALSE(fixed.has_entry("relaxed"));  // served from Dynamic, not its own
+  int listed = 0;
   for (const auto& e : fixed.entries()) {
     if (e.name == "shadowed") {
+      ++listed;
       EXPECT_EQ(e.description, "at 6");
     }
   }
+  EXPECT_EQ(listed, 1);
   // At another fixed size the Dynamic entry still serves, adapted.
   auto other = EngineRegistry<5>::global().create("shadowed");
   EXPECT_NE(dynamic_cast<DynamicSizeEngine<5>*>(other.get()), nullptr);
@@ -298,6 +303,20 @@ TEST(EngineRegistry, BuiltInsAtSizesTheLibraryDoesNotCompile) {
   EXPECT_TRUE(s.converged());
   EXPECT_GT(s.jacobian_evaluations, 0);
   EXPECT_LE(s.function_evaluations, s.iterations + 2) << s.full_report();
+  // Without a Jacobian Newton differences G through the adapter.
+  const auto plain = FixedPointProblem<5>::from_map([](const Vector<5>& v, Vector<5>& g) {
+    for (Index i = 0; i < 5; ++i) g[i] = 0.5 * std::cos(v[i]) + 0.1 * static_cast<double>(i);
+  });
+  Vector<5> xp = Vector<5>::Zero();
+  const Summary sp = newton->solve(plain, xp);
+  EXPECT_TRUE(sp.converged()) << sp.full_report();
+  EXPECT_GT(sp.function_evaluations, s.function_evaluations);  // the differences count
+  EXPECT_LT(fixed_point_residual<5>(xp), 1e-10);
+  // The fixed-size-only Ceres back end names the way out at a size without its own entries.
+  EXPECT_NE(message_of([] {
+              EngineRegistry<5>::global().create("ceres:backend=tiny");
+            }).find("add_builtin_engines<5>"),
+            std::string::npos);
   // Least squares (m = 7 > n = 5) through the adapter: F_i = x_{i mod 5} − c_{i mod 5}.
   const Vector<5> c(1.0, -2.0, 3.0, 0.5, 4.0);
   const auto f = [c](const Vector<5>& v, Vector<Dynamic>& r) {
@@ -310,10 +329,27 @@ TEST(EngineRegistry, BuiltInsAtSizesTheLibraryDoesNotCompile) {
   const Summary ls = ceres->solve_least_squares(RootProblem<5, Dynamic>::from_map(f, 5, 7), y);
   EXPECT_TRUE(ls.converged()) << ls.full_report();
   EXPECT_LT((y - c).lpNorm<Eigen::Infinity>(), 1e-8);
+  // With its Jacobian (counted, no differencing): the same answer.
+  int jacobians = 0;
+  const auto df = [&jacobians](const Vector<5>&, Matrix<Dynamic, 5>& j) {
+    ++jacobians;
+    j.setZero(7, 5);
+    for (Index i = 0; i < 7; ++i) j(i, i % 5) = 1.0;
+  };
+  Vector<5> yj = Vector<5>::Zero();
+  const Summary lsj =
+      ceres->solve_least_squares(RootProblem<5, Dynamic>::with_jacobian(f, df, 5, 7), yj);
+  EXPECT_TRUE(lsj.converged()) << lsj.full_report();
+  EXPECT_GT(jacobians, 0);
+  EXPECT_LT((yj - c).lpNorm<Eigen::Infinity>(), 1e-8);
   // Fixed-size built-ins at another size on request (builtin_engines.hpp): no adapter. The
   // registry is process-wide, so a repeated test finds them there already.
   auto& eight = EngineRegistry<8>::global();
-  if (!dynamic_cast<NewtonEngine<8>*>(eight.create("newton").get())) add_builtin_engines<8>(eight);
+  if (!eight.has_entry("newton")) {  // first in this process: the Dynamic engine, adapted
+    EXPECT_NE(dynamic_cast<DynamicSizeEngine<8>*>(eight.create("newton").get()), nullptr);
+  }
+  add_builtin_engines<8>(eight);
+  add_builtin_engines<8>(eight);  // idempotent
   auto fixed_newton = eight.create("newton", o);
   ASSERT_NE(dynamic_cast<NewtonEngine<8>*>(fixed_newton.get()), nullptr);
   Vector<8> z = Vector<8>::Zero();

@@ -466,8 +466,6 @@ TEST(RunHighGain, ThetaSweepShowsPeakingAndNoise) {
             std::string::npos);
 }
 
-// The maps from the model through the CLI: taylor, adolc and ad (taylor up to N = 8) run the
-// same observer on Lorenz to rounding; past N = 8, ad takes ADOL-C and taylor is refused.
 // A Lorenz run with the high-gain observer on the map `map` at order N; its summary.
 nlohmann::json high_gain_map_run(const std::string& map, int N, std::string* error = nullptr) {
   // 0.3 s (MSE after 0.2 s); under the sanitizers 0.1 s (MSE after 0.05 s): ADOL-C at N = 9 is
@@ -491,6 +489,8 @@ nlohmann::json high_gain_map_run(const std::string& map, int N, std::string* err
   return observer_of(nlohmann::json::parse(in), "hg");
 }
 
+// The maps from the model through the CLI: taylor, adolc and ad (taylor up to N = 8) run the
+// same observer on Lorenz to rounding.
 TEST(RunHighGain, MapsFromTheModelGiveTheSameRun) {
   const nlohmann::json taylor = high_gain_map_run("taylor", 4),
                        adolc = high_gain_map_run("adolc", 4), ad = high_gain_map_run("ad", 4);
@@ -503,8 +503,8 @@ TEST(RunHighGain, MapsFromTheModelGiveTheSameRun) {
   EXPECT_TRUE(taylor["failures"].empty());
 }
 
+// Past N = 8, ad takes ADOL-C (the same run as adolc) and taylor is refused.
 TEST(RunHighGain, PastTheTaylorMapsAdIsAdolc) {
-  // N = 9: ad takes ADOL-C (taylor stops at 8), the same run as adolc.
   const nlohmann::json ad9 = high_gain_map_run("ad", 9), adolc9 = high_gain_map_run("adolc", 9);
   EXPECT_EQ(ad9["mse"], adolc9["mse"]);
   EXPECT_TRUE(ad9["mse"].is_array()) << ad9["mse"];

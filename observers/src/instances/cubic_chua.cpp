@@ -6,6 +6,8 @@
 
 namespace nlobs {
 
+#define NLOBS_INSTANTIATE_TAYLOR_MAP(M, N) template class TaylorObservabilityMap<M, N>;
+
 static_assert(3 == (CubicChua::kStates > 2 ? CubicChua::kStates : 2),
               "catalogue.hpp's lowest order for CubicChua must be max(2, n)");
 
@@ -13,11 +15,6 @@ template class MvtObserver<CubicChua>;
 template class HighGainObserver<CubicChua>;
 template std::shared_ptr<ObservabilityMap> make_taylor_observability_map<CubicChua>(
     const CubicChua&, int, std::string);
-template class TaylorObservabilityMap<CubicChua, 3>;
-template class TaylorObservabilityMap<CubicChua, 4>;
-template class TaylorObservabilityMap<CubicChua, 5>;
-template class TaylorObservabilityMap<CubicChua, 6>;
-template class TaylorObservabilityMap<CubicChua, 7>;
-template class TaylorObservabilityMap<CubicChua, 8>;
+NLOBS_TAYLOR_ORDERS_FROM(NLOBS_INSTANTIATE_TAYLOR_MAP, CubicChua, 3)
 
 }  // namespace nlobs

@@ -6,6 +6,8 @@
 
 namespace nlobs {
 
+#define NLOBS_INSTANTIATE_TAYLOR_MAP(M, N) template class TaylorObservabilityMap<M, N>;
+
 static_assert(2 == (Duffing::kStates > 2 ? Duffing::kStates : 2),
               "catalogue.hpp's lowest order for Duffing must be max(2, n)");
 
@@ -13,12 +15,6 @@ template class MvtObserver<Duffing>;
 template class HighGainObserver<Duffing>;
 template std::shared_ptr<ObservabilityMap> make_taylor_observability_map<Duffing>(const Duffing&,
                                                                                   int, std::string);
-template class TaylorObservabilityMap<Duffing, 2>;
-template class TaylorObservabilityMap<Duffing, 3>;
-template class TaylorObservabilityMap<Duffing, 4>;
-template class TaylorObservabilityMap<Duffing, 5>;
-template class TaylorObservabilityMap<Duffing, 6>;
-template class TaylorObservabilityMap<Duffing, 7>;
-template class TaylorObservabilityMap<Duffing, 8>;
+NLOBS_TAYLOR_ORDERS_FROM(NLOBS_INSTANTIATE_TAYLOR_MAP, Duffing, 2)
 
 }  // namespace nlobs

@@ -6,6 +6,8 @@
 
 namespace nlobs {
 
+#define NLOBS_INSTANTIATE_TAYLOR_MAP(M, N) template class TaylorObservabilityMap<M, N>;
+
 static_assert(3 == (Lorenz::kStates > 2 ? Lorenz::kStates : 2),
               "catalogue.hpp's lowest order for Lorenz must be max(2, n)");
 
@@ -13,11 +15,6 @@ template class MvtObserver<Lorenz>;
 template class HighGainObserver<Lorenz>;
 template std::shared_ptr<ObservabilityMap> make_taylor_observability_map<Lorenz>(const Lorenz&, int,
                                                                                  std::string);
-template class TaylorObservabilityMap<Lorenz, 3>;
-template class TaylorObservabilityMap<Lorenz, 4>;
-template class TaylorObservabilityMap<Lorenz, 5>;
-template class TaylorObservabilityMap<Lorenz, 6>;
-template class TaylorObservabilityMap<Lorenz, 7>;
-template class TaylorObservabilityMap<Lorenz, 8>;
+NLOBS_TAYLOR_ORDERS_FROM(NLOBS_INSTANTIATE_TAYLOR_MAP, Lorenz, 3)
 
 }  // namespace nlobs

@@ -6,6 +6,8 @@
 
 namespace nlobs {
 
+#define NLOBS_INSTANTIATE_TAYLOR_MAP(M, N) template class TaylorObservabilityMap<M, N>;
+
 static_assert(2 == (LtiOutputInjection::kStates > 2 ? LtiOutputInjection::kStates : 2),
               "catalogue.hpp's lowest order for LtiOutputInjection must be max(2, n)");
 
@@ -13,12 +15,6 @@ template class MvtObserver<LtiOutputInjection>;
 template class HighGainObserver<LtiOutputInjection>;
 template std::shared_ptr<ObservabilityMap> make_taylor_observability_map<LtiOutputInjection>(
     const LtiOutputInjection&, int, std::string);
-template class TaylorObservabilityMap<LtiOutputInjection, 2>;
-template class TaylorObservabilityMap<LtiOutputInjection, 3>;
-template class TaylorObservabilityMap<LtiOutputInjection, 4>;
-template class TaylorObservabilityMap<LtiOutputInjection, 5>;
-template class TaylorObservabilityMap<LtiOutputInjection, 6>;
-template class TaylorObservabilityMap<LtiOutputInjection, 7>;
-template class TaylorObservabilityMap<LtiOutputInjection, 8>;
+NLOBS_TAYLOR_ORDERS_FROM(NLOBS_INSTANTIATE_TAYLOR_MAP, LtiOutputInjection, 2)
 
 }  // namespace nlobs

@@ -6,6 +6,8 @@
 
 namespace nlobs {
 
+#define NLOBS_INSTANTIATE_TAYLOR_MAP(M, N) template class TaylorObservabilityMap<M, N>;
+
 static_assert(3 == (ModifiedChua::kStates > 2 ? ModifiedChua::kStates : 2),
               "catalogue.hpp's lowest order for ModifiedChua must be max(2, n)");
 
@@ -13,11 +15,6 @@ template class MvtObserver<ModifiedChua>;
 template class HighGainObserver<ModifiedChua>;
 template std::shared_ptr<ObservabilityMap> make_taylor_observability_map<ModifiedChua>(
     const ModifiedChua&, int, std::string);
-template class TaylorObservabilityMap<ModifiedChua, 3>;
-template class TaylorObservabilityMap<ModifiedChua, 4>;
-template class TaylorObservabilityMap<ModifiedChua, 5>;
-template class TaylorObservabilityMap<ModifiedChua, 6>;
-template class TaylorObservabilityMap<ModifiedChua, 7>;
-template class TaylorObservabilityMap<ModifiedChua, 8>;
+NLOBS_TAYLOR_ORDERS_FROM(NLOBS_INSTANTIATE_TAYLOR_MAP, ModifiedChua, 3)
 
 }  // namespace nlobs

@@ -6,6 +6,8 @@
 
 namespace nlobs {
 
+#define NLOBS_INSTANTIATE_TAYLOR_MAP(M, N) template class TaylorObservabilityMap<M, N>;
+
 static_assert(2 ==
                   (OscillatorNonlinearOutput::kStates > 2 ? OscillatorNonlinearOutput::kStates : 2),
               "catalogue.hpp's lowest order for OscillatorNonlinearOutput must be max(2, n)");
@@ -14,12 +16,6 @@ template class MvtObserver<OscillatorNonlinearOutput>;
 template class HighGainObserver<OscillatorNonlinearOutput>;
 template std::shared_ptr<ObservabilityMap> make_taylor_observability_map<OscillatorNonlinearOutput>(
     const OscillatorNonlinearOutput&, int, std::string);
-template class TaylorObservabilityMap<OscillatorNonlinearOutput, 2>;
-template class TaylorObservabilityMap<OscillatorNonlinearOutput, 3>;
-template class TaylorObservabilityMap<OscillatorNonlinearOutput, 4>;
-template class TaylorObservabilityMap<OscillatorNonlinearOutput, 5>;
-template class TaylorObservabilityMap<OscillatorNonlinearOutput, 6>;
-template class TaylorObservabilityMap<OscillatorNonlinearOutput, 7>;
-template class TaylorObservabilityMap<OscillatorNonlinearOutput, 8>;
+NLOBS_TAYLOR_ORDERS_FROM(NLOBS_INSTANTIATE_TAYLOR_MAP, OscillatorNonlinearOutput, 2)
 
 }  // namespace nlobs

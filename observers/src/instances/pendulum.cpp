@@ -7,6 +7,8 @@
 
 namespace nlobs {
 
+#define NLOBS_INSTANTIATE_TAYLOR_MAP(M, N) template class TaylorObservabilityMap<M, N>;
+
 static_assert(2 == (PendulumTimeVaryingFriction::kStates > 2 ? PendulumTimeVaryingFriction::kStates
                                                              : 2),
               "catalogue.hpp's lowest order for PendulumTimeVaryingFriction must be max(2, n)");
@@ -16,12 +18,6 @@ template class HighGainObserver<PendulumTimeVaryingFriction>;
 template std::shared_ptr<ObservabilityMap>
 make_taylor_observability_map<PendulumTimeVaryingFriction>(const PendulumTimeVaryingFriction&, int,
                                                            std::string);
-template class TaylorObservabilityMap<PendulumTimeVaryingFriction, 2>;
-template class TaylorObservabilityMap<PendulumTimeVaryingFriction, 3>;
-template class TaylorObservabilityMap<PendulumTimeVaryingFriction, 4>;
-template class TaylorObservabilityMap<PendulumTimeVaryingFriction, 5>;
-template class TaylorObservabilityMap<PendulumTimeVaryingFriction, 6>;
-template class TaylorObservabilityMap<PendulumTimeVaryingFriction, 7>;
-template class TaylorObservabilityMap<PendulumTimeVaryingFriction, 8>;
+NLOBS_TAYLOR_ORDERS_FROM(NLOBS_INSTANTIATE_TAYLOR_MAP, PendulumTimeVaryingFriction, 2)
 
 }  // namespace nlobs

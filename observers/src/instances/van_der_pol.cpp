@@ -6,6 +6,8 @@
 
 namespace nlobs {
 
+#define NLOBS_INSTANTIATE_TAYLOR_MAP(M, N) template class TaylorObservabilityMap<M, N>;
+
 static_assert(2 == (VanDerPol::kStates > 2 ? VanDerPol::kStates : 2),
               "catalogue.hpp's lowest order for VanDerPol must be max(2, n)");
 
@@ -13,12 +15,6 @@ template class MvtObserver<VanDerPol>;
 template class HighGainObserver<VanDerPol>;
 template std::shared_ptr<ObservabilityMap> make_taylor_observability_map<VanDerPol>(
     const VanDerPol&, int, std::string);
-template class TaylorObservabilityMap<VanDerPol, 2>;
-template class TaylorObservabilityMap<VanDerPol, 3>;
-template class TaylorObservabilityMap<VanDerPol, 4>;
-template class TaylorObservabilityMap<VanDerPol, 5>;
-template class TaylorObservabilityMap<VanDerPol, 6>;
-template class TaylorObservabilityMap<VanDerPol, 7>;
-template class TaylorObservabilityMap<VanDerPol, 8>;
+NLOBS_TAYLOR_ORDERS_FROM(NLOBS_INSTANTIATE_TAYLOR_MAP, VanDerPol, 2)
 
 }  // namespace nlobs

@@ -6,8 +6,9 @@
 
 namespace nlobs {
 
-#define NLOBS_INSTANTIATE(n)        \
-  template class EngineRegistry<n>; \
+#define NLOBS_INSTANTIATE(n)           \
+  template class EngineRegistry<n>;    \
+  template class DynamicSizeEngine<n>; \
   template void add_builtin_engines<n>(EngineRegistry<n>&);
 NLOBS_FOR_EACH_LIBRARY_SIZE(NLOBS_INSTANTIATE)
 #undef NLOBS_INSTANTIATE

@@ -1,7 +1,9 @@
 #pragma once
 // The catalogue's continuous models as C++ types, listed once for the explicit instantiations
 // of the observers library (observers/src/instances/): the observers the CLI builds for these
-// models are compiled there, once, and their headers declare them extern.
+// models are compiled there, once, and their headers declare them extern. A model added here
+// needs its file in observers/src/instances/ (one per model; the static_asserts there check
+// the lists), or its users fail to link.
 #include "nlobs/models/modified_chua.hpp"
 #include "nlobs/models/systems.hpp"
 
@@ -22,7 +24,8 @@
   X(LtiOutputInjection)                   \
   X(PendulumTimeVaryingFriction)
 
-// X(Model, lowest) for the autonomous one-output models (the high-gain observer's), with
+// X(Model, lowest) for the input-free one-output models (kInputs = 0, kOutputs = 1: those the
+// CLI builds high-gain observers for; a time-varying one is refused when built), with
 // lowest = max(2, n), the smallest order of their observability maps.
 #define NLOBS_FOR_EACH_AUTONOMOUS_SINGLE_OUTPUT_CATALOGUE_MODEL(X) \
   X(ModifiedChua, 3)                                               \

@@ -220,7 +220,8 @@ std::shared_ptr<ObservabilityMap> make_taylor_observability_map(
   return map;
 }
 
-// X(Model, N) for every order make_taylor_observability_map builds, from `lowest` = max(2, n).
+// X(Model, N) for every order make_taylor_observability_map builds, from `lowest` = max(2, n):
+// the extern declarations below and the instantiations in src/instances/ use the same list.
 #define NLOBS_TAYLOR_ORDERS_FROM_3(X, M) X(M, 3) X(M, 4) X(M, 5) X(M, 6) X(M, 7) X(M, 8)
 #define NLOBS_TAYLOR_ORDERS_FROM(X, M, lowest) NLOBS_TAYLOR_ORDERS_FROM_##lowest(X, M)
 #define NLOBS_TAYLOR_ORDERS_FROM_2(X, M) X(M, 2) NLOBS_TAYLOR_ORDERS_FROM_3(X, M)

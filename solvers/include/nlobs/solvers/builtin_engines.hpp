@@ -25,93 +25,97 @@ inline FiniteDifference parse_finite_difference(const std::string& v) {
 
 template <int N>
 void add_builtin_engines(EngineRegistry<N>& registry) {
-  registry.add({"picard", "x <- G(x)", {}, {"picard"}, [](EngineSpecReader&, SolverOptions o) {
-                  return std::make_unique<PicardEngine<N>>(std::move(o));
-                }});
-  registry.add({"aitken",
-                "component-wise Aitken delta^2 of the Picard sequence",
-                {},
-                {"aitken"},
-                [](EngineSpecReader&, SolverOptions o) {
-                  return std::make_unique<AitkenEngine<N>>(std::move(o));
-                }});
-  registry.add({"steffensen",
-                "Aitken restarted every three iterates",
-                {},
-                {"steffensen"},
-                [](EngineSpecReader&, SolverOptions o) {
-                  return std::make_unique<SteffensenEngine<N>>(std::move(o));
-                }});
-  registry.add({"anderson",
-                "Anderson acceleration (type II)",
-                {{"m", "depth >= 0; default 3"},
-                 {"damping", "beta in (0, 1]; default 1"},
-                 {"cond", "drop old columns above this condition estimate; default 1e8"}},
-                {"anderson", "anderson:m=3,damping=0.5"},
-                [](EngineSpecReader& s, SolverOptions o) {
-                  AndersonOptions a;
-                  if (auto v = s.integer("m")) a.depth = *v;
-                  if (auto v = s.number("damping")) a.damping = *v;
-                  if (auto v = s.number("cond")) a.condition_limit = *v;
-                  return std::make_unique<AndersonEngine<N>>(a, std::move(o));
-                }});
-  registry.add({"newton",
-                "Newton on F = G - x, any Jacobian source",
-                {{"linesearch", "0/1 Armijo backtracking; default 0"},
-                 {"fd", "forward|central differences when no Jacobian; default central"}},
-                {"newton", "newton:linesearch=1"},
-                [](EngineSpecReader& s, SolverOptions o) {
-                  NewtonOptions n;
-                  if (auto v = s.boolean("linesearch")) n.line_search = *v;
-                  if (auto v = s.text("fd"))
-                    n.finite_difference = detail::parse_finite_difference(*v);
-                  return std::make_unique<NewtonEngine<N>>(n, std::move(o));
-                }});
-  registry.add({"ceres",
-                "Ceres least squares, Levenberg-Marquardt or dogleg",
-                {{"<lm|dogleg>", "trust-region strategy; default lm"},
-                 {"backend", "auto|tiny|solver; default auto"},
-                 {"function_tol", "relative cost change; default 1e-10"},
-                 {"gradient_tol", "default 1e-12"},
-                 {"jacobi", "0/1 Jacobi scaling (solver backend); default 0"},
-                 {"nonmonotonic", "0/1 non-monotonic steps (solver backend); default 1"}},
-                {"ceres", "ceres:dogleg", "ceres:lm,backend=solver"},
-                [](EngineSpecReader& s, SolverOptions o) {
-                  CeresOptions c;
-                  if (auto w = s.word({"lm", "dogleg"}); w && *w == "dogleg") {
-                    c.method = CeresOptions::Method::kDogleg;
-                  }
-                  if (auto v = s.text("backend")) {
-                    if (*v == "auto")
-                      c.backend = CeresOptions::Backend::kAuto;
-                    else if (*v == "tiny")
-                      c.backend = CeresOptions::Backend::kTinySolver;
-                    else if (*v == "solver")
-                      c.backend = CeresOptions::Backend::kSolver;
-                    else
-                      throw InvalidInput("ceres: backend=" + *v + " is not auto, tiny or solver");
-                  }
-                  if (auto v = s.number("function_tol")) c.function_tolerance = *v;
-                  if (auto v = s.number("gradient_tol")) c.gradient_tolerance = *v;
-                  if (auto v = s.boolean("jacobi")) c.jacobi_scaling = *v;
-                  if (auto v = s.boolean("nonmonotonic")) c.nonmonotonic_steps = *v;
-                  return std::make_unique<CeresEngine<N>>(c, std::move(o));
-                }});
-  registry.add({"nlopt",
-                "NLopt minimisation of 1/2 |F|^2 (bounds through the C++ API)",
-                {{"<ALGORITHM>",
-                  "any NLopt name, e.g. LN_BOBYQA (default), LN_COBYLA, LD_SLSQP, "
-                  "LD_LBFGS, GN_DIRECT_L"},
-                 {"xtol_rel", "relative step tolerance; default off"},
-                 {"initial_step", "first step of derivative-free algorithms"}},
-                {"nlopt:LN_BOBYQA", "nlopt:LD_SLSQP"},
-                [](EngineSpecReader& s, SolverOptions o) {
-                  NloptOptions n;
-                  if (auto w = s.word()) n.algorithm = *w;
-                  if (auto v = s.number("xtol_rel")) n.relative_step_tolerance = *v;
-                  if (auto v = s.number("initial_step")) n.initial_step = *v;
-                  return std::make_unique<NloptEngine<N>>(n, std::move(o));
-                }});
+  // Idempotent: a name the registry already has an entry of (a second call, or the user's own
+  // entry under a built-in's name) is left as it is.
+  const auto add = [&registry](typename EngineRegistry<N>::Entry entry) {
+    if (!registry.has_entry(entry.name)) registry.add(std::move(entry));
+  };
+  add({"picard", "x <- G(x)", {}, {"picard"}, [](EngineSpecReader&, SolverOptions o) {
+         return std::make_unique<PicardEngine<N>>(std::move(o));
+       }});
+  add({"aitken",
+       "component-wise Aitken delta^2 of the Picard sequence",
+       {},
+       {"aitken"},
+       [](EngineSpecReader&, SolverOptions o) {
+         return std::make_unique<AitkenEngine<N>>(std::move(o));
+       }});
+  add({"steffensen",
+       "Aitken restarted every three iterates",
+       {},
+       {"steffensen"},
+       [](EngineSpecReader&, SolverOptions o) {
+         return std::make_unique<SteffensenEngine<N>>(std::move(o));
+       }});
+  add({"anderson",
+       "Anderson acceleration (type II)",
+       {{"m", "depth >= 0; default 3"},
+        {"damping", "beta in (0, 1]; default 1"},
+        {"cond", "drop old columns above this condition estimate; default 1e8"}},
+       {"anderson", "anderson:m=3,damping=0.5"},
+       [](EngineSpecReader& s, SolverOptions o) {
+         AndersonOptions a;
+         if (auto v = s.integer("m")) a.depth = *v;
+         if (auto v = s.number("damping")) a.damping = *v;
+         if (auto v = s.number("cond")) a.condition_limit = *v;
+         return std::make_unique<AndersonEngine<N>>(a, std::move(o));
+       }});
+  add({"newton",
+       "Newton on F = G - x, any Jacobian source",
+       {{"linesearch", "0/1 Armijo backtracking; default 0"},
+        {"fd", "forward|central differences when no Jacobian; default central"}},
+       {"newton", "newton:linesearch=1"},
+       [](EngineSpecReader& s, SolverOptions o) {
+         NewtonOptions n;
+         if (auto v = s.boolean("linesearch")) n.line_search = *v;
+         if (auto v = s.text("fd")) n.finite_difference = detail::parse_finite_difference(*v);
+         return std::make_unique<NewtonEngine<N>>(n, std::move(o));
+       }});
+  add({"ceres",
+       "Ceres least squares, Levenberg-Marquardt or dogleg",
+       {{"<lm|dogleg>", "trust-region strategy; default lm"},
+        {"backend", "auto|tiny|solver; default auto"},
+        {"function_tol", "relative cost change; default 1e-10"},
+        {"gradient_tol", "default 1e-12"},
+        {"jacobi", "0/1 Jacobi scaling (solver backend); default 0"},
+        {"nonmonotonic", "0/1 non-monotonic steps (solver backend); default 1"}},
+       {"ceres", "ceres:dogleg", "ceres:lm,backend=solver"},
+       [](EngineSpecReader& s, SolverOptions o) {
+         CeresOptions c;
+         if (auto w = s.word({"lm", "dogleg"}); w && *w == "dogleg") {
+           c.method = CeresOptions::Method::kDogleg;
+         }
+         if (auto v = s.text("backend")) {
+           if (*v == "auto")
+             c.backend = CeresOptions::Backend::kAuto;
+           else if (*v == "tiny")
+             c.backend = CeresOptions::Backend::kTinySolver;
+           else if (*v == "solver")
+             c.backend = CeresOptions::Backend::kSolver;
+           else
+             throw InvalidInput("ceres: backend=" + *v + " is not auto, tiny or solver");
+         }
+         if (auto v = s.number("function_tol")) c.function_tolerance = *v;
+         if (auto v = s.number("gradient_tol")) c.gradient_tolerance = *v;
+         if (auto v = s.boolean("jacobi")) c.jacobi_scaling = *v;
+         if (auto v = s.boolean("nonmonotonic")) c.nonmonotonic_steps = *v;
+         return std::make_unique<CeresEngine<N>>(c, std::move(o));
+       }});
+  add({"nlopt",
+       "NLopt minimisation of 1/2 |F|^2 (bounds through the C++ API)",
+       {{"<ALGORITHM>",
+         "any NLopt name, e.g. LN_BOBYQA (default), LN_COBYLA, LD_SLSQP, "
+         "LD_LBFGS, GN_DIRECT_L"},
+        {"xtol_rel", "relative step tolerance; default off"},
+        {"initial_step", "first step of derivative-free algorithms"}},
+       {"nlopt:LN_BOBYQA", "nlopt:LD_SLSQP"},
+       [](EngineSpecReader& s, SolverOptions o) {
+         NloptOptions n;
+         if (auto w = s.word()) n.algorithm = *w;
+         if (auto v = s.number("xtol_rel")) n.relative_step_tolerance = *v;
+         if (auto v = s.number("initial_step")) n.initial_step = *v;
+         return std::make_unique<NloptEngine<N>>(n, std::move(o));
+       }});
 }
 
 }  // namespace nlobs

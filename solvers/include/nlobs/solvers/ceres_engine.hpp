@@ -344,9 +344,9 @@ class CeresEngine : public Engine<N> {
   ceres::Solver::Summary ceres_summary_;
 };
 
-// Out of the class body, so that the library's explicit instantiations (below) are all an
-// includer of a library size compiles: in-class bodies are inline and GCC instantiates them
-// anyway, to inline them.
+// Out of the class body: GCC instantiates in-class (inline) bodies even of an extern template,
+// to inline them, so only out-of-class bodies let a file that uses a library size (extern
+// below) compile none of the engine.
 template <int N>
 Summary CeresEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
   detail::check_initial_guess(name(), problem, x);

@@ -9,13 +9,13 @@
 #include <utility>
 
 #include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/library_sizes.hpp"
 
 namespace nlobs {
 
+// At N = Dynamic it passes the problem through unchanged.
 template <int N>
 class DynamicSizeEngine final : public Engine<N> {
-  static_assert(N != Dynamic, "DynamicSizeEngine adapts a Dynamic engine to a fixed size");
-
  public:
   // Throws InvalidInput for a null engine.
   explicit DynamicSizeEngine(std::unique_ptr<Engine<Dynamic>> engine)
@@ -27,7 +27,19 @@ class DynamicSizeEngine final : public Engine<N> {
   bool least_squares() const override { return engine_->least_squares(); }
   Engine<Dynamic>& engine() { return *engine_; }
 
-  Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override {
+  Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
+
+  Summary solve_least_squares(const RootProblem<N, Dynamic>& problem, Vector<N>& x) override;
+
+ private:
+  std::unique_ptr<Engine<Dynamic>> engine_;
+};
+
+template <int N>
+Summary DynamicSizeEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
+  if constexpr (N == Dynamic) {
+    return engine_->solve(problem, x);
+  } else {
     detail::check_initial_guess(name(), problem, x);
     const auto g = [&problem](const Vector<Dynamic>& at, Vector<Dynamic>& out) {
       const Vector<N> point = at;
@@ -55,8 +67,14 @@ class DynamicSizeEngine final : public Engine<N> {
     if (xd.size() == N) x = xd;
     return s;
   }
+}
 
-  Summary solve_least_squares(const RootProblem<N, Dynamic>& problem, Vector<N>& x) override {
+template <int N>
+Summary DynamicSizeEngine<N>::solve_least_squares(const RootProblem<N, Dynamic>& problem,
+                                                  Vector<N>& x) {
+  if constexpr (N == Dynamic) {
+    return engine_->solve_least_squares(problem, x);
+  } else {
     detail::check_initial_guess(name(), problem.size(), x);
     const Index m = problem.residual_size();
     const auto f = [&problem, m](const Vector<Dynamic>& at, Vector<Dynamic>& out) {
@@ -73,17 +91,19 @@ class DynamicSizeEngine final : public Engine<N> {
         problem.jacobian(point, j);
         jac = j;
       };
-      s = engine_->solve_least_squares(RootProblem<Dynamic, Dynamic>::with_jacobian(f, df, N, m),
-                                       xd);
+      s = engine_->solve_least_squares(
+          RootProblem<Dynamic, Dynamic>::with_jacobian(f, df, N, m, problem.jacobian_source()), xd);
     } else {
       s = engine_->solve_least_squares(RootProblem<Dynamic, Dynamic>::from_map(f, N, m), xd);
     }
     if (xd.size() == N) x = xd;
     return s;
   }
+}
 
- private:
-  std::unique_ptr<Engine<Dynamic>> engine_;
-};
+// Compiled once in the library for its sizes (nlobs/solvers/library_sizes.hpp).
+#define NLOBS_EXTERN_DYNAMIC_SIZE_ENGINE(n) extern template class DynamicSizeEngine<n>;
+NLOBS_FOR_EACH_LIBRARY_SIZE(NLOBS_EXTERN_DYNAMIC_SIZE_ENGINE)
+#undef NLOBS_EXTERN_DYNAMIC_SIZE_ENGINE
 
 }  // namespace nlobs

@@ -32,7 +32,8 @@ template <int N>
 class EngineRegistry;
 
 // Adds the built-in engines (picard, aitken, steffensen, anderson, newton, ceres, nlopt) to
-// `registry`. Defined in builtin_engines.hpp; compiled in the library for its sizes.
+// `registry`, skipping names it already has. Defined in builtin_engines.hpp; compiled in the
+// library for its sizes.
 template <int N>
 void add_builtin_engines(EngineRegistry<N>& registry);
 
@@ -68,83 +69,28 @@ class EngineRegistry {
   }
 
   // Throws InvalidInput if the name is empty, malformed or taken, or the factory is empty.
-  void add(Entry entry) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (entry.name.empty() || entry.name.find_first_of(":,=") != std::string::npos) {
-      throw InvalidInput("engine name '" + entry.name + "' is empty or contains ':', ',' or '='");
-    }
-    if (entries_.count(entry.name)) {
-      throw InvalidInput("an engine named '" + entry.name + "' is already registered");
-    }
-    if (!entry.make) throw InvalidInput("engine '" + entry.name + "' has no factory");
-    const std::string name = entry.name;
-    entries_.emplace(name, std::move(entry));
-  }
+  void add(Entry entry);
 
   // Whether create() knows the name (here or, for a fixed N, at Dynamic).
   bool contains(const std::string& name) const { return find(name).has_value(); }
+  // Whether this registry has an entry of its own under the name (add() would refuse it).
+  bool has_entry(const std::string& name) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return entries_.count(name) > 0;
+  }
 
   // This registry's entries and, for a fixed N, those of EngineRegistry<Dynamic> it does not
   // shadow (their factories adapt the Dynamic engine); sorted by name.
-  std::vector<Entry> entries() const {
-    std::map<std::string, Entry> all;
-    if constexpr (N != Dynamic) {
-      for (auto& e : EngineRegistry<Dynamic>::global().entries()) {
-        std::string name = e.name;
-        all.emplace(std::move(name), adapt(std::move(e)));
-      }
-    }
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      for (const auto& [name, e] : entries_) all.insert_or_assign(name, e);
-    }
-    std::vector<Entry> out;
-    for (auto& [name, e] : all) out.push_back(std::move(e));
-    return out;
-  }
+  std::vector<Entry> entries() const;
 
-  std::vector<std::string> names() const {
-    std::vector<std::string> out;
-    for (const auto& e : entries()) out.push_back(e.name);
-    return out;
-  }
+  std::vector<std::string> names() const;
 
   // Builds the engine a spec names; `base` supplies stop criteria the spec does not set.
   // Throws InvalidInput for an unknown name (listing the valid ones) or option.
-  std::unique_ptr<Engine<N>> create(std::string_view spec_text, SolverOptions base = {}) const {
-    const EngineSpec spec = parse_engine_spec(spec_text);
-    std::optional<Entry> entry = find(spec.name);
-    if (!entry) {
-      std::string list;
-      for (const auto& name : names()) list += (list.empty() ? "" : ", ") + name;
-      throw InvalidInput("unknown engine '" + spec.name + "'; valid engines: " + list);
-    }
-    std::vector<EngineOptionInfo> valid = entry->options;
-    valid.insert(valid.end(), common_options().begin(), common_options().end());
-    EngineSpecReader reader(spec, valid);
-    if (auto v = reader.number("tol")) base.stop.step_tolerance = *v;
-    if (auto v = reader.number("ftol")) base.stop.residual_tolerance = *v;
-    if (auto v = reader.integer("max_iter")) base.stop.max_iterations = *v;
-    if (auto v = reader.integer("max_evals")) base.stop.max_evaluations = *v;
-    std::unique_ptr<Engine<N>> engine = entry->make(reader, std::move(base));
-    reader.finish();
-    if (!engine) throw InvalidInput("engine '" + spec.name + "': its factory returned no engine");
-    return engine;
-  }
+  std::unique_ptr<Engine<N>> create(std::string_view spec_text, SolverOptions base = {}) const;
 
  private:
-  std::optional<Entry> find(const std::string& name) const {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (auto it = entries_.find(name); it != entries_.end()) return it->second;
-    }
-    if constexpr (N != Dynamic) {
-      for (auto& e : EngineRegistry<Dynamic>::global().entries()) {
-        if (e.name == name) return adapt(std::move(e));
-      }
-    }
-    return std::nullopt;
-  }
+  std::optional<Entry> find(const std::string& name) const;
 
   // An entry of EngineRegistry<Dynamic> seen at size N.
   template <typename DynamicEntry>
@@ -154,7 +100,16 @@ class EngineRegistry {
             std::move(e.examples),
             [make = std::move(make)](EngineSpecReader& s,
                                      SolverOptions o) -> std::unique_ptr<Engine<N>> {
-              auto engine = make(s, std::move(o));
+              std::unique_ptr<Engine<Dynamic>> engine;
+              try {
+                engine = make(s, std::move(o));
+              } catch (const InvalidInput& refused) {
+                throw InvalidInput(
+                    std::string(refused.what()) + " (EngineRegistry<" + std::to_string(N) +
+                    "> serves this engine through its Dynamic entry; give size " +
+                    std::to_string(N) + " its own entry, for the built-ins add_builtin_engines<" +
+                    std::to_string(N) + ">() from builtin_engines.hpp)");
+              }
               if (!engine) return nullptr;
               return std::make_unique<DynamicSizeEngine<N>>(std::move(engine));
             }};
@@ -166,6 +121,82 @@ class EngineRegistry {
   mutable std::mutex mutex_;
   std::map<std::string, Entry> entries_;
 };
+
+template <int N>
+void EngineRegistry<N>::add(Entry entry) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (entry.name.empty() || entry.name.find_first_of(":,=") != std::string::npos) {
+    throw InvalidInput("engine name '" + entry.name + "' is empty or contains ':', ',' or '='");
+  }
+  if (entries_.count(entry.name)) {
+    throw InvalidInput("an engine named '" + entry.name + "' is already registered");
+  }
+  if (!entry.make) throw InvalidInput("engine '" + entry.name + "' has no factory");
+  const std::string name = entry.name;
+  entries_.emplace(name, std::move(entry));
+}
+
+template <int N>
+auto EngineRegistry<N>::entries() const -> std::vector<Entry> {
+  std::map<std::string, Entry> all;
+  if constexpr (N != Dynamic) {
+    for (auto& e : EngineRegistry<Dynamic>::global().entries()) {
+      std::string name = e.name;
+      all.emplace(std::move(name), adapt(std::move(e)));
+    }
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& [name, e] : entries_) all.insert_or_assign(name, e);
+  }
+  std::vector<Entry> out;
+  for (auto& [name, e] : all) out.push_back(std::move(e));
+  return out;
+}
+
+template <int N>
+std::vector<std::string> EngineRegistry<N>::names() const {
+  std::vector<std::string> out;
+  for (const auto& e : entries()) out.push_back(e.name);
+  return out;
+}
+
+template <int N>
+std::unique_ptr<Engine<N>> EngineRegistry<N>::create(std::string_view spec_text,
+                                                     SolverOptions base) const {
+  const EngineSpec spec = parse_engine_spec(spec_text);
+  std::optional<Entry> entry = find(spec.name);
+  if (!entry) {
+    std::string list;
+    for (const auto& name : names()) list += (list.empty() ? "" : ", ") + name;
+    throw InvalidInput("unknown engine '" + spec.name + "'; valid engines: " + list);
+  }
+  std::vector<EngineOptionInfo> valid = entry->options;
+  valid.insert(valid.end(), common_options().begin(), common_options().end());
+  EngineSpecReader reader(spec, valid);
+  if (auto v = reader.number("tol")) base.stop.step_tolerance = *v;
+  if (auto v = reader.number("ftol")) base.stop.residual_tolerance = *v;
+  if (auto v = reader.integer("max_iter")) base.stop.max_iterations = *v;
+  if (auto v = reader.integer("max_evals")) base.stop.max_evaluations = *v;
+  std::unique_ptr<Engine<N>> engine = entry->make(reader, std::move(base));
+  reader.finish();
+  if (!engine) throw InvalidInput("engine '" + spec.name + "': its factory returned no engine");
+  return engine;
+}
+
+template <int N>
+auto EngineRegistry<N>::find(const std::string& name) const -> std::optional<Entry> {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (auto it = entries_.find(name); it != entries_.end()) return it->second;
+  }
+  if constexpr (N != Dynamic) {
+    for (auto& e : EngineRegistry<Dynamic>::global().entries()) {
+      if (e.name == name) return adapt(std::move(e));
+    }
+  }
+  return std::nullopt;
+}
 
 // Compiled once in the library for its sizes (nlobs/solvers/library_sizes.hpp).
 #define NLOBS_EXTERN_ENGINE_REGISTRY(n)    \

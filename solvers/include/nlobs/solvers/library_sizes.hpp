@@ -1,8 +1,10 @@
 #pragma once
 // The compile-time sizes N for which the solvers library compiles the built-in engines and the
 // engine registry once (explicit instantiation in src/instances/): a file that uses them at
-// these sizes pays for parsing the headers, not for compiling the engines again. Any other
-// size works the same way and is compiled in the file that uses it, as any template.
+// these sizes pays for parsing the headers, not for compiling the engines again. An engine
+// named in code at any other size is compiled in the file that uses it, as any template; the
+// registry's built-in entries at another fixed size are the Dynamic engines adapted
+// (DynamicSizeEngine), unless add_builtin_engines<N> gave that size its own.
 #include "nlobs/solvers/types.hpp"
 
 // X(n) for each library size; -1 is nlobs::Dynamic.

@@ -138,13 +138,15 @@ class RootProblem {
     };
     return RootProblem(n, m, wrap(std::move(f)), std::move(df), JacobianSource::kAutoDiff);
   }
+  // `source` lets adapters that forward an AD Jacobian report it as such.
   template <typename F, typename DF>
-  static RootProblem with_jacobian(F f, DF df, Index n = N, Index m = M) {
+  static RootProblem with_jacobian(F f, DF df, Index n = N, Index m = M,
+                                   JacobianSource source = JacobianSource::kUserSupplied) {
     JacobianMap jm = [df = std::move(df), n, m](const VectorType& x, JacobianType& jac) mutable {
       if constexpr (N == Dynamic || M == Dynamic) jac.resize(m, n);
       detail::invoke_map(df, x, jac);
     };
-    return RootProblem(n, m, wrap(std::move(f)), std::move(jm), JacobianSource::kUserSupplied);
+    return RootProblem(n, m, wrap(std::move(f)), std::move(jm), source);
   }
 
   Index size() const { return n_; }
