@@ -32,7 +32,8 @@ void print_list(const std::string& what, std::ostream& out) {
   if (all || what == "observers") {
     out << "observers (scenario \"observers\" entries):\n"
         << "  window — any engine x output window: engine, tol, window (N; 0 = square), "
-           "warm_start (propagated|previous)\n"
+           "warm_start (propagated|previous), psi (auto|identity|newton|a number: the square "
+           "window's gain)\n"
         << "  luenberger — constant gain: gain (n x p)\n"
         << "  sliding_mode — Q, R (n x p), gamma (saturation boundary layer)\n"
         << "  ekf — extended Kalman filter, AD Jacobians: process_covariance, "

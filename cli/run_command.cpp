@@ -480,6 +480,24 @@ std::vector<double> parse_sweep_values(const std::string& key, const std::string
 
 namespace {
 
+// One colour and dash pattern per observer, the same in every plot of a run: line style
+// kFirstObserverStyle + o (the truth is black). Eight colours, then the same with dashes.
+constexpr long kFirstObserverStyle = 100;
+
+void define_observer_styles(std::ostream& g, long observers) {
+  static const char* const kColours[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e",
+                                         "#9467bd", "#8c564b", "#e377c2", "#17becf"};
+  for (long o = 0; o < observers; ++o) {
+    g << "set style line " << kFirstObserverStyle + o << " lc rgb '" << kColours[o % 8] << "' dt "
+      << 1 + (o / 8) % 5 << " lw 1.5\n";
+  }
+  g << "set style line 99 lc rgb 'black' lw 2\n";
+}
+
+std::string observer_style(long o) {
+  return " ls " + std::to_string(kFirstObserverStyle + o);
+}
+
 // PNG plots through gnuplot: estimates vs truth, errors, and the first window's convergence.
 std::vector<std::string> plot(const fs::path& dir, const Measurements& data, const RunResult& r,
                               const std::vector<std::string>& traced) {
@@ -488,8 +506,9 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
   const long observers = static_cast<long>(r.metrics.size());
   const long offset = data.has_truth() ? n : 0;
   std::ostringstream g;
-  g << "set datafile separator ','\nset key outside right\nset grid\nset termoption noenhanced\n"
-    << "set terminal pngcairo size 1200," << 300 * std::max<Eigen::Index>(n, 1) << "\n";
+  g << "set datafile separator ','\nset key outside right\nset grid\n"
+    << "set terminal pngcairo noenhanced size 1200," << 300 * std::max<Eigen::Index>(n, 1) << "\n";
+  define_observer_styles(g, observers);
   g << "set output '" << (dir / "states.png").string() << "'\nset multiplot layout " << n << ",1\n";
   for (Eigen::Index i = 0; i < n; ++i) {
     g << "set ylabel 'x" << i + 1 << "'\n";
@@ -502,26 +521,40 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
     }
     g << "plot ";
     if (data.has_truth())
-      g << "'trajectories.csv' using 1:" << i + 2 << " with lines lw 2 title 'true', ";
+      g << "'trajectories.csv' using 1:" << i + 2 << " with lines ls 99 title 'true', ";
     for (long o = 0; o < observers; ++o) {
-      g << "'trajectories.csv' using 1:" << 2 + offset + o * n + i << " with lines title '"
-        << r.metrics[static_cast<size_t>(o)].name << "'" << (o + 1 < observers ? ", " : "\n");
+      g << "'trajectories.csv' using 1:" << 2 + offset + o * n + i << " with lines"
+        << observer_style(o) << " title '" << r.metrics[static_cast<size_t>(o)].name << "'"
+        << (o + 1 < observers ? ", " : "\n");
     }
   }
   g << "unset multiplot\nset autoscale y\n";
   written.push_back("states.png");
   if (data.has_truth()) {
+    // Each panel from 1e-16 to 1e3 times the truth's scale (its range, or its size when it is
+    // constant): one diverging observer must not squeeze the others into a line. An observer
+    // whose error leaves the panel is drawn clipped and says so in its key entry.
     g << "set output '" << (dir / "errors.png").string() << "'\nset logscale y\n"
-      << "set multiplot layout " << n << ",1\n";
+      << "set format y '1e%L'\nset multiplot layout " << n << ",1\n";
     for (Eigen::Index i = 0; i < n; ++i) {
-      g << "set ylabel '|x" << i + 1 << " - xhat" << i + 1 << "|'\nplot ";
+      const double lo = data.x.row(i).minCoeff(), hi = data.x.row(i).maxCoeff();
+      const double size = std::max(std::abs(lo), std::abs(hi));
+      const double spread = std::max(hi - lo, 1e-3 * size);
+      const double scale = spread > 0.0 && std::isfinite(spread) ? spread : 1.0;
+      const double top = 1e3 * scale;
+      g << "set yrange [" << 1e-16 * scale << ":" << top << "]\nset ylabel '|x" << i + 1
+        << " - xhat" << i + 1 << "|'\nplot ";
       for (long o = 0; o < observers; ++o) {
+        const Eigen::ArrayXd error =
+            (data.x.row(i) - r.estimates[static_cast<size_t>(o)].row(i)).array().abs();
+        const bool left = !(error.isFinite().all() && error.maxCoeff() <= top);
         g << "'trajectories.csv' using 1:(abs($" << i + 2 << " - $" << 2 + offset + o * n + i
-          << ")+1e-16) with lines title '" << r.metrics[static_cast<size_t>(o)].name << "'"
+          << ")+1e-16) with lines" << observer_style(o) << " title '"
+          << r.metrics[static_cast<size_t>(o)].name << (left ? " (beyond the panel)" : "") << "'"
           << (o + 1 < observers ? ", " : "\n");
       }
     }
-    g << "unset multiplot\nunset logscale y\n";
+    g << "unset multiplot\nunset logscale y\nset format y '% h'\nset autoscale y\n";
     written.push_back("errors.png");
   }
   // Further signals of observers that publish them (PI banks: η̂, η̂₁ per channel, ...).
@@ -530,7 +563,7 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
     const auto& names = r.extra_names[o];
     if (names.empty()) continue;
     const std::string file = "signals_" + std::to_string(o + 1) + ".png";
-    g << "set terminal pngcairo size 1200," << 250 * names.size() << "\nset output '"
+    g << "set terminal pngcairo noenhanced size 1200," << 250 * names.size() << "\nset output '"
       << (dir / file).string() << "'\nset multiplot layout " << names.size() << ",1 title '"
       << r.metrics[o].name << "'\n";
     for (const auto& name : names) {
@@ -545,32 +578,38 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
        {std::pair<std::string, std::string>{"z_error", "||z - zhat||_2"},
         {"eta_error", "||eta - etahat||_2"}}) {
     std::vector<std::pair<long, std::string>> columns;
+    std::vector<long> style_of;  // the observer of each column
     for (size_t o = 0, c = static_cast<size_t>(2 + offset + observers * n);
          o < r.extra_names.size(); c += r.extra_names[o].size(), ++o) {
       const auto& names = r.extra_names[o];
       const auto at = std::find(names.begin(), names.end(), extra);
       if (at != names.end()) {
         columns.emplace_back(static_cast<long>(c) + (at - names.begin()), r.metrics[o].name);
+        style_of.push_back(static_cast<long>(o));
       }
     }
     if (columns.empty()) continue;
     const std::string file = extra + ".png";
-    g << "set terminal pngcairo size 1000,600\nset output '" << (dir / file).string()
+    g << "set terminal pngcairo noenhanced size 1000,600\nset output '" << (dir / file).string()
       << "'\nset logscale y\nset xlabel 't'\nset ylabel '" << label << "'\nplot ";
     for (size_t i = 0; i < columns.size(); ++i) {
-      g << "'trajectories.csv' using 1:($" << columns[i].first << "+1e-16) with lines title '"
-        << columns[i].second << "'" << (i + 1 < columns.size() ? ", " : "\n");
+      g << "'trajectories.csv' using 1:($" << columns[i].first << "+1e-16) with lines"
+        << observer_style(style_of[i]) << " title '" << columns[i].second << "'"
+        << (i + 1 < columns.size() ? ", " : "\n");
     }
     g << "unset logscale y\nunset xlabel\n";
     written.push_back(file);
   }
   if (!traced.empty()) {
-    g << "set datafile separator whitespace\nset terminal pngcairo size 1000,600\n"
+    g << "set datafile separator whitespace\nset terminal pngcairo noenhanced size 1000,600\n"
       << "set output '" << (dir / "first_window.png").string() << "'\nset logscale y\n"
       << "set xlabel 'iteration'\nset ylabel 'step norm (max)'\nplot ";
     for (size_t i = 0; i < traced.size(); ++i) {
-      g << "'first_window.dat' index " << i << " using 2:3 with linespoints title '" << traced[i]
-        << "'" << (i + 1 < traced.size() ? ", " : "\n");
+      long o = 0;  // the traced observer's index, for its style
+      while (o < observers && r.metrics[static_cast<size_t>(o)].name != traced[i]) ++o;
+      g << "'first_window.dat' index " << i << " using 2:3 with linespoints"
+        << observer_style(o < observers ? o : 0) << " title '" << traced[i] << "'"
+        << (i + 1 < traced.size() ? ", " : "\n");
     }
     written.push_back("first_window.png");
   }
@@ -682,7 +721,8 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
       }
       return text;
     };
-    g << "set terminal pngcairo size 1000,800\nset output '" << (dir / "sweep.png").string()
+    g << "set terminal pngcairo noenhanced size 1000,800\nset output '"
+      << (dir / "sweep.png").string()
       << "'\nset multiplot layout 2,1 title 'theta sweep: " << s.name << " (noise " << s.noise
       << ")'\nset logscale xy\nset grid\nset key outside right\n"
       << "set xlabel 'theta'\nset ylabel 'max ||zhat|| (peaking)'\nplot " << series(2, "")
@@ -769,6 +809,14 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
         << " observer steps" << std::flush;
   });
   if (printed) err << '\n';
+  // What the run itself found (a window map that does not contract, a singular guess).
+  for (const auto& o : observers) {
+    for (const auto& w : o->warnings()) {
+      if (std::find(warnings.begin(), warnings.end(), w) != warnings.end()) continue;
+      warnings.push_back(w);
+      err << "nlobs: warning: " << w << '\n';
+    }
+  }
   add_coordinate_errors(data, observers, r);
 
   std::vector<long> horizon_indices;  // the first sample with a full window, per observer

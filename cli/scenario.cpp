@@ -381,8 +381,20 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
       if (spec.warm_start != "propagated" && spec.warm_start != "previous") {
         o.fail("'warm_start' must be propagated or previous");
       }
+      if (o.has("psi") && o.json()["psi"].is_number()) {
+        spec.psi = "scalar";
+        spec.psi_scale = *o.number("psi");
+        if (!std::isfinite(spec.psi_scale) || spec.psi_scale == 0.0) {
+          o.fail("'psi' as a number (Psi = psi I) must be finite and nonzero");
+        }
+      } else {
+        spec.psi = o.text("psi").value_or("auto");
+        if (spec.psi != "auto" && spec.psi != "identity" && spec.psi != "newton") {
+          o.fail("'psi' must be auto, identity, newton or a number (got '" + spec.psi + "')");
+        }
+      }
       spec.initial = o.vector("initial");
-      o.finish({"type", "engine", "tol", "window", "warm_start", "initial"});
+      o.finish({"type", "engine", "tol", "window", "warm_start", "psi", "initial"});
     } else if (spec.type == "pi_bank") {
       spec.pi.bank = o.required_text("bank");
       PiBankInfo info;
@@ -538,6 +550,11 @@ nlohmann::json to_json(const Scenario& s) {
       if (o.tol) jo["tol"] = *o.tol;
       jo["window"] = o.window;
       jo["warm_start"] = o.warm_start;
+      if (o.psi == "scalar") {
+        jo["psi"] = o.psi_scale;
+      } else {
+        jo["psi"] = o.psi;
+      }
     } else if (o.type == "luenberger") {
       jo["gain"] = matrix_json(o.gain);
     } else if (o.type == "sliding_mode") {
@@ -636,10 +653,17 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& s, const A
           options.stop.residual_tolerance = *o.tol;
         }
         auto& registry = EngineRegistry<Dynamic>::global();
+        WindowEstimatorOptions window_options;
+        window_options.window = o.window;
+        window_options.warm_start =
+            o.warm_start == "previous" ? WarmStart::kPrevious : WarmStart::kPropagated;
+        window_options.gain = o.psi == "identity" ? WindowGain::kIdentity
+                              : o.psi == "newton" ? WindowGain::kNewton
+                              : o.psi == "scalar" ? WindowGain::kScalar
+                                                  : WindowGain::kAuto;
+        window_options.gain_scale = o.psi_scale;
         auto estimator = std::make_unique<WindowEstimator<AnyModel>>(
-            model, registry.create(o.engine, options), o.engine, start,
-            WindowEstimatorOptions{o.window, o.warm_start == "previous" ? WarmStart::kPrevious
-                                                                        : WarmStart::kPropagated});
+            model, registry.create(o.engine, options), o.engine, start, window_options);
         if (trace_first_window) {
           options.record_trace = true;
           estimator->set_first_window_engine(registry.create(o.engine, options));

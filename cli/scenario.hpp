@@ -29,6 +29,10 @@ struct ObserverSpec {
   std::optional<double> tol{};  // step and residual tolerance of the engine
   long window = 0;              // 0 = square
   std::string warm_start = "propagated";
+  // Ψ of a square window: "auto", "identity", "newton", or "scalar" with psi_scale (the JSON
+  // key "psi" holds the word or the number)
+  std::string psi = "auto";
+  double psi_scale = 1.0;
   // luenberger: gain (n×p); sliding_mode: Q, R (n×p), gamma
   Eigen::MatrixXd gain, q, r;
   double gamma = 1.0;

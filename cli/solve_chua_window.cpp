@@ -24,9 +24,8 @@ KinsolStrategy strategy_of(const std::string& name) {
 }
 
 std::string kinsol_status(const reference::KinsolResult& r) {
-  if (r.success) return "converged";
   if (r.flag_name == "KIN_MAXITER_REACHED") return "max_iterations";
-  std::string s = r.flag_name;
+  std::string s = r.status();
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
   return s;
 }

@@ -8,14 +8,18 @@
 #include <new>
 #include <vector>
 
+#include "nlobs/models/modified_chua.hpp"
 #include "nlobs/models/systems.hpp"
 #include "nlobs/observers/embedded_forms.hpp"
 #include "nlobs/observers/high_gain_observer.hpp"
 #include "nlobs/observers/modulating_function_observer.hpp"
 #include "nlobs/observers/mvt_observer.hpp"
 #include "nlobs/observers/pi_bank.hpp"
+#include "nlobs/observers/simulation.hpp"
 #include "nlobs/observers/taylor_observability_map.hpp"
+#include "nlobs/observers/window_estimator.hpp"
 #include "nlobs/solvers/ceres_engine.hpp"
+#include "nlobs/solvers/engine_registry.hpp"
 #include "nlobs/solvers/solvers.hpp"
 #include "reference/chua_window.hpp"
 
@@ -130,6 +134,44 @@ TEST(Allocations, PiBankStepAllocatesNothing) {
 
 // An MVT step with the per-row β search (secant, grid, TOMS 748, Brent) and RK4 on std::array
 // states: fixed-size work only, with ê far from zero so every β problem is solved.
+// A window-estimator step on the paper's Chua window, noisy data (so solves take iterations
+// and Ψ = newton refreshes now and then): nothing allocated, whatever Ψ and engine.
+TEST(Allocations, WindowEstimatorStepAllocatesNothing) {
+  using Chua = Discretized<ModifiedChua>;
+  SimulationOptions so;
+  so.steps = 200;
+  so.sample_time = 0.05;
+  so.noise_std = 0.01;
+  const Measurements data =
+      simulate(paper_modified_chua(), Eigen::Vector3d(1, 2.1428, -0.1648), so);
+  for (const char* engine : {"picard", "steffensen", "anderson", "newton"}) {
+    for (WindowGain gain : {WindowGain::kIdentity, WindowGain::kNewton}) {
+      SolverOptions solver;
+      solver.stop.step_tolerance = 1e-8;
+      solver.stop.residual_tolerance = 1e-8;
+      WindowEstimatorOptions options;
+      options.gain = gain;
+      WindowEstimator<Chua> estimator(paper_modified_chua(),
+                                      EngineRegistry<3>::global().create(engine, solver), engine,
+                                      Eigen::Vector3d(5.0, 10.0, -5.0), options);
+      const Eigen::VectorXd no_input(0);
+      Eigen::VectorXd y(1);
+      for (long k = 0; k < 10; ++k) {  // the first windows: Ψ chosen, workspaces sized
+        y = data.y.col(k);
+        estimator.step(k, y, no_input);
+      }
+      long solves = 0;
+      const long before = g_allocations.load();
+      for (long k = 10; k < data.steps(); ++k) {
+        y = data.y.col(k);
+        solves += estimator.step(k, y, no_input).summary.has_value();
+      }
+      EXPECT_EQ(g_allocations.load() - before, 0) << engine << " psi " << to_string(gain);
+      EXPECT_EQ(solves, data.steps() - 10);
+    }
+  }
+}
+
 TEST(Allocations, MvtStepWithPerRowBetaAllocatesNothing) {
   MvtOptions o;
   o.sample_time = 1e-3;

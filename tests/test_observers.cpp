@@ -224,7 +224,7 @@ TEST(Baselines, EkfOnALinearSystemIsTheKalmanFilter) {
   const Linear2 model;
   ExtendedKalmanFilter<Linear2> ekf(
       model, Eigen::Vector2d(0.0, 0.0),
-      {Eigen::Matrix2d::Identity() * 1e-8, Eigen::Matrix<double, 1, 1>(1e-6),
+      {Eigen::Matrix2d::Identity() * 1e-8, Eigen::MatrixXd::Constant(1, 1, 1e-6),
        Eigen::Matrix2d::Identity()});
   Eigen::Vector2d x(1.0, -1.0);
   double last = 0.0;

@@ -146,6 +146,57 @@ TEST(Run, ScenarioFileErrorsNameTheFileAndKey) {
   EXPECT_NE(error_of("no-such-scenario").find("neither a built-in scenario"), std::string::npos);
 }
 
+// Issue "estimates that never lock onto a wrong answer": Ψ from the scenario file, the
+// warnings a run finds, and failures that are never silent in the table and summary.json.
+TEST(Run, PsiRoundTripsAndBadValuesNameTheKey) {
+  nlohmann::json j = to_json(load_scenario("chua-fp"));
+  j["observers"][0]["psi"] = "newton";
+  j["observers"][1]["psi"] = 0.5;
+  const Scenario s = parse_scenario(j, "psi");
+  EXPECT_EQ(s.observers[0].psi, "newton");
+  EXPECT_EQ(s.observers[1].psi, "scalar");
+  EXPECT_EQ(s.observers[1].psi_scale, 0.5);
+  EXPECT_EQ(to_json(s), j);
+  const fs::path f = scratch("psi.json");
+  for (const nlohmann::json& bad : {nlohmann::json("chord"), nlohmann::json(0.0)}) {
+    j["observers"][1]["psi"] = bad;
+    write(f, j.dump());
+    const std::string e = error_of(f.string());
+    EXPECT_NE(e.find("observers[1]"), std::string::npos) << e;
+    EXPECT_NE(e.find("'psi'"), std::string::npos) << e;
+  }
+}
+
+TEST(Run, FailuresAndWarningsAreReported) {
+  // Lorenz from its equilibrium: the newton window warns of the singular guess; Picard with
+  // Ψ = I stagnates; an unstable Luenberger gain overflows. None of it is silent.
+  const fs::path f = scratch("failing.json");
+  write(f, R"({"name": "failing", "model": {"name": "lorenz", "scheme": "rk4", "step": 0.01},
+    "x0": [1, 1, 1], "initial_guess": [0, 0, 0], "steps": 300, "noise": 0.01, "seed": 7,
+    "observers": [{"type": "window", "engine": "newton", "tol": 1e-8},
+                  {"type": "window", "engine": "picard", "tol": 1e-8, "psi": 0.5},
+                  {"type": "luenberger", "gain": [[5], [3], [1]]}]})");
+  std::ostringstream out, err;
+  const fs::path dir = scratch("failing_out");
+  RunOptions o;
+  o.out_dir = dir.string();
+  run_scenario(f.string(), o, out, err);
+  EXPECT_NE(err.str().find("singular point of the window map"), std::string::npos) << err.str();
+  EXPECT_NE(out.str().find("first failure of window:picard: k = 2"), std::string::npos)
+      << out.str();
+  EXPECT_NE(out.str().find("first failure of luenberger"), std::string::npos) << out.str();
+  std::ifstream in(dir / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(in);
+  bool warned = false;
+  for (const auto& w : summary["warnings"]) {
+    warned = warned || w.get<std::string>().find("singular point") != std::string::npos;
+  }
+  EXPECT_TRUE(warned) << summary["warnings"];
+  const auto& luenberger = summary["observers"][2];
+  EXPECT_GT(luenberger["failures"]["non_finite_estimate"].get<int>(), 100);
+  EXPECT_NE(luenberger["first_failure"].get<std::string>().find("not finite"), std::string::npos);
+}
+
 TEST(Run, WindowLongerThanDataIsAnError) {
   EXPECT_NE(error_of("chua-fp", {.steps = 4}).find("window of 6 samples is longer than the data"),
             std::string::npos);

@@ -84,6 +84,7 @@ ReferenceResult solve_gsl(const std::string& method, const RootProblem<Dynamic>&
   for (size_t i = 0; i < n; ++i) x[static_cast<Eigen::Index>(i)] = gsl_vector_get(s.get()->x, i);
   result.f_evals = c.f_evals;
   result.j_evals = c.j_evals;
+  check_answer(problem, x, options, result);
   return result;
 }
 

@@ -7,7 +7,10 @@
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
 
+#include <cmath>
 #include <cstdlib>
+#include <limits>
+#include <sstream>
 #include <stdexcept>
 
 namespace nlobs::reference {
@@ -24,10 +27,12 @@ struct KinsolSolver::Impl {
   SUNLinearSolver linear_solver = nullptr;
   Eigen::VectorXd x_in, f_out;
   Eigen::MatrixXd jac_out;
+  long calls = 0;  // evaluations of F (or G), whoever asked
 
   static int residual(N_Vector u_vec, N_Vector f_vec, void* data) {
     auto* self = static_cast<Impl*>(data);
     self->x_in = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(u_vec), self->n);
+    ++self->calls;
     self->function(self->x_in, self->f_out);
     Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(f_vec), self->n) = self->f_out;
     return self->f_out.allFinite() ? 0 : 1;  // > 0: recoverable error
@@ -100,16 +105,42 @@ KinsolResult KinsolSolver::solve(Eigen::VectorXd& x) {
   const int strategy =
       s.options.strategy == KinsolStrategy::kNewtonLineSearch ? KIN_LINESEARCH : KIN_FP;
   KinsolResult r;
+  s.calls = 0;
   r.flag = KINSol(s.kinsol, s.u, strategy, s.scale, s.scale);
-  r.success = r.flag >= 0;
   char* name = KINGetReturnFlagName(r.flag);
   r.flag_name = name ? name : "?";
   free(name);
   KINGetNumNonlinSolvIters(s.kinsol, &r.iterations);
-  KINGetNumFuncEvals(s.kinsol, &r.evaluations);
   if (s.linear_solver) KINGetNumJacEvals(s.kinsol, &r.jacobian_evaluations);
   x = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(s.u), s.n);
+  // Judge the returned point ourselves (one more evaluation, counted).
+  r.residual = std::numeric_limits<double>::infinity();
+  if (x.allFinite()) {
+    ++s.calls;
+    s.function(x, s.f_out);
+    const bool fixed_point = s.options.strategy != KinsolStrategy::kNewtonLineSearch;
+    if (s.f_out.allFinite()) {
+      r.residual = (fixed_point ? Eigen::VectorXd(s.f_out - x) : s.f_out).lpNorm<Eigen::Infinity>();
+    }
+  }
+  r.evaluations = s.calls;
+  r.success = r.flag >= 0 && r.residual <= s.options.tolerance;
+  if (r.flag >= 0 && !r.success) {
+    std::ostringstream os;
+    if (!x.allFinite()) {
+      os << "returned a point that is not finite";
+    } else {
+      os << "|F| " << r.residual << " > tolerance " << s.options.tolerance;
+    }
+    r.reason = os.str();
+  }
   return r;
+}
+
+std::string KinsolResult::status() const {
+  if (success) return "converged";
+  if (flag >= 0) return std::isfinite(residual) ? "residual_above_tolerance" : "non_finite";
+  return flag_name;
 }
 
 std::string KinsolSolver::name(KinsolStrategy strategy) {

@@ -26,10 +26,24 @@ struct KinsolOptions {
 struct KinsolResult {
   int flag = 0;           // KINSol's return flag
   std::string flag_name;  // KINGetReturnFlagName
-  bool success = false;   // flag >= 0 (KIN_SUCCESS, KIN_INITIAL_GUESS_OK, KIN_STEP_LT_STPTOL)
+  // flag >= 0 (KIN_SUCCESS, KIN_INITIAL_GUESS_OK, KIN_STEP_LT_STPTOL) and the returned u is
+  // finite with ‖F(u)‖∞ ≤ tolerance (‖G(u) − u‖∞ for FP), checked by one more evaluation:
+  // KINSOL's fixed-point iteration reports KIN_SUCCESS on a step test alone, even for a u that
+  // overflowed or is NaN.
+  bool success = false;
+  // Why success is false although flag >= 0: "returned a point that is not finite" or
+  // "|F| 300 > tolerance 1e-08".
+  std::string reason;
+  double residual = 0.0;  // ‖F(u)‖∞ (‖G(u) − u‖∞ for FP) at the returned u
   long iterations = 0;    // KINGetNumNonlinSolvIters
-  long evaluations = 0;   // KINGetNumFuncEvals
+  // Every evaluation of F (or G): KINSOL's own, those of its difference-quotient Jacobian
+  // (KINGetNumFuncEvals leaves them out) and the final check above, counted at the callback,
+  // so the column compares with our engines' function_evaluations.
+  long evaluations = 0;
   long jacobian_evaluations = 0;  // KINGetNumJacEvals (Newton only)
+  // "converged", "non_finite" or "residual_above_tolerance" (flag >= 0 that does not stand),
+  // else KINSOL's flag name (KIN_MAXITER_REACHED, ...).
+  std::string status() const;
 };
 
 class KinsolSolver {

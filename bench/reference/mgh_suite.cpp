@@ -51,7 +51,7 @@ Outcome run_reference(const std::string& solver, const MghCase& c, Eigen::Vector
         c.n, ko, [p](const Eigen::VectorXd& v, Eigen::VectorXd& f) { p->evaluate(v, f); },
         [p](const Eigen::VectorXd& v, Eigen::MatrixXd& j) { p->jacobian(v, j); });
     const KinsolResult r = solver_k.solve(x);
-    out = {r.success ? "converged" : r.flag_name, r.evaluations, r.jacobian_evaluations};
+    out = {r.status(), r.evaluations, r.jacobian_evaluations};
   }
   return out;
 }

@@ -65,6 +65,7 @@ ReferenceResult solve_minpack_hybrj(const RootProblem<Dynamic>& problem, Eigen::
     default:
       result.status = info < 0 ? "non_finite" : "improper_input";
   }
+  check_answer(problem, x, options, result);
   return result;
 }
 

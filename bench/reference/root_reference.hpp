@@ -2,6 +2,8 @@
 // Established square-system solvers run on the same RootProblem as our engines, with the same
 // analytic (AD) Jacobian: MINPACK hybrj, GSL hybridsj and gnewton. (KINSOL: kinsol_solver.hpp.)
 #include <Eigen/Core>
+#include <cmath>
+#include <sstream>
 #include <string>
 
 #include "nlobs/solvers/problem.hpp"
@@ -17,7 +19,30 @@ struct ReferenceResult {
 struct ReferenceOptions {
   double tolerance = 1e-10;  // hybrj: xtol; GSL: residual test sum|F_i| < tol and step test
   long max_evaluations = 10000;
+  // A solver's "converged" stands only for a finite point with ‖F‖∞ ≤ residual_tolerance
+  // (checked by one more evaluation, counted): hybrj's xtol test and GSL's step test stop on
+  // the step alone.
+  double residual_tolerance = 1e-8;
 };
+
+// The check above: evaluates F at the returned x (counted in f_evals) and replaces a
+// "converged" that does not stand by "non_finite" or "residual_above_tolerance".
+inline void check_answer(const RootProblem<Dynamic>& problem, const Eigen::VectorXd& x,
+                         const ReferenceOptions& options, ReferenceResult& result) {
+  if (!x.allFinite()) {
+    if (result.status == "converged") result.status = "non_finite";
+    return;
+  }
+  Eigen::VectorXd f(problem.residual_size());
+  problem.evaluate(x, f);
+  ++result.f_evals;
+  if (result.status != "converged") return;
+  if (!f.allFinite()) {
+    result.status = "non_finite";
+  } else if (!(f.lpNorm<Eigen::Infinity>() <= options.residual_tolerance)) {
+    result.status = "residual_above_tolerance";
+  }
+}
 
 // MINPACK hybrj (Powell hybrid method, user Jacobian), through cminpack.
 ReferenceResult solve_minpack_hybrj(const RootProblem<Dynamic>& problem, Eigen::VectorXd& x,

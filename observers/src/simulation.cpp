@@ -1,6 +1,7 @@
 #include "nlobs/observers/simulation.hpp"
 
 #include <algorithm>
+#include <sstream>
 
 namespace nlobs {
 namespace {
@@ -81,10 +82,30 @@ RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Ob
       if (estimate.rows() == 0) estimate.resize(s.estimate.size(), steps);
       estimate.col(k) = s.estimate;
       if (extras.rows() > 0) extras.col(k) = s.extras;
+      // The first failing step's reason: the engine's (status, message, why not used) before
+      // the observer's own, which often follows from it. Built once.
+      const auto note_first = [&](const auto& why) {
+        if (!m.first_failure.empty()) return;
+        std::ostringstream os;
+        os << "k = " << k;
+        if (data.t.size() == data.steps()) os << " (t = " << data.t[k] << ")";
+        os << ": " << why();
+        m.first_failure = os.str();
+      };
+      if (s.summary && !s.summary->usable()) {
+        if (s.summary->converged()) ++m.failures["unusable"];
+        note_first([&] {
+          return s.summary->brief_report() + "; not used: " + s.summary->unusable_reason();
+        });
+      }
       if (s.measurement_missing) ++m.failures["missing_measurement"];
       if (!s.failure.empty()) {
         ++m.failures[s.failure];
-        if (m.first_failure.empty()) m.first_failure = s.failure_message;
+        note_first([&] { return s.failure_message.empty() ? s.failure : s.failure_message; });
+      }
+      if (!s.estimate.allFinite()) {
+        ++m.failures["non_finite_estimate"];
+        note_first([&] { return m.name + ": the estimate is not finite"; });
       }
       if (s.summary) {
         ++m.solves;

@@ -40,6 +40,9 @@ void validate(const StopCriteria& c) {
   if (!(c.divergence_limit > 0.0)) {
     fail("divergence_limit", c.divergence_limit, "must be > 0 (may be +inf to disable)");
   }
+  if (!(std::isfinite(c.acceptance_tolerance) && c.acceptance_tolerance > 0.0)) {
+    fail("acceptance_tolerance", c.acceptance_tolerance, "must be finite and > 0");
+  }
   if (c.max_iterations < 1) fail("max_iterations", c.max_iterations, "must be >= 1");
   if (c.max_evaluations < 1) fail("max_evaluations", c.max_evaluations, "must be >= 1");
   if (!c.step_tolerance && !c.residual_tolerance && !c.error_tolerance &&

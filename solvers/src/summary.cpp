@@ -1,5 +1,6 @@
 #include "nlobs/solvers/summary.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -13,7 +14,59 @@ std::string sci(double v) {
   return buf;
 }
 
+bool cut_short(Status s) {
+  return s == Status::kMaxIterations || s == Status::kMaxEvaluations || s == Status::kStagnated ||
+         s == Status::kRepeatedIterates;
+}
+
 }  // namespace
+
+// Allocation-free: observers call it at every step.
+bool Summary::usable() const {
+  if (!point_finite || std::isinf(residual_norm)) return false;
+  const bool judged = !residual_minimised && std::isfinite(residual_norm);
+  // Small enough to use: the tolerance asked for, or acceptance_tolerance if that is looser.
+  const double small = std::max(residual_tolerance.value_or(0.0), acceptance_tolerance);
+  if (status == Status::kConverged) return !(judged && residual_tolerance && residual_norm > small);
+  if (cut_short(status)) return judged && residual_norm <= small;
+  return false;
+}
+
+std::string Summary::unusable_reason() const {
+  if (usable()) return {};
+  const std::string status_name(to_string(status));
+  const std::string detail = message.empty() ? "" : " (" + message + ")";
+  if (status != Status::kConverged && !cut_short(status)) {
+    return message.empty() ? status_name : status_name + ": " + message;
+  }
+  if (!point_finite) return status_name + ": the returned point is not finite";
+  if (std::isinf(residual_norm)) return status_name + ": |F| is not finite";
+  const bool judged = !residual_minimised && std::isfinite(residual_norm);
+  const double small = std::max(residual_tolerance.value_or(0.0), acceptance_tolerance);
+  switch (status) {
+    case Status::kConverged:
+      if (judged && residual_tolerance && residual_norm > small) {
+        return "converged by its step with |F| " + sci(residual_norm) + " > " +
+               (small == *residual_tolerance ? "residual_tolerance " : "acceptance_tolerance ") +
+               sci(small);
+      }
+      return {};
+    case Status::kMaxIterations:
+    case Status::kMaxEvaluations:
+    case Status::kStagnated:
+    case Status::kRepeatedIterates:
+      if (!judged)
+        return status_name + " at a point whose residual does not show a solution" + detail;
+      if (residual_norm > small) {
+        return status_name + " with |F| " + sci(residual_norm) + " > " +
+               (small == acceptance_tolerance ? "acceptance_tolerance " : "residual_tolerance ") +
+               sci(small) + detail;
+      }
+      return {};
+    default:
+      return message.empty() ? status_name : status_name + ": " + message;
+  }
+}
 
 std::string Summary::brief_report() const {
   std::ostringstream os;

@@ -28,7 +28,8 @@ inline void require_shape(const char* who, const char* what, const Eigen::Matrix
 
 }  // namespace detail
 
-// x̂⁺ = f(x̂, u, k) + L (y − h(x̂)), constant gain L (n × p).
+// x̂⁺ = f(x̂, u, k) + L (y − h(x̂)), constant gain L (n × p). A next estimate that is not finite
+// (an unstable gain, a model that overflows) is not taken: the step says so, x̂ stays.
 template <DiscreteModel Model>
 class LuenbergerObserver final : public Observer {
  public:
@@ -42,10 +43,12 @@ class LuenbergerObserver final : public Observer {
   void reset() override { x_ = initial_; }
   const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
     step_.estimate = x_;
+    step_.failure.clear();
+    step_.failure_message.clear();
     step_.measurement_missing = !y.allFinite();
     Eigen::VectorXd next = f(x_, u, k);
     if (!step_.measurement_missing) next += gain_ * (y - h(x_));
-    x_ = next;
+    accept_finite(next, x_, step_, name(), k);  // an unstable gain L overflows: say so
     return step_;
   }
 
@@ -87,6 +90,8 @@ class SlidingModeObserver final : public Observer {
   void reset() override { x_ = initial_; }
   const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
     step_.estimate = x_;
+    step_.failure.clear();
+    step_.failure_message.clear();
     step_.measurement_missing = !y.allFinite();
     Eigen::VectorXd next = model_.f(ModelVector<double, Model::kStates>(x_),
                                     ModelVector<double, Model::kInputs>(u), k);
@@ -95,7 +100,7 @@ class SlidingModeObserver final : public Observer {
           y - Eigen::VectorXd(model_.h(ModelVector<double, Model::kStates>(x_)));
       next += q_ * e + r_ * (e / gamma_).cwiseMax(-1.0).cwiseMin(1.0);
     }
-    x_ = next;
+    accept_finite(next, x_, step_, name(), k);
     return step_;
   }
 
@@ -110,6 +115,8 @@ class SlidingModeObserver final : public Observer {
 // Extended Kalman filter with Jacobians of f and h by forward-mode AD (ceres::Jet):
 //   update with y_k:  K = P Hᵀ (H P Hᵀ + R)⁻¹, x̂ ← x̂ + K (y − h(x̂)), P ← (I − K H) P (I − K H)ᵀ + K
 //   R Kᵀ report x̂_k, then predict: x̂ ← f(x̂, u_k, k), P ← F P Fᵀ + Q.
+// An update or prediction that is not finite is not taken (the step says so): the estimate
+// keeps its last finite value, and a non-finite predicted covariance restarts from P0.
 struct EkfOptions {
   Eigen::MatrixXd process_covariance;      // Q (n × n); empty: 1e-6 I
   Eigen::MatrixXd measurement_covariance;  // R (p × p); empty: 1e-4 I
@@ -154,6 +161,8 @@ class ExtendedKalmanFilter final : public Observer {
   }
   const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
     const Eigen::Index n = model_.states();
+    step_.failure.clear();
+    step_.failure_message.clear();
     step_.measurement_missing = !y.allFinite();
     if (!step_.measurement_missing) {
       Eigen::MatrixXd hj;
@@ -163,18 +172,30 @@ class ExtendedKalmanFilter final : public Observer {
       const Eigen::VectorXd innovation =
           y - Eigen::VectorXd(model_.h(ModelVector<double, Model::kStates>(x_)));
       const Eigen::VectorXd updated = x_ + gain * innovation;
-      if (updated.allFinite()) {
-        const Eigen::MatrixXd ikh = Eigen::MatrixXd::Identity(n, n) - gain * hj;
+      const Eigen::MatrixXd ikh = Eigen::MatrixXd::Identity(n, n) - gain * hj;
+      const Eigen::MatrixXd covariance =
+          ikh * p_ * ikh.transpose() + gain * r_ * gain.transpose();  // Joseph form
+      if (updated.allFinite() && covariance.allFinite()) {
         x_ = updated;
-        p_ = ikh * p_ * ikh.transpose() + gain * r_ * gain.transpose();  // Joseph form
+        p_ = covariance;
+      } else {
+        predicted_failure(k, "the measurement update", "kept the last finite estimate");
       }
     }
     step_.estimate = x_;
     Eigen::MatrixXd fj;
     jacobian_f(x_, u, k, fj);
-    x_ = model_.f(ModelVector<double, Model::kStates>(x_), ModelVector<double, Model::kInputs>(u),
-                  k);
-    p_ = fj * p_ * fj.transpose() + q_;
+    const Eigen::VectorXd predicted = model_.f(ModelVector<double, Model::kStates>(x_),
+                                               ModelVector<double, Model::kInputs>(u), k);
+    const Eigen::MatrixXd covariance = fj * p_ * fj.transpose() + q_;
+    if (accept_finite(predicted, x_, step_, name(), k, "the predicted state")) {
+      if (covariance.allFinite()) {
+        p_ = covariance;
+      } else {  // restart the covariance from P0 so that the filter can re-acquire
+        predicted_failure(k, "the predicted covariance P", "P restarts from P0");
+        p_ = p0_;
+      }
+    }
     return step_;
   }
 
@@ -200,6 +221,13 @@ class ExtendedKalmanFilter final : public Observer {
     autodiff_jacobian<Model::kStates, Model::kOutputs>(h, ModelVector<double, Model::kStates>(x),
                                                        jac);
     j = jac;
+  }
+
+  void predicted_failure(long k, const char* what, const char* action) {
+    step_.failure = "non_finite_estimate";
+    std::ostringstream os;
+    os << name() << ": " << what << " at sample k = " << k << " is not finite; " << action;
+    step_.failure_message = os.str();
   }
 
   Model model_;

@@ -33,8 +33,12 @@ class FiniteDifferenceObserver final : public Observer {
     filled_ = 0;
     step_.estimate = Eigen::VectorXd::Zero(n_);
     step_.ready = false;
+    step_.failure.clear();
+    step_.failure_message.clear();
   }
-  const ObserverStep& step(long, const Eigen::VectorXd& y, const Eigen::VectorXd&) override {
+  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd&) override {
+    step_.failure.clear();
+    step_.failure_message.clear();
     step_.measurement_missing = !(y.size() == 1 && std::isfinite(y[0]));
     if (step_.measurement_missing) {  // the differences restart after a gap
       filled_ = 0;
@@ -49,12 +53,14 @@ class FiniteDifferenceObserver final : public Observer {
     // ∇ⁱ y_k from the newest n samples: repeated differences, newest first.
     differences_ = history_;
     double scale = 1.0;
-    step_.estimate[0] = differences_[0];
+    estimate_.resize(n_);
+    estimate_[0] = differences_[0];
     for (Eigen::Index i = 1; i < n_; ++i) {
       for (Eigen::Index m = 0; m + i < n_; ++m) differences_[m] -= differences_[m + 1];
       scale *= delta_;
-      step_.estimate[i] = differences_[0] / scale;
+      estimate_[i] = differences_[0] / scale;
     }
+    accept_finite(estimate_, step_.estimate, step_, name_, k, "the differences");  // huge y
     return step_;
   }
 
@@ -62,7 +68,7 @@ class FiniteDifferenceObserver final : public Observer {
   Eigen::Index n_;
   double delta_;
   std::string name_;
-  Eigen::VectorXd history_, differences_;
+  Eigen::VectorXd history_, differences_, estimate_;
   Eigen::Index filled_ = 0;
   ObserverStep step_;
 };

@@ -649,6 +649,10 @@ void HighGainObserver<Model>::project(double t) {
   if (lie_alpha_) update_weight();
 }
 
+// The projection is a best fit, min ‖q_N(x) − ẑ‖, not a root: ẑ is off the image of q_N between
+// samples, so Summary::usable() (a root's residual) does not apply. A few warm-started
+// iterations improve x̂ whatever the status; project() keeps x̂ when the answer is not finite
+// and publishes the fit's residual.
 template <ContinuousModel Model>
 auto HighGainObserver<Model>::solve_projection(Vector<n> x) -> State {
   try {

@@ -324,8 +324,15 @@ class ModulatingFunctionObserver final : public Observer {
       // The first estimate replaces the guess: no extrapolation across that jump.
       if (!ever_ready_) eta_previous_ = eta_;
       ever_ready_ = true;
-      xhat_ = form_.state(t, eta_);
-      step_.estimate = xhat_;
+      const State x = form_.state(t, eta_);
+      if (x.allFinite()) {
+        xhat_ = x;
+        step_.estimate = xhat_;
+      } else {
+        step_.failure = "non_finite_estimate";
+        step_.failure_message =
+            options_.name + ": the state of eta at t = " + fmt(t) + " is not finite; estimate kept";
+      }
     }  // not ready: η̂ stays the guess before the first horizon, the last estimate after
     if (every_ != 0) rate_ = predictor_rate(t, yhat_, eta_, u);
     publish();

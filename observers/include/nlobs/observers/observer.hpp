@@ -4,6 +4,7 @@
 // own (possibly fixed-size) state inside.
 #include <Eigen/Core>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -12,12 +13,13 @@
 namespace nlobs {
 
 struct ObserverStep {
-  Eigen::VectorXd estimate;          // x̂_k
+  Eigen::VectorXd estimate;          // x̂_k; finite (accept_finite() keeps it so)
   bool ready = true;                 // false while a window fills (the estimate coasts on f)
   bool measurement_missing = false;  // y_k had a non-finite entry: skipped, estimate coasts
   std::optional<Summary> summary;    // the engine's summary when this step solved a window
   Eigen::VectorXd extras;  // further named signals (extra_names()), e.g. η̂₁ of a PI bank
-  std::string failure;     // empty, or why this step kept the last good state (e.g. "non_finite")
+  // Empty, or why this step kept the last good state ("non_finite", "non_finite_estimate", …).
+  std::string failure;
   std::string failure_message;  // what and where, for the report
 };
 
@@ -52,5 +54,23 @@ class Observer {
     return step(k, y, u);
   }
 };
+
+// The one rule for an observer's own state: `next` replaces `state` only when it is finite;
+// otherwise the state keeps its last finite value and the step says so (failure
+// "non_finite_estimate", with who, k and what overflowed). Returns whether `next` was taken.
+template <typename State>
+bool accept_finite(const State& next, State& state, ObserverStep& step, const std::string& who,
+                   long k, const char* what = "the next estimate") {
+  if (next.allFinite()) {
+    state = next;
+    return true;
+  }
+  step.failure = "non_finite_estimate";
+  std::ostringstream os;
+  os << who << ": " << what << " at sample k = " << k
+     << " is not finite; kept the last finite estimate";
+  step.failure_message = os.str();
+  return false;
+}
 
 }  // namespace nlobs

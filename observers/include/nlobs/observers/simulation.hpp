@@ -1,9 +1,9 @@
 #pragma once
 // The simulation harness: simulate the true system from x0 (stopping with a clear message if
-// it leaves its domain), add seeded Gaussian measurement noise, run several observers side by
-// side on identical measurements, and measure them: per-state MSE (paper eq. 92) over the
-// whole run and after the window has filled, iterations and evaluations per step (mean, max,
-// first window), time per step, failures counted by status.
+// it leaves its domain or its state or output becomes non-finite), add seeded Gaussian measurement
+// noise, run several observers side by side on identical measurements, and measure them: per-state
+// MSE (paper eq. 92) over the whole run and after the window has filled, iterations and evaluations
+// per step (mean, max, first window), time per step, failures counted by status.
 #include <Eigen/Core>
 #include <chrono>
 #include <cmath>
@@ -63,7 +63,20 @@ Measurements simulate(const Model& model, const Eigen::VectorXd& x0, const Simul
   std::normal_distribution<double> noise(0.0, 1.0);
   ModelVector<double, Model::kStates> x = x0;
   for (long k = 0; k < o.steps; ++k) {
-    const std::string violation = domain_violation_of(model, x);
+    // Stop where the state leaves its domain or the state or its output is no longer finite:
+    // a NaN measurement must never reach the observers.
+    std::string violation = domain_violation_of(model, x);
+    Eigen::VectorXd y;
+    if (violation.empty() && !x.allFinite()) {
+      std::ostringstream os;
+      os << "the true state is not finite (x = [" << x.transpose()
+         << "]): the model overflowed or left its domain";
+      violation = os.str();
+    }
+    if (violation.empty()) {
+      y = model.h(x);
+      if (!y.allFinite()) violation = "the output h(x) is not finite";
+    }
     if (!violation.empty()) {
       std::ostringstream os;
       os << "stopped at sample " << k << " (t = " << static_cast<double>(k) * o.sample_time
@@ -80,7 +93,6 @@ Measurements simulate(const Model& model, const Eigen::VectorXd& x0, const Simul
     data.x.col(k) = x;
     data.t[k] = static_cast<double>(k) * o.sample_time;
     data.u.col(k) = u;
-    Eigen::VectorXd y = model.h(x);
     if (o.noise_std > 0.0) {
       for (Eigen::Index i = 0; i < p; ++i) y[i] += o.noise_std * noise(rng);
     }
@@ -101,10 +113,15 @@ struct ObserverMetrics {
   double evaluations_mean = 0.0;
   double ns_per_step = 0.0;
   int solves = 0;
-  std::map<std::string, int>
-      failures;  // status name → count (solves not converged, missing samples)
+  // Failure name → count: the status of every solve that did not converge, "unusable" for a
+  // converged solve whose Summary is not usable(), ObserverStep::failure of every step that set
+  // one, "missing_measurement", and "non_finite_estimate" for every non-finite estimate that
+  // reached the harness (the built-in observers never publish one).
+  std::map<std::string, int> failures;
   std::optional<Summary> first_window;  // with its trace when the engine records one
-  std::string first_failure;            // the first ObserverStep::failure_message, if any
+  // Why the first failing step failed, with its k and t: the engine's status and message of
+  // an unusable solve, an observer's ObserverStep::failure_message, or a non-finite estimate.
+  std::string first_failure;
 };
 
 struct RunResult {

@@ -56,6 +56,7 @@ class AcceleratedEngine : public Engine<N> {
   }
 
   std::string_view name() const override { return accelerator_.name(); }
+  bool needs_contraction() const override { return true; }
   Accelerator& accelerator() { return accelerator_; }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
@@ -136,6 +137,7 @@ Summary AcceleratedEngine<N, Accelerator>::solve(const FixedPointProblem<N>& pro
   summary.status = *status;
   summary.function_evaluations = evaluations;
   monitor.fill(summary, residual);
+  summary.record_answer(x, opt.stop);
   return summary;
 }
 

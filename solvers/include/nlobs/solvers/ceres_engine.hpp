@@ -183,6 +183,8 @@ class CeresEngine : public Engine<N> {
     s.step_norm = w.last_step;
     s.residual_norm = w.f.allFinite() ? w.f.template lpNorm<Eigen::Infinity>()
                                       : std::numeric_limits<double>::infinity();
+    // An overdetermined F keeps a residual at its least-squares point.
+    s.record_answer(x, this->options_.stop, source.residual_size() > source.size());
     return s;
   }
 

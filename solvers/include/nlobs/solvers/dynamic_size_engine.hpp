@@ -25,6 +25,7 @@ class DynamicSizeEngine final : public Engine<N> {
 
   std::string_view name() const override { return engine_->name(); }
   bool least_squares() const override { return engine_->least_squares(); }
+  bool needs_contraction() const override { return engine_->needs_contraction(); }
   Engine<Dynamic>& engine() { return *engine_; }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
@@ -64,7 +65,12 @@ Summary DynamicSizeEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<
     } else {
       s = engine_->solve(FixedPointProblem<Dynamic>::from_map(g, N), xd);
     }
-    if (xd.size() == N) x = xd;
+    if (xd.size() == N) {
+      x = xd;
+    } else {
+      s.answer_recorded = true;  // the engine returned a point of another size: not an answer
+      s.point_finite = false;
+    }
     return s;
   }
 }
@@ -96,7 +102,12 @@ Summary DynamicSizeEngine<N>::solve_least_squares(const RootProblem<N, Dynamic>&
     } else {
       s = engine_->solve_least_squares(RootProblem<Dynamic, Dynamic>::from_map(f, N, m), xd);
     }
-    if (xd.size() == N) x = xd;
+    if (xd.size() == N) {
+      x = xd;
+    } else {
+      s.answer_recorded = true;  // the engine returned a point of another size: not an answer
+      s.point_finite = false;
+    }
     return s;
   }
 }

@@ -33,6 +33,9 @@ class Engine {
 
   // True for engines that solve m > n (Ceres, NLopt).
   virtual bool least_squares() const { return false; }
+  // True for engines that converge only where G contracts (Picard and its accelerations):
+  // an observer then chooses a gain Ψ that makes its fixed-point map contract.
+  virtual bool needs_contraction() const { return false; }
 
   const SolverOptions& options() const { return options_; }
 

@@ -177,6 +177,7 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
   summary.function_evaluations = evaluations;
   summary.jacobian_evaluations = jacobians;
   monitor.fill(summary, f_.allFinite() ? fnorm : std::numeric_limits<double>::infinity());
+  summary.record_answer(x, stop);
   return summary;
 }
 

@@ -128,6 +128,7 @@ class NloptEngine : public Engine<N> {
     ++s.function_evaluations;
     s.residual_norm = ctx.f.allFinite() ? ctx.f.template lpNorm<Eigen::Infinity>()
                                         : std::numeric_limits<double>::infinity();
+    s.record_answer(x, this->options_.stop, m > n);
     return s;
   }
 
@@ -217,6 +218,7 @@ Summary NloptEngine<N>::minimize(const ObjectiveProblem<N>& problem, Vector<N>& 
       },
       &ctx);
   s.residual_norm = std::numeric_limits<double>::quiet_NaN();  // not a residual problem
+  s.record_answer(x, this->options_.stop, /*minimised=*/true);
   return s;
 }
 

@@ -13,6 +13,7 @@
 #include "nlobs/solvers/objective_problem.hpp"
 #include "nlobs/solvers/problem.hpp"
 #include "nlobs/solvers/root_adapter.hpp"
+#include "nlobs/solvers/spectral_radius.hpp"
 #include "nlobs/solvers/status.hpp"
 #include "nlobs/solvers/stop_criteria.hpp"
 #include "nlobs/solvers/summary.hpp"

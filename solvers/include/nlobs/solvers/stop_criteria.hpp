@@ -33,6 +33,12 @@ struct StopCriteria {
   // Remark 8: three consecutive equal iterates end the run (status repeated_iterates).
   bool stop_on_repeated_iterates = true;
 
+  // Summary::usable(): the residual ‖F‖∞ (‖G(x) − x‖∞) at or below which an answer may be used
+  // even when it was cut short (max iterations or evaluations, stagnation, repeated iterates) or
+  // lands above a tighter residual_tolerance. Absolute, in the units of F; raise it for a
+  // badly scaled F.
+  double acceptance_tolerance = 1e-6;
+
   int max_iterations = 10000;
   int max_evaluations = 100000;
 };

@@ -1,12 +1,14 @@
 #pragma once
 // One summary format for every engine (compare Ceres' Solver::Summary).
 #include <Eigen/Core>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "nlobs/solvers/status.hpp"
+#include "nlobs/solvers/stop_criteria.hpp"
 
 namespace nlobs {
 
@@ -25,7 +27,8 @@ struct Summary {
   int function_evaluations = 0;  // evaluations of G (or F), including finite differences
   int jacobian_evaluations = 0;  // Jacobians computed (user-supplied, AD or finite differences)
   double step_norm = 0.0;        // ‖x_l − x_{l−1}‖∞ of the last step
-  double residual_norm = 0.0;    // ‖G(x) − x‖∞ at the returned x
+  double residual_norm = std::numeric_limits<double>::quiet_NaN();  // ‖G(x) − x‖∞ at the
+                                                                    // returned x (NaN: unknown)
   // Ratio of the last consecutive step norms: estimates the linear convergence factor.
   std::optional<double> contraction_estimate;
   // The L used for the error bound: StopCriteria::lipschitz_constant or, if unset and the
@@ -43,7 +46,38 @@ struct Summary {
   std::string message;  // detail for kInvalidInput, kSingularJacobian, kSolverFailure, backends
   std::vector<TraceEntry> trace;
 
+  // What usable() judges by, recorded by the engine (record_answer()) from the x it returned
+  // and the StopCriteria it was given.
+  bool answer_recorded = false;     // record_answer() was called (a user's engine may not)
+  bool point_finite = false;        // every entry of the returned x is finite
+  bool residual_minimised = false;  // least squares / minimisation: ‖F‖ need not reach 0
+  std::optional<double> residual_tolerance;  // StopCriteria::residual_tolerance, if asked for
+  double acceptance_tolerance = 1e-6;        // StopCriteria::acceptance_tolerance
+
   bool converged() const { return status == Status::kConverged; }
+  // The one policy for "this answer may be used" (every observer follows it): the returned x
+  // is finite and ‖F‖∞ is not infinite, and with small = max(residual_tolerance,
+  // acceptance_tolerance):
+  //   converged:  ‖F‖∞ ≤ small when a residual_tolerance was asked for (a step criterion met
+  //               first under Combine::kAny does not excuse a residual above it);
+  //   cut short (max_iterations, max_evaluations, stagnated, repeated_iterates): only with
+  //               ‖F‖∞ ≤ small, on a root problem (at a least-squares or minimisation point ‖F‖
+  //               does not show a solution: not usable);
+  //   diverged, non_finite, singular_jacobian, solver_failure, invalid_input: never.
+  bool usable() const;
+  // Why usable() is false, in one line ("stagnated with |F| 1.500e+03 > acceptance_tolerance
+  // 1.000e-06"); empty if usable.
+  std::string unusable_reason() const;
+  // Records the returned point and the criteria usable() needs; every engine calls it last
+  // (a caller holding the answer of an engine that did not may call it for the engine).
+  template <typename Vec>
+  void record_answer(const Vec& x, const StopCriteria& criteria, bool minimised = false) {
+    answer_recorded = true;
+    point_finite = x.allFinite();
+    residual_minimised = minimised;
+    residual_tolerance = criteria.residual_tolerance;
+    acceptance_tolerance = criteria.acceptance_tolerance;
+  }
   // "steffensen: converged after 12 iterations (25 evaluations), |step| 3.1e-09, |F| 2.0e-12"
   std::string brief_report() const;
   // Multi-line report of every field.

@@ -1,0 +1,32 @@
+#include "nlobs/observers/window_estimator.hpp"
+
+namespace nlobs {
+
+std::string_view to_string(WindowGain gain) {
+  switch (gain) {
+    case WindowGain::kAuto:
+      return "auto";
+    case WindowGain::kIdentity:
+      return "identity";
+    case WindowGain::kScalar:
+      return "scalar";
+    case WindowGain::kNewton:
+      return "newton";
+  }
+  return "unknown";
+}
+
+void WindowEstimatorOptions::validate() const {
+  if (window < 0) {
+    throw InvalidInput("WindowEstimatorOptions::window = " + std::to_string(window) +
+                       " must be >= 0 (0 = the square window n/p)");
+  }
+  if (!std::isfinite(gain_scale) || gain_scale == 0.0) {
+    std::ostringstream os;
+    os << "WindowEstimatorOptions::gain_scale = " << gain_scale
+       << " must be finite and nonzero (Psi = gain_scale I must be invertible)";
+    throw InvalidInput(os.str());
+  }
+}
+
+}  // namespace nlobs
