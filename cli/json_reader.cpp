@@ -4,6 +4,31 @@
 
 namespace nlobs::cli {
 
+std::string json_excerpt(const nlohmann::json& value) {
+  std::string text = value.dump();  // bounded: parse_json refuses deeper nesting
+  if (text.size() > kJsonExcerptLength) text = text.substr(0, kJsonExcerptLength) + "...";
+  return text;
+}
+
+nlohmann::json parse_json(std::istream& in, const std::string& where) {
+  std::string last_key;
+  const nlohmann::json::parser_callback_t limit =
+      [&](int depth, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+        if (event == nlohmann::json::parse_event_t::key) last_key = parsed.get<std::string>();
+        if (depth >= kMaxJsonDepth) {  // the top level is depth 0
+          throw std::invalid_argument(where + ": nested deeper than " +
+                                      std::to_string(kMaxJsonDepth) + " levels" +
+                                      (last_key.empty() ? "" : " (under key '" + last_key + "')"));
+        }
+        return true;
+      };
+  try {
+    return nlohmann::json::parse(in, limit);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw std::invalid_argument(where + ": not valid JSON: " + e.what());
+  }
+}
+
 JsonReader::JsonReader(const nlohmann::json& object, std::string where)
     : object_(object), where_(std::move(where)) {
   if (!object_.is_object()) fail("expected an object");
@@ -22,7 +47,7 @@ std::optional<double> JsonReader::number(const std::string& key) {
   if (!has(key)) return std::nullopt;
   const auto& v = get(key);
   if (!v.is_number() || !std::isfinite(v.get<double>())) {
-    fail("'" + key + "' must be a finite number, got " + v.dump());
+    fail("'" + key + "' must be a finite number, got " + json_excerpt(v));
   }
   return v.get<double>();
 }
@@ -30,32 +55,33 @@ std::optional<double> JsonReader::number(const std::string& key) {
 std::optional<long> JsonReader::integer(const std::string& key) {
   if (!has(key)) return std::nullopt;
   const auto& v = get(key);
-  if (!v.is_number_integer()) fail("'" + key + "' must be an integer, got " + v.dump());
+  if (!v.is_number_integer()) fail("'" + key + "' must be an integer, got " + json_excerpt(v));
   return v.get<long>();
 }
 
 std::optional<bool> JsonReader::boolean(const std::string& key) {
   if (!has(key)) return std::nullopt;
   const auto& v = get(key);
-  if (!v.is_boolean()) fail("'" + key + "' must be true or false, got " + v.dump());
+  if (!v.is_boolean()) fail("'" + key + "' must be true or false, got " + json_excerpt(v));
   return v.get<bool>();
 }
 
 std::optional<std::string> JsonReader::text(const std::string& key) {
   if (!has(key)) return std::nullopt;
   const auto& v = get(key);
-  if (!v.is_string()) fail("'" + key + "' must be a string, got " + v.dump());
+  if (!v.is_string()) fail("'" + key + "' must be a string, got " + json_excerpt(v));
   return v.get<std::string>();
 }
 
 std::optional<Eigen::VectorXd> JsonReader::vector(const std::string& key) {
   if (!has(key)) return std::nullopt;
   const auto& v = get(key);
-  if (!v.is_array()) fail("'" + key + "' must be an array of numbers, got " + v.dump());
+  if (!v.is_array()) fail("'" + key + "' must be an array of numbers, got " + json_excerpt(v));
   Eigen::VectorXd out(static_cast<Eigen::Index>(v.size()));
   for (size_t i = 0; i < v.size(); ++i) {
     if (!v[i].is_number() || !std::isfinite(v[i].get<double>())) {
-      fail("'" + key + "[" + std::to_string(i) + "]' must be a finite number, got " + v[i].dump());
+      fail("'" + key + "[" + std::to_string(i) + "]' must be a finite number, got " +
+           json_excerpt(v[i]));
     }
     out[static_cast<Eigen::Index>(i)] = v[i].get<double>();
   }
@@ -95,7 +121,7 @@ std::optional<Eigen::MatrixXd> JsonReader::matrix(const std::string& key) {
 std::optional<JsonReader> JsonReader::object(const std::string& key) {
   if (!has(key)) return std::nullopt;
   const auto& v = get(key);
-  if (!v.is_object()) fail("'" + key + "' must be an object, got " + v.dump());
+  if (!v.is_object()) fail("'" + key + "' must be an object, got " + json_excerpt(v));
   return JsonReader(v, where_ + "." + key);
 }
 

@@ -2,6 +2,7 @@
 // Strict reading of JSON objects: every key must be known, every value of the right type, and
 // an error names the file and the path ("scenario.json: observers[2].tol: expected a number").
 #include <Eigen/Core>
+#include <istream>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
@@ -10,6 +11,17 @@
 #include <vector>
 
 namespace nlobs::cli {
+
+// Scenario files are nested a few levels; a hostile one 70 000 levels deep must be refused at
+// parse time, not crash the printer of an error message.
+inline constexpr int kMaxJsonDepth = 64;
+inline constexpr std::size_t kJsonExcerptLength = 80;
+
+// Parses `in` (named `where` in errors): std::invalid_argument naming `where` for invalid JSON
+// and for nesting deeper than kMaxJsonDepth (with the key under which it happened).
+nlohmann::json parse_json(std::istream& in, const std::string& where);
+// At most kJsonExcerptLength characters of a value's JSON text, for error messages.
+std::string json_excerpt(const nlohmann::json& value);
 
 class JsonReader {
  public:

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "gnuplot.hpp"
 #include "run_support.hpp"
 
 namespace nlobs::cli {
@@ -91,7 +92,8 @@ bool is_modulating_sweep(const std::string& key) {
 
 void run_modulating_sweep(const Scenario& s, const std::string& key,
                           const std::vector<double>& values, const Measurements& data,
-                          long settle_index, const RunOptions& options, std::ostream& out) {
+                          long settle_index, const RunOptions& options, std::ostream& out,
+                          std::ostream& err) {
   namespace fs = std::filesystem;
   const bool observer_key = key == "horizon" || key == "sample_period";
   if (observer_key && std::none_of(s.observers.begin(), s.observers.end(),
@@ -114,7 +116,7 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
     settle_index = std::max(settle_index, static_cast<long>(std::ceil(longest / delta - 1e-9)));
   }
   std::ostringstream csv;
-  csv << std::setprecision(10) << key
+  csv << std::setprecision(10) << csv_field(key)
       << ",observer,x_rms_after,x2_rms_after,eta_rms_after,max_eta_rel_error_after_horizon,"
          "final_eta_rel_error,max_eta_bound,converged,failures,us_per_step,"
          "max_eta_error_after_horizon\n";
@@ -196,9 +198,9 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
                     fmt(eta_rms).c_str(), fmt(rel).c_str(), fmt(final_rel).c_str(),
                     fmt(bound).c_str(), converged, m.ns_per_step / 1e3);
       out << line;
-      csv << value << ',' << m.name << ',' << x_rms << ',' << x2_rms << ',' << eta_rms << ',' << rel
-          << ',' << final_rel << ',' << bound << ',' << converged << ',' << failures << ','
-          << m.ns_per_step / 1e3 << ',' << (mm ? mm->abs_after_horizon : NAN) << '\n';
+      csv << value << ',' << csv_field(m.name) << ',' << x_rms << ',' << x2_rms << ',' << eta_rms
+          << ',' << rel << ',' << final_rel << ',' << bound << ',' << converged << ',' << failures
+          << ',' << m.ns_per_step / 1e3 << ',' << (mm ? mm->abs_after_horizon : NAN) << '\n';
       rows.push_back({value, m.name, x2_rms, mm ? mm->abs_after_horizon : NAN, final_rel, bound});
     }
   }
@@ -208,7 +210,7 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
   std::ostringstream blocks;
   blocks << std::setprecision(10);
   for (const std::string& name : names) {
-    blocks << "# " << name << ": " << key
+    blocks << "# " << gnuplot_comment_text(name) << ": " << gnuplot_comment_text(key)
            << " x2_rms_after max_eta_error_after_horizon final_eta_rel_error max_eta_bound\n";
     for (const auto& row : rows) {
       if (row.name != name) continue;
@@ -233,25 +235,30 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
       for (size_t i = 0; i < names.size(); ++i) {
         if (!has(names[i], field)) continue;
         text += (text.empty() ? "" : ", ") + std::string("'sweep.dat' index ") + std::to_string(i) +
-                " using 1:" + std::to_string(column) + " with linespoints title '" + names[i] +
-                suffix + "'";
+                " using 1:" + std::to_string(column) + " with linespoints title " +
+                gnuplot_quoted(names[i] + suffix);
       }
       return text;
     };
-    g << "set terminal pngcairo size 1000,800\nset output '" << (dir / "sweep.png").string()
-      << "'\nset multiplot layout 2,1 title '" << key << " sweep: " << s.name << " (noise "
-      << s.noise << ")'\n"
+    std::ostringstream title;
+    title << key << " sweep: " << s.name << " (noise " << s.noise << ")";
+    g << "set terminal pngcairo noenhanced size 1000,800\nset output 'sweep.png'\n"
+      << "set multiplot layout 2,1 title " << gnuplot_quoted(title.str()) << "\n"
       << (positive ? "set logscale xy\n" : "set logscale y\n")
       << "set grid\nset key outside right\n"
-      << "set xlabel '" << key
-      << "'\nset ylabel 'RMS error of x2 (derivative) after settling'\nplot "
+      << "set xlabel " << gnuplot_quoted(key)
+      << "\nset ylabel 'RMS error of x2 (derivative) after settling'\nplot "
       << series(2, "", &Row::x2) << "\nset ylabel 'max ||eta - etahat|| from one horizon'\nplot "
       << series(3, "", &Row::eta_abs);
     const std::string bounds = series(5, " Theorem 1 bound", &Row::bound);
     if (!bounds.empty()) g << ", " << bounds;
     g << "\nunset multiplot\n";
-    run_gnuplot(dir, "sweep.gp", g.str());
-    out << ", sweep.png";
+    const std::string failure = run_gnuplot(dir, "sweep.gp", g.str());
+    if (failure.empty()) {
+      out << ", sweep.png";
+    } else {
+      err << "nlobs: warning: no sweep.png: " << failure << '\n';
+    }
   }
   out << '\n';
 }

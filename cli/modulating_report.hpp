@@ -35,6 +35,7 @@ void add_modulating_json(const RunResult& r, size_t i, long horizon_index, nlohm
 bool is_modulating_sweep(const std::string& key);
 void run_modulating_sweep(const Scenario& s, const std::string& key,
                           const std::vector<double>& values, const Measurements& data,
-                          long settle_index, const RunOptions& options, std::ostream& out);
+                          long settle_index, const RunOptions& options, std::ostream& out,
+                          std::ostream& err);
 
 }  // namespace nlobs::cli

@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -14,6 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "gnuplot.hpp"
 #include "modulating_report.hpp"
 #include "nlobs/observers/simulation.hpp"
 #include "run_support.hpp"
@@ -36,6 +36,16 @@ void write_atomically(const fs::path& path, const std::string& content) {
     if (!out) throw std::runtime_error("writing " + tmp.string() + " failed");
   }
   fs::rename(tmp, path);
+}
+
+std::string csv_field(std::string_view text) {
+  if (text.find_first_of(",\"\r\n") == std::string_view::npos) return std::string(text);
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"') out += '"';  // RFC 4180: a quote inside a quoted field is doubled
+    out += c;
+  }
+  return out + "\"";
 }
 
 namespace {
@@ -386,11 +396,15 @@ std::string trajectories_csv(const Measurements& data, const RunResult& r) {
   if (data.has_truth()) {
     for (Eigen::Index i = 0; i < n; ++i) os << ",x" << i + 1;
   }
+  // Observer names hold commas ("window:ceres,N=6"): RFC 4180 quoting keeps one field each.
   for (const auto& m : r.metrics) {
-    for (Eigen::Index i = 0; i < n; ++i) os << "," << m.name << ".x" << i + 1;
+    for (Eigen::Index i = 0; i < n; ++i)
+      os << "," << csv_field(m.name + ".x" + std::to_string(i + 1));
   }
   for (size_t o = 0; o < r.extra_names.size(); ++o) {
-    for (const auto& e : r.extra_names[o]) os << "," << r.metrics[o].name << ".signal." << e;
+    for (const auto& e : r.extra_names[o]) {
+      os << "," << csv_field(r.metrics[o].name + ".signal." + e);
+    }
   }
   os << '\n';
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
@@ -417,7 +431,8 @@ std::string first_window_csv(const RunResult& r, std::vector<std::string>* names
     if (!m.first_window || m.first_window->trace.empty()) continue;
     names->push_back(m.name);
     for (const TraceEntry& t : m.first_window->trace) {
-      os << m.name << ' ' << t.iteration << ' ' << std::max(t.step_norm, 1e-300) << '\n';
+      os << gnuplot_data_token(m.name) << ' ' << t.iteration << ' ' << std::max(t.step_norm, 1e-300)
+         << '\n';
     }
     os << "\n\n";  // gnuplot index separator
   }
@@ -427,7 +442,7 @@ std::string first_window_csv(const RunResult& r, std::vector<std::string>* names
 }  // namespace
 
 bool have_gnuplot() {
-  return std::system("command -v gnuplot >/dev/null 2>&1") == 0;
+  return find_gnuplot().has_value();
 }
 
 Measurements simulate_scenario(const Scenario& s, const AnyModel& model) {
@@ -448,12 +463,8 @@ fs::path output_directory(const std::string& out_dir) {
   return dir;
 }
 
-void run_gnuplot(const fs::path& dir, const std::string& file, const std::string& script) {
-  write_atomically(dir / file, script);
-  const std::string cmd = "cd '" + dir.string() + "' && gnuplot " + file + " 2>gnuplot.log";
-  if (std::system(cmd.c_str()) != 0) {
-    throw std::runtime_error("gnuplot failed; see " + (dir / "gnuplot.log").string());
-  }
+std::string run_gnuplot(const fs::path& dir, const std::string& file, const std::string& script) {
+  return run_gnuplot_script(dir, file, script);
 }
 
 std::vector<double> parse_sweep_values(const std::string& key, const std::string& list,
@@ -499,8 +510,11 @@ std::string observer_style(long o) {
 }
 
 // PNG plots through gnuplot: estimates vs truth, errors, and the first window's convergence.
+// Every name from the scenario (observers, signals) goes into the script through
+// gnuplot_quoted(); files are named relative to dir, where gnuplot runs. `failure`: why gnuplot
+// failed, or empty.
 std::vector<std::string> plot(const fs::path& dir, const Measurements& data, const RunResult& r,
-                              const std::vector<std::string>& traced) {
+                              const std::vector<std::string>& traced, std::string* failure) {
   std::vector<std::string> written;
   const Eigen::Index n = r.estimates.empty() ? 0 : r.estimates.front().rows();
   const long observers = static_cast<long>(r.metrics.size());
@@ -509,7 +523,7 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
   g << "set datafile separator ','\nset key outside right\nset grid\n"
     << "set terminal pngcairo noenhanced size 1200," << 300 * std::max<Eigen::Index>(n, 1) << "\n";
   define_observer_styles(g, observers);
-  g << "set output '" << (dir / "states.png").string() << "'\nset multiplot layout " << n << ",1\n";
+  g << "set output 'states.png'\nset multiplot layout " << n << ",1\n";
   for (Eigen::Index i = 0; i < n; ++i) {
     g << "set ylabel 'x" << i + 1 << "'\n";
     // The truth's range plus half of it on each side: an estimate's transient spikes (a PI
@@ -524,7 +538,7 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
       g << "'trajectories.csv' using 1:" << i + 2 << " with lines ls 99 title 'true', ";
     for (long o = 0; o < observers; ++o) {
       g << "'trajectories.csv' using 1:" << 2 + offset + o * n + i << " with lines"
-        << observer_style(o) << " title '" << r.metrics[static_cast<size_t>(o)].name << "'"
+        << observer_style(o) << " title " << gnuplot_quoted(r.metrics[static_cast<size_t>(o)].name)
         << (o + 1 < observers ? ", " : "\n");
     }
   }
@@ -534,7 +548,7 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
     // Each panel from 1e-16 to 1e3 times the truth's scale (its range, or its size when it is
     // constant): one diverging observer must not squeeze the others into a line. An observer
     // whose error leaves the panel is drawn clipped and says so in its key entry.
-    g << "set output '" << (dir / "errors.png").string() << "'\nset logscale y\n"
+    g << "set output 'errors.png'\nset logscale y\n"
       << "set format y '1e%L'\nset multiplot layout " << n << ",1\n";
     for (Eigen::Index i = 0; i < n; ++i) {
       const double lo = data.x.row(i).minCoeff(), hi = data.x.row(i).maxCoeff();
@@ -549,8 +563,9 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
             (data.x.row(i) - r.estimates[static_cast<size_t>(o)].row(i)).array().abs();
         const bool left = !(error.isFinite().all() && error.maxCoeff() <= top);
         g << "'trajectories.csv' using 1:(abs($" << i + 2 << " - $" << 2 + offset + o * n + i
-          << ")+1e-16) with lines" << observer_style(o) << " title '"
-          << r.metrics[static_cast<size_t>(o)].name << (left ? " (beyond the panel)" : "") << "'"
+          << ")+1e-16) with lines" << observer_style(o) << " title "
+          << gnuplot_quoted(r.metrics[static_cast<size_t>(o)].name +
+                            (left ? " (beyond the panel)" : ""))
           << (o + 1 < observers ? ", " : "\n");
       }
     }
@@ -563,11 +578,11 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
     const auto& names = r.extra_names[o];
     if (names.empty()) continue;
     const std::string file = "signals_" + std::to_string(o + 1) + ".png";
-    g << "set terminal pngcairo noenhanced size 1200," << 250 * names.size() << "\nset output '"
-      << (dir / file).string() << "'\nset multiplot layout " << names.size() << ",1 title '"
-      << r.metrics[o].name << "'\n";
+    g << "set terminal pngcairo noenhanced size 1200," << 250 * names.size() << "\nset output "
+      << gnuplot_quoted(file) << "\nset multiplot layout " << names.size() << ",1 title "
+      << gnuplot_quoted(r.metrics[o].name) << "\n";
     for (const auto& name : names) {
-      g << "set ylabel '" << name << "'\nplot 'trajectories.csv' using 1:" << column++
+      g << "set ylabel " << gnuplot_quoted(name) << "\nplot 'trajectories.csv' using 1:" << column++
         << " with lines notitle\n";
     }
     g << "unset multiplot\n";
@@ -590,11 +605,11 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
     }
     if (columns.empty()) continue;
     const std::string file = extra + ".png";
-    g << "set terminal pngcairo noenhanced size 1000,600\nset output '" << (dir / file).string()
-      << "'\nset logscale y\nset xlabel 't'\nset ylabel '" << label << "'\nplot ";
+    g << "set terminal pngcairo noenhanced size 1000,600\nset output " << gnuplot_quoted(file)
+      << "\nset logscale y\nset xlabel 't'\nset ylabel " << gnuplot_quoted(label) << "\nplot ";
     for (size_t i = 0; i < columns.size(); ++i) {
       g << "'trajectories.csv' using 1:($" << columns[i].first << "+1e-16) with lines"
-        << observer_style(style_of[i]) << " title '" << columns[i].second << "'"
+        << observer_style(style_of[i]) << " title " << gnuplot_quoted(columns[i].second)
         << (i + 1 < columns.size() ? ", " : "\n");
     }
     g << "unset logscale y\nunset xlabel\n";
@@ -602,18 +617,19 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
   }
   if (!traced.empty()) {
     g << "set datafile separator whitespace\nset terminal pngcairo noenhanced size 1000,600\n"
-      << "set output '" << (dir / "first_window.png").string() << "'\nset logscale y\n"
+      << "set output 'first_window.png'\nset logscale y\n"
       << "set xlabel 'iteration'\nset ylabel 'step norm (max)'\nplot ";
     for (size_t i = 0; i < traced.size(); ++i) {
       long o = 0;  // the traced observer's index, for its style
       while (o < observers && r.metrics[static_cast<size_t>(o)].name != traced[i]) ++o;
       g << "'first_window.dat' index " << i << " using 2:3 with linespoints"
-        << observer_style(o < observers ? o : 0) << " title '" << traced[i] << "'"
+        << observer_style(o < observers ? o : 0) << " title " << gnuplot_quoted(traced[i])
         << (i + 1 < traced.size() ? ", " : "\n");
     }
     written.push_back("first_window.png");
   }
-  run_gnuplot(dir, "plots.gp", g.str());
+  *failure = run_gnuplot(dir, "plots.gp", g.str());
+  if (!failure->empty()) written.clear();
   return written;
 }
 
@@ -621,7 +637,7 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
 // peaking/noise trade-off: peaking grows as θ shrinks, noise amplification too). Other keys
 // are the modulating-function sweeps (modulating_report.cpp).
 void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& data,
-               long settle_index, const RunOptions& options, std::ostream& out) {
+               long settle_index, const RunOptions& options, std::ostream& out, std::ostream& err) {
   const std::string& spec = options.sweep;
   const auto eq = spec.find('=');
   if (eq == std::string::npos || eq == 0) {
@@ -632,7 +648,7 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
     // horizon and sample_period: > 0; a model parameter (the disturbance level a_max) may be 0.
     const std::vector<double> values =
         parse_sweep_values(key, spec.substr(eq + 1), key == "horizon" || key == "sample_period");
-    run_modulating_sweep(s, key, values, data, settle_index, options, out);
+    run_modulating_sweep(s, key, values, data, settle_index, options, out, err);
     return;
   }
   const std::vector<double> values = parse_sweep_values(key, spec.substr(eq + 1), true);
@@ -688,7 +704,7 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
       out << line;
       rows.push_back(
           {theta, m.name, em ? em->max_zhat_norm : NAN, em ? em->z_rms_after : NAN, x_rms});
-      csv << theta << ',' << m.name << ',' << (em ? em->max_zhat_norm : NAN) << ','
+      csv << theta << ',' << csv_field(m.name) << ',' << (em ? em->max_zhat_norm : NAN) << ','
           << (em ? em->z_rms_after : NAN) << ',' << x_rms << ',' << t_below << ','
           << (em ? em->jumps : 0.0) << ',' << failures << ',' << m.ns_per_step / 1e3 << '\n';
     }
@@ -700,7 +716,8 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
   std::ostringstream blocks;
   blocks << std::setprecision(10);
   for (const std::string& name : names) {
-    blocks << "# " << name << ": theta max_zhat_norm z_rms_after x_rms_after\n";
+    blocks << "# " << gnuplot_comment_text(name)
+           << ": theta max_zhat_norm z_rms_after x_rms_after\n";
     for (const auto& row : rows) {
       if (row.name == name) {
         blocks << row.theta << ' ' << row.peak << ' ' << row.z_rms << ' ' << row.x_rms << '\n';
@@ -716,20 +733,25 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
       std::string text;
       for (size_t i = 0; i < names.size(); ++i) {
         text += (i ? ", " : "") + std::string("'sweep.dat' index ") + std::to_string(i) +
-                " using 1:" + std::to_string(column) + " with linespoints title '" + names[i] +
-                suffix + "'";
+                " using 1:" + std::to_string(column) + " with linespoints title " +
+                gnuplot_quoted(names[i] + suffix);
       }
       return text;
     };
-    g << "set terminal pngcairo noenhanced size 1000,800\nset output '"
-      << (dir / "sweep.png").string()
-      << "'\nset multiplot layout 2,1 title 'theta sweep: " << s.name << " (noise " << s.noise
-      << ")'\nset logscale xy\nset grid\nset key outside right\n"
+    std::ostringstream title;
+    title << "theta sweep: " << s.name << " (noise " << s.noise << ")";
+    g << "set terminal pngcairo noenhanced size 1000,800\nset output 'sweep.png'\n"
+      << "set multiplot layout 2,1 title " << gnuplot_quoted(title.str())
+      << "\nset logscale xy\nset grid\nset key outside right\n"
       << "set xlabel 'theta'\nset ylabel 'max ||zhat|| (peaking)'\nplot " << series(2, "")
       << "\nset ylabel 'RMS error after settling'\nplot " << series(3, " z") << ", "
       << series(4, " x") << "\nunset multiplot\n";
-    run_gnuplot(dir, "sweep.gp", g.str());
-    out << ", sweep.png";
+    const std::string failure = run_gnuplot(dir, "sweep.gp", g.str());
+    if (failure.empty()) {
+      out << ", sweep.png";
+    } else {
+      err << "nlobs: warning: no sweep.png: " << failure << '\n';
+    }
   }
   out << '\n';
 }
@@ -768,7 +790,7 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
       settle = static_cast<long>(
           std::min(std::ceil(s.settle_time / T - 1e-9), static_cast<double>(data.steps())));
     }
-    run_sweep(s, model, data, settle < 0 ? 0 : settle, options, out);
+    run_sweep(s, model, data, settle < 0 ? 0 : settle, options, out, err);
     return;
   }
   Eigen::Index longest = 1;
@@ -833,7 +855,13 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
     write_atomically(dir / "scenario.json", to_json(s).dump(2) + "\n");
     std::vector<std::string> plots;
     if (have_gnuplot()) {
-      plots = plot(dir, data, r, traced);
+      // Best-effort: the data files above are complete whatever gnuplot does.
+      std::string failure;
+      plots = plot(dir, data, r, traced, &failure);
+      if (!failure.empty()) {
+        warnings.push_back("no PNG plots: " + failure);
+        err << "nlobs: warning: " << warnings.back() << '\n';
+      }
     } else {
       err << "nlobs: gnuplot not found: no PNG plots (apt-get install gnuplot-nox)\n";
     }

@@ -4,6 +4,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "nlobs/observers/simulation.hpp"
@@ -13,14 +14,18 @@ namespace nlobs::cli {
 
 // Writes through a temporary name and renames at the end: nothing half-written looks complete.
 void write_atomically(const std::filesystem::path& path, const std::string& content);
+// `text` as one RFC 4180 field: quoted (inner quotes doubled) when it holds a comma, a quote,
+// CR or LF; as it is otherwise.
+std::string csv_field(std::string_view text);
 nlohmann::json number_or_null(double v);
 std::string fmt(double v, const char* f = "%.3e");  // "-" for non-finite values
-bool have_gnuplot();
-// --out DIR made absolute (gnuplot runs inside it and writes to this path) and created.
+bool have_gnuplot();                                // on PATH (gnuplot.hpp)
+// --out DIR made absolute and created (gnuplot runs inside it: scripts name files relative to it).
 std::filesystem::path output_directory(const std::string& out_dir);
-// Writes `script` to dir/file and runs gnuplot on it there; throws naming gnuplot.log.
-void run_gnuplot(const std::filesystem::path& dir, const std::string& file,
-                 const std::string& script);
+// Writes `script` to dir/file and runs gnuplot on it there, without a shell (gnuplot.hpp). Plots
+// are best-effort: returns an empty string, or why they failed (for a warning; never thrown).
+std::string run_gnuplot(const std::filesystem::path& dir, const std::string& file,
+                        const std::string& script);
 // "v1,v2,…" of `--sweep key=…`: finite numbers (> 0 when `positive`), at least one.
 std::vector<double> parse_sweep_values(const std::string& key, const std::string& list,
                                        bool positive);

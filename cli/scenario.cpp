@@ -317,13 +317,7 @@ Scenario load_scenario(const std::string& name_or_file) {
     throw std::invalid_argument("'" + name_or_file + "' is neither a built-in scenario (" + list +
                                 ") nor a readable JSON file");
   }
-  nlohmann::json json;
-  try {
-    json = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw std::invalid_argument(name_or_file + ": not valid JSON: " + e.what());
-  }
-  return parse_scenario(json, name_or_file);
+  return parse_scenario(parse_json(in, name_or_file), name_or_file);
 }
 
 Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {

@@ -22,6 +22,7 @@ packages=(
   libcli11-dev         # command-line parsing for the nlobs CLI
   nlohmann-json3-dev   # JSON output of the CLI
   libgtest-dev         # unit tests
+  libcsv-dev           # tests: an independent RFC 4180 reader parses our CSV output back
   libbenchmark-dev     # Google Benchmark
 )
 

@@ -296,6 +296,39 @@ TEST(ModulatingFunctionObserver, SampledDataBridgesAMissingSample) {
       1e-6);
 }
 
+// A time jump far beyond a horizon (recorded data: t jumps from 6 s to 1e6 s): FIR mode skips
+// the missing grid times at once and recovers exactly one horizon later; sampled-data mode
+// restarts the predictor there. Each sample's work is independent of the gap (1e8 grid times
+// would take minutes one by one).
+TEST(ModulatingFunctionObserver, ATimeJumpIsSkippedAtOnceAndRecovers) {
+  const Measurements data =
+      simulate_continuous(LtiOutputInjection{}, Eigen::Vector2d(2.0, 0.0), 0.01, 12.0);
+  for (const double period : {0.0, 0.1}) {
+    ModulatingOptions o = options(0.01, 1.0);
+    o.sample_period = period;
+    ModulatingFunctionObserver<LtiInjectionForm> observer(LtiInjectionForm{},
+                                                          Eigen::Vector2d::Zero(), o);
+    // The second half of the data, shifted by 1e6 s (LTI: the dynamics do not depend on t).
+    const Eigen::Index half = data.steps() / 2;
+    bool jumped_missing = false, ready_again = false;
+    for (Eigen::Index k = 0; k < data.steps(); ++k) {
+      const double t = data.t[k] + (k >= half ? 1e6 : 0.0);
+      const ObserverStep& s = observer.step_at(k, t, data.y.col(k), data.u.col(k));
+      EXPECT_TRUE(s.failure.empty()) << s.failure_message;
+      if (k == half) jumped_missing = s.measurement_missing && !s.ready;
+      if (k > half + 150) ready_again = ready_again || s.ready;
+    }
+    EXPECT_TRUE(jumped_missing) << "period " << period;
+    EXPECT_TRUE(ready_again) << "period " << period;
+    const Eigen::Index K = data.steps() - 1;
+    EXPECT_LT(
+        (observer.coordinates_at(data.x.col(K), data.t[K] + 1e6) - Eigen::VectorXd(observer.eta()))
+            .norm(),
+        1e-6)
+        << "period " << period;
+  }
+}
+
 // n = 1: y' = v with v = u (a_0 = 0): η_0 = y, in FIR and in sampled-data mode (the predictor
 // ŷ' = b_0 v integrates u exactly).
 TEST(ModulatingFunctionObserver, FirstOrderChainInBothModes) {

@@ -1,16 +1,20 @@
 // `nlobs run`: the chua-fp experiment's claims, the output contract, scenario files and
 // recorded data, and every bad input the issue lists.
+#include <csv.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "gnuplot.hpp"
 #include "nlobs/models/discretization.hpp"
 #include "nlobs/models/systems.hpp"
 #include "nlobs/observers/pi_bound.hpp"
@@ -44,6 +48,31 @@ std::string error_of(const std::string& scenario, const RunOptions& o = {}) {
 
 void write(const fs::path& p, const std::string& text) {
   std::ofstream(p) << text;
+}
+
+// Every record of a CSV file as parsed by libcsv in strict RFC 4180 mode (not our reader).
+std::vector<std::vector<std::string>> csv_records(const fs::path& p) {
+  struct Parsed {
+    std::vector<std::vector<std::string>> records{{}};
+  } parsed;
+  csv_parser parser;
+  EXPECT_EQ(csv_init(&parser, CSV_STRICT | CSV_STRICT_FINI), 0);
+  csv_set_space_func(&parser, [](unsigned char) { return 0; });  // RFC 4180 keeps spaces
+  std::ifstream in(p, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto on_field = [](void* field, size_t length, void* data) {
+    static_cast<Parsed*>(data)->records.back().emplace_back(static_cast<const char*>(field),
+                                                            length);
+  };
+  const auto on_record = [](int, void* data) {
+    static_cast<Parsed*>(data)->records.emplace_back();
+  };
+  EXPECT_EQ(csv_parse(&parser, text.data(), text.size(), on_field, on_record, &parsed), text.size())
+      << csv_strerror(csv_error(&parser));
+  EXPECT_EQ(csv_fini(&parser, on_field, on_record, &parsed), 0) << p;
+  csv_free(&parser);
+  if (parsed.records.back().empty()) parsed.records.pop_back();
+  return parsed.records;
 }
 
 TEST(Run, ChuaFpReproducesThePapersClaims) {
@@ -96,6 +125,15 @@ TEST(Run, ChuaFpReproducesThePapersClaims) {
   std::string header;
   std::getline(csv, header);
   EXPECT_EQ(header.rfind("t,x1,x2,x3,window:picard.x1", 0), 0U) << header;
+  // RFC 4180: "window:ceres,N=6.x1" is one quoted field, so every row has the header's fields.
+  const auto records = csv_records(dir / "trajectories.csv");
+  ASSERT_GT(records.size(), 2u);
+  const std::vector<std::string>& names = records.front();
+  EXPECT_NE(std::find(names.begin(), names.end(), "window:ceres,N=6.x1"), names.end()) << header;
+  EXPECT_EQ(names.size(), 1u + 3u + 9u * 3u);  // t, the truth, nine observers' estimates
+  for (size_t k = 1; k < records.size(); ++k) {
+    ASSERT_EQ(records[k].size(), names.size()) << "row " << k;
+  }
 }
 
 TEST(Run, ScenarioJsonRoundTrip) {
@@ -195,6 +233,107 @@ TEST(Run, FailuresAndWarningsAreReported) {
   const auto& luenberger = summary["observers"][2];
   EXPECT_GT(luenberger["failures"]["non_finite_estimate"].get<int>(), 100);
   EXPECT_NE(luenberger["first_failure"].get<std::string>().find("not finite"), std::string::npos);
+}
+
+// Issue "Safe inputs and outputs": scenario text and paths never reach a shell or gnuplot code.
+TEST(RunSafety, GnuplotQuotingKeepsEveryByteLiteral) {
+  EXPECT_EQ(gnuplot_quoted("a'b"), "'a''b'");
+  EXPECT_EQ(gnuplot_quoted("x\ny\r\t"), "'x\\ny\\r\\t'");
+  EXPECT_EQ(gnuplot_quoted("`touch p` @macro \\n"), "'`touch p` @macro \\n'");  // inert in ''
+  EXPECT_EQ(gnuplot_quoted(std::string("\x1b\x7f", 2)), "'\\x1b\\x7f'");
+}
+
+nlohmann::json hostile_high_gain_scenario(const std::string& payload) {
+  nlohmann::json j = nlohmann::json::parse(R"({"name": "x", "model": {"name": "oscillator",
+    "scheme": "rk4", "step": 0.01}, "x0": [-0.5, 0.0], "initial_guess": [-0.3, 0.0],
+    "steps": 400, "settle_time": 1.0, "observers": [{"type": "high_gain", "name": "hg",
+    "N": 4, "alpha": "explicit", "inverse": true}, {"type": "ekf"}]})");
+  j["name"] = payload;
+  j["observers"][0]["name"] = payload;
+  return j;
+}
+
+TEST(RunSafety, HostileNamesAndPathsRunNoCommand) {
+  const fs::path base = scratch("hostile");
+  fs::create_directories(base);
+  const fs::path marker = base / "PWNED";
+  // A quote and a newline end gnuplot's string and command; system(), backquotes and $( ) would
+  // then run; the directory name breaks a shell command line the same way.
+  const std::string payload =
+      "x'\nsystem(\"touch " + marker.string() + "\")\nprint '`touch " + marker.string() + "`";
+  const fs::path file = base / "hostile.json";
+  write(file, hostile_high_gain_scenario(payload).dump());
+  const fs::path dir =
+      base / ("it's `touch " + marker.string() + "` $(touch " + marker.string() + ")\nout");
+  for (const std::string sweep : {"", "theta=0.1,0.2"}) {
+    std::ostringstream out, err;
+    RunOptions o;
+    o.out_dir = dir.string();
+    o.sweep = sweep;
+    ASSERT_NO_THROW(run_scenario(file.string(), o, out, err)) << err.str();
+    EXPECT_FALSE(fs::exists(marker)) << "a command ran (sweep '" << sweep << "')";
+    if (have_gnuplot()) {
+      EXPECT_TRUE(fs::exists(dir / (sweep.empty() ? "states.png" : "sweep.png")))
+          << out.str() << err.str();
+      EXPECT_EQ(err.str().find("warning: no"), std::string::npos) << err.str();
+    }
+  }
+  EXPECT_TRUE(fs::exists(dir / "summary.json"));
+  // The payload name (a quote, newlines) is one RFC 4180 field of sweep.csv, read back intact.
+  const auto records = csv_records(dir / "sweep.csv");
+  ASSERT_EQ(records.size(), 3u);  // header, θ = 0.1 and 0.2 for the one high-gain observer
+  for (const auto& record : records) EXPECT_EQ(record.size(), records.front().size());
+  EXPECT_EQ(records[1][1], payload);
+}
+
+// A value of the wrong type nested 70 000 levels deep (140 KB) crashed the error printer: parsing
+// stops at 64 levels naming the file, the key and the limit; values in messages are excerpts.
+TEST(RunSafety, DeepOrHugeJsonValuesGiveShortErrors) {
+  const fs::path f = scratch("deep.json");
+  write(f, "{\"name\": \"deep\", \"model\": " + std::string(70000, '[') + std::string(70000, ']') +
+               "}");
+  std::string e = error_of(f.string());
+  EXPECT_NE(e.find(f.string()), std::string::npos) << e.substr(0, 300);
+  EXPECT_NE(e.find("nested deeper than 64 levels (under key 'model')"), std::string::npos)
+      << e.substr(0, 300);
+  EXPECT_LT(e.size(), 400u);
+
+  nlohmann::json j = to_json(load_scenario("chua-fp"));
+  j["observers"][0]["tol"] = std::vector<double>(10000, 1.0);  // the wrong type, and large
+  write(f, j.dump());
+  e = error_of(f.string());
+  EXPECT_NE(e.find("'tol' must be a finite number, got [1.0,1.0,"), std::string::npos) << e;
+  EXPECT_LT(e.size(), 300u) << e;
+}
+
+// Plots are best-effort: a gnuplot that fails costs the PNGs and a warning, not the run's data.
+TEST(RunSafety, AFailingGnuplotLeavesTheDataAndAWarning) {
+  const fs::path bin = scratch("fake_gnuplot_bin");
+  fs::create_directories(bin);
+  write(bin / "gnuplot",
+        "#!/bin/sh\necho '         plot x' >&2\n"
+        "echo '\"'\"$1\"'\" line 7: all points y value undefined!' >&2\nexit 1\n");
+  fs::permissions(bin / "gnuplot", fs::perms::owner_all);
+  const char* old_path = std::getenv("PATH");
+  const std::string saved = old_path != nullptr ? old_path : "";
+  ::setenv("PATH", bin.c_str(), 1);
+  const fs::path dir = scratch("failing_plots");
+  std::ostringstream out, err;
+  RunOptions o;
+  o.steps = 50;
+  o.out_dir = dir.string();
+  EXPECT_NO_THROW(run_scenario("chua-fp", o, out, err));
+  ::setenv("PATH", saved.c_str(), 1);
+  EXPECT_TRUE(fs::exists(dir / "summary.json"));
+  EXPECT_TRUE(fs::exists(dir / "trajectories.csv"));
+  EXPECT_NE(err.str().find("warning: no PNG plots: gnuplot failed (\"plots.gp\" line 7: all "
+                           "points y value undefined!"),
+            std::string::npos)
+      << err.str();
+  std::ifstream in(dir / "summary.json");
+  const nlohmann::json summary = nlohmann::json::parse(in);
+  ASSERT_TRUE(summary.contains("warnings"));
+  EXPECT_NE(summary["warnings"].dump().find("no PNG plots"), std::string::npos);
 }
 
 TEST(Run, WindowLongerThanDataIsAnError) {
@@ -754,6 +893,34 @@ TEST(RunModulating, NonUniformFileIsRefusedOrResampled) {
   std::ostringstream out2, err2;
   run_scenario(f.string(), {.out_dir = dir.string(), .data_file = data.string()}, out2, err2);
   EXPECT_EQ(out2.str().find("off the uniform grid"), std::string::npos) << out2.str();
+}
+
+// --data with a time jump (200 rows, then 200 from t = 1e9): a sample's work must not grow with
+// the gap (it stepped through all 1e11 skipped grid times). Times so large that their rounding
+// spans the grid step (1e16, 1e17 at δ = 0.01) are refused, not looped on.
+TEST(RunModulating, ATimeJumpCostsNothingAndRestartsTheWindow) {
+  for (const bool resample : {false, true}) {
+    const fs::path data = scratch("mf-jump.csv");
+    {
+      std::ofstream out(data);
+      out << std::setprecision(17) << "t,y\n";
+      for (int k = 0; k < 200; ++k) out << 0.01 * k << ',' << 2.0 * std::cos(0.01 * k) << '\n';
+      for (int k = 0; k < 200; ++k) {
+        const double t = 1e9 + 0.01 * k;
+        out << t << ',' << 2.0 * std::cos(t) << '\n';
+      }
+      out << 1e16 << ',' << 1.0 << '\n' << 1e17 << ',' << 1.0 << '\n';
+    }
+    const fs::path f = scratch("mf-jump.json");
+    write(f, std::string(R"({"name": "mf-jump", "model": {"name": "lti-injection", "step": 0.01},
+      "x0": [2, 0], "initial_guess": [0, 0], "steps": 300, "observers": [{"type": "modulating",
+      "resample": )") +
+                 (resample ? "true" : "false") + "}]}");
+    std::ostringstream out, err;
+    run_scenario(f.string(), {.data_file = data.string()}, out, err);
+    EXPECT_NE(out.str().find("missing_measurement"), std::string::npos) << out.str();
+    EXPECT_NE(out.str().find("non_uniform"), std::string::npos) << out.str();  // 1e17: refused
+  }
 }
 
 }  // namespace

@@ -185,6 +185,11 @@ class ModulatingFunctionObserver final : public Observer {
     // Recorded times carry their decimal rounding: a few ulps of t, relative to δ.
     const double tolerance =
         1e-6 + 4.0 * std::numeric_limits<double>::epsilon() * std::abs(t) / delta;
+    if (!(tolerance < 0.25)) {  // t's rounding spans the grid step: no grid time to place it at
+      return refuse(k, "non_uniform",
+                    "t = " + fmt(t) + " is too large for a grid step of " + fmt(delta) +
+                        " (its rounding exceeds a quarter step)");
+    }
     const bool on_grid = std::abs(position - grid) <= tolerance;
     if (count_ > 0 && (!(t > t_raw_) || (on_grid && grid < static_cast<double>(count_)))) {
       return refuse(k, "non_uniform",
@@ -197,6 +202,9 @@ class ModulatingFunctionObserver final : public Observer {
       // (t_raw, t]; a span longer than the gap limit, or a missing y at either end, makes
       // those samples missing.
       const bool bridge = t - t_raw_ <= max_gap_ * (1.0 + 1e-9);
+      if (!bridge) {  // every grid time before t is missing: skip them at once
+        skip_missing_until(std::floor((t - t0_) / delta + tolerance) - 1.0);
+      }
       while (t0_ + static_cast<double>(count_) * delta <= t + tolerance * delta) {
         const double tg = t0_ + static_cast<double>(count_) * delta;
         const double s = std::min(1.0, (tg - t_raw_) / (t - t_raw_));
@@ -205,6 +213,19 @@ class ModulatingFunctionObserver final : public Observer {
       }
     } else if (on_grid) {
       // Skipped grid times are missing samples (the window refills, or the predictor bridges).
+      // FIR mode: a gap longer than a horizon empties the window, skipped at once. Sampled-data
+      // mode: a gap of more than L + 1 measurement periods is beyond what the predictor
+      // bridges: the observer restarts here (absolute time kept), the last estimate kept.
+      const double gap = grid - static_cast<double>(count_);
+      if (every_ == 0 && gap > static_cast<double>(L_ + 1)) {
+        skip_missing_until(grid - 1.0);
+      } else if (every_ != 0 && gap > static_cast<double>(every_) * static_cast<double>(L_ + 1)) {
+        restart_at(t, y[0]);
+        advance(t0_, y[0], u);
+        t_raw_ = t;
+        y_raw_ = y[0];
+        return step_;
+      }
       while (static_cast<double>(count_) < grid) {
         advance(t0_ + static_cast<double>(count_) * delta, nan, u);
       }
@@ -266,6 +287,31 @@ class ModulatingFunctionObserver final : public Observer {
 
   // One grid time: a measured output (FIR mode; sampled mode at multiples of h) or the
   // predictor's. NaN: the window is invalid until refilled (FIR) or the predictor bridges it.
+  // FIR mode: grid times count_ … last − 1 are all missing, so the window empties once instead
+  // of once per grid time: the work of a sample does not grow with the gap before it (a time
+  // jump to 1e9 in recorded data). The same state as stepping through them one by one.
+  void skip_missing_until(double last) {
+    if (!(last > static_cast<double>(count_) + 1.0)) return;
+    count_ = static_cast<decltype(count_)>(last);
+    step_.measurement_missing = true;
+    invalidate("", "");
+  }
+
+  // Sampled-data mode after a gap the predictor cannot bridge: a fresh start at t, as at the
+  // first sample (the grid is re-anchored at t, so absolute times stay exact), keeping the
+  // last estimate published until the window refills.
+  void restart_at(double t, double y) {
+    const State kept = xhat_;
+    reset();
+    xhat_ = kept;
+    step_.estimate = kept;
+    started_ = true;
+    t0_ = t;
+    t_raw_ = t;
+    y_raw_ = y;
+    step_.measurement_missing = true;
+  }
+
   void advance(double t, double y, const Eigen::VectorXd& u) {
     const bool measured_now = every_ == 0 || count_ % every_ == 0;
     ++count_;
