@@ -179,10 +179,7 @@ std::unique_ptr<Observer> build(Model model, const HighGainSpec& spec, const Eig
 HighGainSpec parse_high_gain_spec(JsonReader& o) {
   HighGainSpec s;
   s.name = o.text("name").value_or("high_gain");
-  if (auto v = o.integer("N")) {
-    if (*v < 2 || *v > 12) o.fail("'N' must be in 2..12");
-    s.N = static_cast<int>(*v);
-  }
+  if (auto v = o.integer("N", 2, 12)) s.N = static_cast<int>(*v);
   s.theta = o.number("theta").value_or(0.1);
   if (!(s.theta > 0.0)) o.fail("'theta' must be > 0");
   if (auto p = o.vector("poles")) s.poles = to_std(*p);
@@ -218,16 +215,13 @@ HighGainSpec parse_high_gain_spec(JsonReader& o) {
   if (s.integrator != "auto" && s.integrator != "rk4" && s.integrator != "cvode") {
     o.fail("'integrator' must be auto, rk4 or cvode");
   }
-  const long substeps = o.integer("substeps").value_or(1);
-  if (substeps < 1 || substeps > 1000) o.fail("'substeps' must be in 1..1000");
-  s.substeps = static_cast<int>(substeps);
+  s.substeps = static_cast<int>(o.integer("substeps", 1, 1000).value_or(1));
   s.jump_threshold = o.number("jump_threshold").value_or(s.jump_threshold);
   s.observability_floor = o.number("observability_floor").value_or(s.observability_floor);
   s.residual_scale = o.number("residual_scale").value_or(s.residual_scale);
   s.restart_residual = o.number("restart_residual").value_or(s.restart_residual);
-  const long every = o.integer("restart_every").value_or(s.restart_every);
-  if (every < 1 || every > 1000000) o.fail("'restart_every' must be in 1..1000000 (samples)");
-  s.restart_every = static_cast<int>(every);
+  s.restart_every =
+      static_cast<int>(o.integer("restart_every", 1, 1000000).value_or(s.restart_every));
   s.initial_z = o.vector("initial_z");
   s.initial_z_from = o.vector("initial_z_from");
   if (s.initial_z && s.initial_z_from) o.fail("give 'initial_z' or 'initial_z_from', not both");

@@ -1,6 +1,8 @@
 #include "json_reader.hpp"
 
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 namespace nlobs::cli {
 
@@ -52,11 +54,22 @@ std::optional<double> JsonReader::number(const std::string& key) {
   return v.get<double>();
 }
 
-std::optional<long> JsonReader::integer(const std::string& key) {
+std::optional<long> JsonReader::integer(const std::string& key, long min, long max) {
   if (!has(key)) return std::nullopt;
   const auto& v = get(key);
   if (!v.is_number_integer()) fail("'" + key + "' must be an integer, got " + json_excerpt(v));
-  return v.get<long>();
+  const auto out_of_range = [&] {
+    fail("'" + key + "' = " + json_excerpt(v) + " is out of range: must be in " +
+         std::to_string(min) + ".." + std::to_string(max));
+  };
+  // Unsigned JSON integers above LONG_MAX (2^63) would wrap when read as long.
+  if (v.is_number_unsigned() &&
+      v.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<long>::max())) {
+    out_of_range();
+  }
+  const long value = v.get<long>();
+  if (value < min || value > max) out_of_range();
+  return value;
 }
 
 std::optional<bool> JsonReader::boolean(const std::string& key) {

@@ -34,7 +34,8 @@ class JsonReader {
   const nlohmann::json& json() const { return object_; }
 
   std::optional<double> number(const std::string& key);
-  std::optional<long> integer(const std::string& key);
+  // An integer in [min, max]; otherwise an error naming the key, the value and the range.
+  std::optional<long> integer(const std::string& key, long min, long max);
   std::optional<bool> boolean(const std::string& key);
   std::optional<std::string> text(const std::string& key);
   std::optional<Eigen::VectorXd> vector(const std::string& key);

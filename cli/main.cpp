@@ -3,13 +3,17 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
+#include <cstdlib>
 #include <iostream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "list_command.hpp"
 #include "reference/mgh_suite.hpp"
 #include "run_command.hpp"
+#include "scenario.hpp"
 #include "solve_chua_window.hpp"
 #include "suite_mgh.hpp"
 
@@ -18,6 +22,24 @@ namespace {
 std::vector<std::string> specs_or(const std::string& list, std::vector<std::string> fallback) {
   if (list.empty()) return fallback;
   return nlobs::reference::split_spec_list(list);
+}
+
+}  // namespace
+
+namespace {
+
+// --seed: decimal digits only, within the generator's 64-bit range (no sign, no wrap-around,
+// no saturation).
+std::uint64_t parse_seed(const std::string& text) {
+  const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+  errno = 0;
+  char* end = nullptr;
+  const unsigned long long v = digits ? std::strtoull(text.c_str(), &end, 10) : 0;
+  if (!digits || errno == ERANGE || end == nullptr || *end != '\0') {
+    throw std::invalid_argument("--seed '" + text.substr(0, 40) +
+                                "' is not an integer in 0..18446744073709551615");
+  }
+  return static_cast<std::uint64_t>(v);
 }
 
 }  // namespace
@@ -62,10 +84,11 @@ int main(int argc, char** argv) {
   std::string scenario;
   long steps = 0;
   double noise = -1.0;
-  std::uint64_t seed = 0;
+  std::string seed;  // parsed strictly below: CLI11 wraps "-1" and saturates 2^70
   nlobs::cli::RunOptions run_options;
   run->add_option("scenario", scenario, "Built-in scenario name or JSON scenario file")->required();
-  CLI::Option* steps_opt = run->add_option("--steps", steps, "Number of samples");
+  CLI::Option* steps_opt = run->add_option("--steps", steps, "Number of samples")
+                               ->check(CLI::Range(1L, nlobs::cli::kMaxSteps));
   CLI::Option* noise_opt =
       run->add_option("--noise", noise, "Std. deviation of Gaussian measurement noise");
   CLI::Option* seed_opt = run->add_option("--seed", seed, "Seed of the noise generator");
@@ -113,7 +136,7 @@ int main(int argc, char** argv) {
     } else if (*run) {
       if (*steps_opt) run_options.steps = steps;
       if (*noise_opt) run_options.noise = noise;
-      if (*seed_opt) run_options.seed = seed;
+      if (*seed_opt) run_options.seed = parse_seed(seed);
       nlobs::cli::run_scenario(scenario, run_options, std::cout, std::cerr);
     } else if (*list) {
       nlobs::cli::print_list(list_what, std::cout);

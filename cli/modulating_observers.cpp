@@ -47,14 +47,8 @@ ModulatingSpec parse_modulating_spec(JsonReader& o) {
   s.name = o.text("name").value_or("modulating");
   s.horizon = o.number("horizon").value_or(1.0);
   if (!(s.horizon > 0.0)) o.fail("'horizon' must be > 0");
-  if (auto v = o.integer("order")) {
-    if (*v < 1 || *v > 20) o.fail("'order' must be in 1..20");
-    s.order = static_cast<int>(*v);
-  }
-  if (auto v = o.integer("degree")) {
-    if (*v < 1 || *v > 29) o.fail("'degree' must be in 1..29");
-    s.degree = static_cast<int>(*v);
-  }
+  if (auto v = o.integer("order", 1, 20)) s.order = static_cast<int>(*v);
+  if (auto v = o.integer("degree", 1, 29)) s.degree = static_cast<int>(*v);
   if (auto w = o.vector("noise_weights")) s.noise_weights = *w;
   s.engine = o.text("engine").value_or("ceres");
   s.quadrature = o.text("quadrature").value_or("simpson");

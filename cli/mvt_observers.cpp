@@ -26,9 +26,7 @@ MvtSpec parse_mvt_spec(JsonReader& o) {
   s.integrator = o.text("integrator").value_or("rk4");
   if (s.integrator != "rk4" && s.integrator != "dopri5")
     o.fail("'integrator' must be rk4 or dopri5");
-  const long substeps = o.integer("substeps").value_or(1);
-  if (substeps < 1 || substeps > 1000) o.fail("'substeps' must be in 1..1000");
-  s.substeps = static_cast<int>(substeps);
+  s.substeps = static_cast<int>(o.integer("substeps", 1, 1000).value_or(1));
   return s;
 }
 

@@ -762,7 +762,10 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
                   std::ostream& err) {
   Scenario s = load_scenario(name);
   if (options.steps) {
-    if (*options.steps < 1) throw std::invalid_argument("--steps must be >= 1");
+    if (*options.steps < 1 || *options.steps > kMaxSteps) {
+      throw std::invalid_argument("--steps " + std::to_string(*options.steps) +
+                                  " is out of range: must be in 1.." + std::to_string(kMaxSteps));
+    }
     s.steps = *options.steps;
   }
   if (options.noise) {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "json_reader.hpp"
@@ -330,15 +331,14 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
   const AnyModel model = make_model(*model_spec);  // validates now, naming the key
   s.x0 = r.required_vector("x0");
   s.initial_guess = r.required_vector("initial_guess");
-  if (auto v = r.integer("steps")) {
-    if (*v < 1) r.fail("'steps' must be >= 1");
-    s.steps = *v;
-  }
+  if (auto v = r.integer("steps", 1, kMaxSteps)) s.steps = *v;
   if (auto v = r.number("noise")) {
     if (*v < 0) r.fail("'noise' must be >= 0");
     s.noise = *v;
   }
-  if (auto v = r.integer("seed")) s.seed = static_cast<std::uint64_t>(*v);
+  if (auto v = r.integer("seed", 0, std::numeric_limits<long>::max())) {
+    s.seed = static_cast<std::uint64_t>(*v);
+  }
   if (auto v = r.number("settle_time")) {
     if (!(*v >= 0.0) || !std::isfinite(*v)) r.fail("'settle_time' must be finite and >= 0 (s)");
     s.settle_time = *v;
@@ -370,7 +370,7 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
     if (spec.type == "window") {
       spec.engine = o.text("engine").value_or("newton");
       spec.tol = o.number("tol");
-      spec.window = o.integer("window").value_or(0);
+      spec.window = o.integer("window", 0, kMaxWindow).value_or(0);
       spec.warm_start = o.text("warm_start").value_or("propagated");
       if (spec.warm_start != "propagated" && spec.warm_start != "previous") {
         o.fail("'warm_start' must be propagated or previous");
@@ -425,9 +425,7 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
       if (spec.pi.start != "paper" && spec.pi.start != "zero") {
         o.fail("'start' must be paper (gamma(0) = 0) or zero (estimates start at 0)");
       }
-      const long substeps = o.integer("substeps").value_or(1);
-      if (substeps < 1 || substeps > 1000) o.fail("'substeps' must be in 1..1000");
-      spec.pi.substeps = static_cast<int>(substeps);
+      spec.pi.substeps = static_cast<int>(o.integer("substeps", 1, 1000).value_or(1));
       if (auto parameters = o.object("parameters")) spec.pi.parameters = parameters->json();
       o.finish({"type", "bank", "gains", "omega_bounds", "start", "substeps", "parameters"});
     } else if (spec.type == "mvt") {

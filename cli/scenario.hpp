@@ -20,6 +20,11 @@
 
 namespace nlobs::cli {
 
+// Limits checked before anything is allocated: samples of a run (n × steps doubles per
+// observer are kept), samples of a window.
+inline constexpr long kMaxSteps = 10'000'000;
+inline constexpr long kMaxWindow = 100'000;
+
 struct ObserverSpec {
   // "window", "luenberger", "sliding_mode", "ekf", "pi_bank", "mvt", "high_gain", "modulating",
   // "finite_difference"

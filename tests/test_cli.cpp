@@ -70,6 +70,23 @@ TEST(Cli, InvalidToleranceIsAnError) {
   EXPECT_NE(r.out.find("--tol"), std::string::npos) << r.out;
 }
 
+// Out-of-range integers are errors naming the option and the range, before anything runs
+// (--seed -1 became 2^64 - 1, huge --steps ended in std::bad_alloc).
+TEST(Cli, OutOfRangeIntegersAreErrors) {
+  for (const char* args : {"run chua-fp --seed -1", "run chua-fp --seed 1180591620717411303424",
+                           "run chua-fp --steps 0", "run chua-fp --steps 100000000000"}) {
+    const CliRun r = run(args);
+    EXPECT_NE(r.status, 0) << args;
+    EXPECT_TRUE(r.out.find("--seed") != std::string::npos ||
+                r.out.find("--steps") != std::string::npos)
+        << args << ": " << r.out;
+  }
+  const CliRun m = run("solve chua-window --engines anderson:m=1000000000 --no-reference");
+  EXPECT_NE(m.status, 0);
+  EXPECT_NE(m.out.find("'m=1000000000' is out of range: must be in 0.."), std::string::npos)
+      << m.out;
+}
+
 TEST(Cli, SolveAcceptsEngineSpecs) {
   const CliRun r =
       run("solve chua-window --tol 1e-8 --no-reference --json "

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -304,6 +305,28 @@ TEST(RunSafety, DeepOrHugeJsonValuesGiveShortErrors) {
   e = error_of(f.string());
   EXPECT_NE(e.find("'tol' must be a finite number, got [1.0,1.0,"), std::string::npos) << e;
   EXPECT_LT(e.size(), 300u) << e;
+}
+
+TEST(RunSafety, OutOfRangeIntegersNameTheKeyAndTheRange) {
+  const fs::path f = scratch("ranges.json");
+  const auto error_with = [&](const std::function<void(nlohmann::json&)>& edit) {
+    nlohmann::json j = to_json(load_scenario("chua-fp"));
+    edit(j);
+    write(f, j.dump());
+    return error_of(f.string());
+  };
+  std::string e = error_with([](nlohmann::json& j) { j["observers"][0]["window"] = -3; });
+  EXPECT_NE(e.find("'window' = -3 is out of range: must be in 0..100000"), std::string::npos) << e;
+  e = error_with([](nlohmann::json& j) { j["steps"] = 9223372036854775808ULL; });  // 2^63
+  EXPECT_NE(e.find("'steps' = 9223372036854775808 is out of range"), std::string::npos) << e;
+  e = error_with([](nlohmann::json& j) { j["steps"] = 100000000000LL; });
+  EXPECT_NE(e.find("must be in 1..10000000"), std::string::npos) << e;
+  e = error_with([](nlohmann::json& j) { j["seed"] = -1; });
+  EXPECT_NE(e.find("'seed' = -1 is out of range"), std::string::npos) << e;
+  EXPECT_NE(error_of("chua-fp", {.steps = 100000000000L})
+                .find("--steps 100000000000 is out of "
+                      "range"),
+            std::string::npos);
 }
 
 // Plots are best-effort: a gnuplot that fails costs the PNGs and a warning, not the run's data.

@@ -78,14 +78,16 @@ std::optional<double> EngineSpecReader::number(const std::string& key) {
   return v;
 }
 
-std::optional<int> EngineSpecReader::integer(const std::string& key) {
+std::optional<int> EngineSpecReader::integer(const std::string& key, int min, int max) {
   const auto t = text(key);
   if (!t) return std::nullopt;
   char* end = nullptr;
   errno = 0;
   const long v = std::strtol(t->c_str(), &end, 10);
-  if (end == t->c_str() || *end != '\0' || errno == ERANGE || v < -1000000000L || v > 1000000000L) {
-    fail("'" + key + "=" + *t + "' is not an integer");
+  if (end == t->c_str() || *end != '\0') fail("'" + key + "=" + *t + "' is not an integer");
+  if (errno == ERANGE || v < min || v > max) {
+    fail("'" + key + "=" + *t + "' is out of range: must be in " + std::to_string(min) + ".." +
+         std::to_string(max));
   }
   return static_cast<int>(v);
 }

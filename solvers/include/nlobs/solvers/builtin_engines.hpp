@@ -55,7 +55,7 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
        {"anderson", "anderson:m=3,damping=0.5"},
        [](EngineSpecReader& s, SolverOptions o) {
          AndersonOptions a;
-         if (auto v = s.integer("m")) a.depth = *v;
+         if (auto v = s.integer("m", 0, AndersonMixing<N>::kMaxDepth)) a.depth = *v;
          if (auto v = s.number("damping")) a.damping = *v;
          if (auto v = s.number("cond")) a.condition_limit = *v;
          return std::make_unique<AndersonEngine<N>>(a, std::move(o));

@@ -176,8 +176,8 @@ std::unique_ptr<Engine<N>> EngineRegistry<N>::create(std::string_view spec_text,
   EngineSpecReader reader(spec, valid);
   if (auto v = reader.number("tol")) base.stop.step_tolerance = *v;
   if (auto v = reader.number("ftol")) base.stop.residual_tolerance = *v;
-  if (auto v = reader.integer("max_iter")) base.stop.max_iterations = *v;
-  if (auto v = reader.integer("max_evals")) base.stop.max_evaluations = *v;
+  if (auto v = reader.integer("max_iter", 1, 1000000000)) base.stop.max_iterations = *v;
+  if (auto v = reader.integer("max_evals", 1, 1000000000)) base.stop.max_evaluations = *v;
   std::unique_ptr<Engine<N>> engine = entry->make(reader, std::move(base));
   reader.finish();
   if (!engine) throw InvalidInput("engine '" + spec.name + "': its factory returned no engine");

@@ -34,7 +34,8 @@ class EngineSpecReader {
   EngineSpecReader(const EngineSpec& spec, std::vector<EngineOptionInfo> valid);
 
   std::optional<double> number(const std::string& key);
-  std::optional<int> integer(const std::string& key);
+  // An integer in [min, max]; otherwise InvalidInput naming the key, the value and the range.
+  std::optional<int> integer(const std::string& key, int min, int max);
   std::optional<bool> boolean(const std::string& key);  // 0/1, true/false, on/off
   std::optional<std::string> text(const std::string& key);
   // The single bare word, if any, which must be one of `allowed` (empty: any).

@@ -24,7 +24,7 @@
 namespace nlobs {
 
 struct AndersonOptions {
-  int depth = 3;         // m ≥ 0
+  int depth = 3;         // m ∈ [0, AndersonMixing::kMaxDepth]
   double damping = 1.0;  // β ∈ (0, 1]
   // Oldest history columns are dropped while max|R_ii| / min|R_ii| (a cheap lower bound on
   // cond(R)) exceeds this: nearly dependent differences otherwise give huge γ and wild steps.
@@ -35,13 +35,16 @@ template <int N = Dynamic>
 class AndersonMixing {
  public:
   static constexpr int kMaxFixedDepth = 16;
+  // Dynamic sizes: the history is n × m; a depth beyond this is never useful and would only
+  // exhaust memory (m = 1e9 did).
+  static constexpr int kMaxDynamicDepth = 1000;
+  static constexpr int kMaxDepth = N != Dynamic ? kMaxFixedDepth : kMaxDynamicDepth;
 
   explicit AndersonMixing(AndersonOptions options = {}) : options_(options) {
-    if (options_.depth < 0 || (N != Dynamic && options_.depth > kMaxFixedDepth)) {
+    if (options_.depth < 0 || options_.depth > kMaxDepth) {
       std::ostringstream os;
-      os << "AndersonOptions::depth = " << options_.depth << " is invalid: must be >= 0"
-         << (N != Dynamic ? " and <= " + std::to_string(kMaxFixedDepth) + " for fixed sizes"
-                          : std::string());
+      os << "AndersonOptions::depth = " << options_.depth << " is invalid: must be in 0.."
+         << kMaxDepth << (N != Dynamic ? " for fixed sizes" : "");
       throw InvalidInput(os.str());
     }
     if (!(options_.condition_limit > 1.0)) {
