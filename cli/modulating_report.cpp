@@ -253,12 +253,7 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
     const std::string bounds = series(5, " Theorem 1 bound", &Row::bound);
     if (!bounds.empty()) g << ", " << bounds;
     g << "\nunset multiplot\n";
-    const std::string failure = run_gnuplot(dir, "sweep.gp", g.str());
-    if (failure.empty()) {
-      out << ", sweep.png";
-    } else {
-      err << "nlobs: warning: no sweep.png: " << failure << '\n';
-    }
+    plot_sweep(dir, g.str(), out, err);
   }
   out << '\n';
 }

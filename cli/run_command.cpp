@@ -463,8 +463,14 @@ fs::path output_directory(const std::string& out_dir) {
   return dir;
 }
 
-std::string run_gnuplot(const fs::path& dir, const std::string& file, const std::string& script) {
-  return run_gnuplot_script(dir, file, script);
+void plot_sweep(const fs::path& dir, const std::string& script, std::ostream& out,
+                std::ostream& err) {
+  const std::string failure = run_gnuplot_script(dir, "sweep.gp", script);
+  if (failure.empty()) {
+    out << ", sweep.png";
+  } else {
+    err << "nlobs: warning: no sweep.png: " << failure << '\n';
+  }
 }
 
 std::vector<double> parse_sweep_values(const std::string& key, const std::string& list,
@@ -628,7 +634,7 @@ std::vector<std::string> plot(const fs::path& dir, const Measurements& data, con
     }
     written.push_back("first_window.png");
   }
-  *failure = run_gnuplot(dir, "plots.gp", g.str());
+  *failure = run_gnuplot_script(dir, "plots.gp", g.str());
   if (!failure->empty()) written.clear();
   return written;
 }
@@ -746,12 +752,7 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
       << "set xlabel 'theta'\nset ylabel 'max ||zhat|| (peaking)'\nplot " << series(2, "")
       << "\nset ylabel 'RMS error after settling'\nplot " << series(3, " z") << ", "
       << series(4, " x") << "\nunset multiplot\n";
-    const std::string failure = run_gnuplot(dir, "sweep.gp", g.str());
-    if (failure.empty()) {
-      out << ", sweep.png";
-    } else {
-      err << "nlobs: warning: no sweep.png: " << failure << '\n';
-    }
+    plot_sweep(dir, g.str(), out, err);
   }
   out << '\n';
 }

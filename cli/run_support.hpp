@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <ostream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -22,10 +23,10 @@ std::string fmt(double v, const char* f = "%.3e");  // "-" for non-finite values
 bool have_gnuplot();                                // on PATH (gnuplot.hpp)
 // --out DIR made absolute and created (gnuplot runs inside it: scripts name files relative to it).
 std::filesystem::path output_directory(const std::string& out_dir);
-// Writes `script` to dir/file and runs gnuplot on it there, without a shell (gnuplot.hpp). Plots
-// are best-effort: returns an empty string, or why they failed (for a warning; never thrown).
-std::string run_gnuplot(const std::filesystem::path& dir, const std::string& file,
-                        const std::string& script);
+// sweep.png from `script` (run_gnuplot_script, gnuplot.hpp): ", sweep.png" to `out` when drawn,
+// else a warning naming why to `err` (plots are best-effort).
+void plot_sweep(const std::filesystem::path& dir, const std::string& script, std::ostream& out,
+                std::ostream& err);
 // "v1,v2,…" of `--sweep key=…`: finite numbers (> 0 when `positive`), at least one.
 std::vector<double> parse_sweep_values(const std::string& key, const std::string& list,
                                        bool positive);

@@ -224,10 +224,9 @@ class ExtendedKalmanFilter final : public Observer {
   }
 
   void predicted_failure(long k, const char* what, const char* action) {
-    step_.failure = "non_finite_estimate";
     std::ostringstream os;
     os << name() << ": " << what << " at sample k = " << k << " is not finite; " << action;
-    step_.failure_message = os.str();
+    mark_non_finite_estimate(step_, os.str());
   }
 
   Model model_;

@@ -375,9 +375,8 @@ class ModulatingFunctionObserver final : public Observer {
         xhat_ = x;
         step_.estimate = xhat_;
       } else {
-        step_.failure = "non_finite_estimate";
-        step_.failure_message =
-            options_.name + ": the state of eta at t = " + fmt(t) + " is not finite; estimate kept";
+        mark_non_finite_estimate(step_, options_.name + ": the state of eta at t = " + fmt(t) +
+                                            " is not finite; estimate kept");
       }
     }  // not ready: η̂ stays the guess before the first horizon, the last estimate after
     if (every_ != 0) rate_ = predictor_rate(t, yhat_, eta_, u);

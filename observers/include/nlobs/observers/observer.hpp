@@ -6,6 +6,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "nlobs/solvers/summary.hpp"
@@ -55,6 +56,12 @@ class Observer {
   }
 };
 
+// Marks a step whose estimate (or what it is computed from) was not finite and was not taken.
+inline void mark_non_finite_estimate(ObserverStep& step, std::string message) {
+  step.failure = "non_finite_estimate";
+  step.failure_message = std::move(message);
+}
+
 // The one rule for an observer's own state: `next` replaces `state` only when it is finite;
 // otherwise the state keeps its last finite value and the step says so (failure
 // "non_finite_estimate", with who, k and what overflowed). Returns whether `next` was taken.
@@ -65,11 +72,10 @@ bool accept_finite(const State& next, State& state, ObserverStep& step, const st
     state = next;
     return true;
   }
-  step.failure = "non_finite_estimate";
   std::ostringstream os;
   os << who << ": " << what << " at sample k = " << k
      << " is not finite; kept the last finite estimate";
-  step.failure_message = os.str();
+  mark_non_finite_estimate(step, os.str());
   return false;
 }
 

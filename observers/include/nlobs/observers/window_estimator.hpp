@@ -108,17 +108,12 @@ class WindowEstimator final : public Observer {
   void require_least_squares_engine() const;
   // The estimate kept for the window's first sample k − N + 1, coasted on the model.
   State coasted_guess(long k) const;
-  void mark_non_finite(const std::string& message) {
-    step_.failure = "non_finite_estimate";
-    step_.failure_message = message;
-  }
   Summary solve_window(Engine<N>& engine, State& w, long k);
   Summary solve_once(Engine<N>& engine, State& w);
   void choose_gain(const Engine<N>& engine, const State& w, long k);
   // Ψ = (∂H/∂w)⁻¹ at w; false (Ψ unchanged) where ∂H/∂w is singular or not finite.
   bool refresh_newton_gain(const State& w);
   bool window_jacobian(const State& w, Gain& dh) const;  // dh = ∂H/∂w
-  void warn(const std::string& text);
 
   WindowEstimatorOptions options_;
   std::unique_ptr<Engine<N>> engine_;
@@ -245,7 +240,7 @@ const ObserverStep& WindowEstimator<Model>::step(long k, const Eigen::VectorXd& 
         std::ostringstream os;
         os << name() << ": the window's solution at sample k = " << k
            << " carried to x̂[k] by the model is not finite; the estimate coasts";
-        mark_non_finite(os.str());
+        mark_non_finite_estimate(step_, os.str());
       }
     }
   }
@@ -253,14 +248,8 @@ const ObserverStep& WindowEstimator<Model>::step(long k, const Eigen::VectorXd& 
   if (!solved && k > 0) {
     const State next =
         window.model().f(coast_, typename OutputWindow<Model>::Input(last_u_), k - 1);
-    if (next.allFinite()) {
-      coast_ = next;
-    } else {
-      std::ostringstream os;
-      os << name() << ": coasting on the model from the last estimate gave a non-finite state "
-         << "at sample k = " << k << "; kept the last finite estimate";
-      mark_non_finite(os.str());
-    }
+    accept_finite(next, coast_, step_, name(), k,
+                  "the state coasted on the model from the last estimate");
   }
   last_u_ = u;
   history_[static_cast<size_t>(k % length)] = coast_;
@@ -301,7 +290,7 @@ Summary WindowEstimator<Model>::solve_window(Engine<N>& engine, State& w, long k
          << " is a singular point of the window map (" << s.message
          << "): the state is not observable from the window there (an equilibrium?); solves "
             "from such a guess restart from a perturbed one";
-      warn(os.str());
+      warnings_.push_back(os.str());
     }
     for (Eigen::Index i = 0; i < w.size(); ++i) {
       const double sign = i % 2 == 0 ? 1.0 : -1.0;
@@ -356,7 +345,7 @@ void WindowEstimator<Model>::choose_gain(const Engine<N>& engine, const State& w
   }
   const Eigen::Index n = w.size();
   Gain dh(n, n);
-  const Gain psi = active_gain_ == WindowGain::kScalar ? state_->gain : Gain(Gain::Identity(n, n));
+  const Gain& psi = state_->gain;  // I, or gain_scale·I (reset()); newton never reaches here
   double rho = std::nan("");
   if (window_jacobian(w, dh)) rho = spectral_radius(Gain(Gain::Identity(n, n) - psi * dh));
   if (rho < 1.0) {
@@ -374,7 +363,7 @@ void WindowEstimator<Model>::choose_gain(const Engine<N>& engine, const State& w
   } else {
     os << "; engine '" << spec_ << "' needs a contraction: psi = auto or newton makes G contract";
   }
-  warn(os.str());
+  warnings_.push_back(os.str());
 }
 
 template <DiscreteModel Model>
@@ -396,11 +385,6 @@ bool WindowEstimator<Model>::window_jacobian(const State& w, Gain& dh) const {
   square_residual_->jacobian(w, dh);  // ∂(Y − H)/∂w
   dh = -dh;
   return dh.allFinite();
-}
-
-template <DiscreteModel Model>
-void WindowEstimator<Model>::warn(const std::string& text) {
-  warnings_.push_back(text);
 }
 
 template <DiscreteModel Model>
