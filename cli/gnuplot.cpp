@@ -1,19 +1,22 @@
 #include "gnuplot.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
-#include "run_support.hpp"
+#include "output_directory.hpp"
 
 extern char** environ;
 
@@ -79,25 +82,26 @@ std::optional<std::filesystem::path> find_gnuplot() {
   return std::nullopt;
 }
 
-std::string run_gnuplot_script(const std::filesystem::path& dir, const std::string& script_name,
-                               const std::string& script) {
+std::string run_gnuplot_script(OutputDirectory& dir, const std::string& script_name,
+                               const std::string& script, std::chrono::milliseconds timeout) {
   const std::optional<std::filesystem::path> gnuplot = find_gnuplot();
   if (!gnuplot) return "gnuplot not found on PATH";
   try {
-    write_atomically(dir / script_name, script);
+    dir.write(script_name, script);
   } catch (const std::exception& e) {
     return e.what();
   }
   // The log is opened here, so that a failure names it rather than gnuplot.
-  const std::filesystem::path log_path = dir / "gnuplot.log";
+  const std::filesystem::path log_path = dir.path() / "gnuplot.log";
   const int log =
       ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW, 0644);
   if (log < 0) return "cannot write " + log_path.string() + ": " + std::strerror(errno);
+  dir.note_written("gnuplot.log");
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   // The child starts in dir (no "cd" through a shell), stdin and stdout on /dev/null, stderr
   // in gnuplot.log.
-  int setup = posix_spawn_file_actions_addchdir_np(&actions, dir.c_str());
+  int setup = posix_spawn_file_actions_addchdir_np(&actions, dir.path().c_str());
   if (setup == 0) setup = posix_spawn_file_actions_adddup2(&actions, log, STDERR_FILENO);
   if (setup == 0) {
     setup = posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
@@ -114,11 +118,38 @@ std::string run_gnuplot_script(const std::filesystem::path& dir, const std::stri
   posix_spawn_file_actions_destroy(&actions);
   ::close(log);
   if (spawned != 0) {
-    return "cannot start " + program + " in " + dir.string() + ": " + std::strerror(spawned);
+    return "cannot start " + program + " in " + dir.path().string() + ": " + std::strerror(spawned);
   }
+  // Polled, so that a gnuplot that hangs (a huge plot, a stuck font lookup) is stopped. The
+  // child is reaped only after the signal handler has forgotten it (waitid with WNOWAIT leaves
+  // it a zombie), so the handler can never kill a process that reuses its PID.
+  set_interruptible_child(pid);
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  bool timed_out = false;
+  for (;;) {
+    siginfo_t info{};
+    const int polled = waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOHANG | WNOWAIT);
+    if (polled == 0 && info.si_pid == pid) break;  // exited, not yet reaped
+    if (polled < 0 && errno != EINTR) {
+      const int error = errno;
+      set_interruptible_child(0);
+      return std::string("waiting for gnuplot: ") + std::strerror(error);
+    }
+    if (!timed_out && std::chrono::steady_clock::now() > deadline) {
+      ::kill(pid, SIGKILL);
+      timed_out = true;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  set_interruptible_child(0);
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) return std::string("waiting for gnuplot: ") + std::strerror(errno);
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (timed_out) {
+    char limit[32];
+    std::snprintf(limit, sizeof limit, "%g s", static_cast<double>(timeout.count()) / 1e3);
+    return std::string("gnuplot did not finish within ") + limit + " and was stopped (see " +
+           log_path.string() + ")";
   }
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return {};
   // gnuplot echoes the failing command, marks the column with ^, then says
@@ -138,7 +169,7 @@ std::string run_gnuplot_script(const std::filesystem::path& dir, const std::stri
     first = WIFSIGNALED(status) ? "killed by signal " + std::to_string(WTERMSIG(status))
                                 : "exit status " + std::to_string(WEXITSTATUS(status));
   }
-  return "gnuplot failed (" + first + "; see " + (dir / "gnuplot.log").string() + ")";
+  return "gnuplot failed (" + first + "; see " + log_path.string() + ")";
 }
 
 }  // namespace nlobs::cli

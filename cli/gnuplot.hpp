@@ -3,6 +3,7 @@
 // directory set directly), and every user-provided string written into a script through one
 // quoting function, so that a scenario name, an observer name or an --out path may contain any
 // bytes without running a command.
+#include <chrono>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -26,10 +27,18 @@ std::string gnuplot_comment_text(std::string_view text);
 // The gnuplot executable found on PATH's absolute entries (searched directly, no shell).
 std::optional<std::filesystem::path> find_gnuplot();
 
-// Writes `script` to dir/script_name and runs gnuplot on it with dir as the working directory
-// (stderr to dir/gnuplot.log). Returns an empty string on success, else why it failed: the
-// first line of gnuplot's message, or the system's reason it could not start.
-std::string run_gnuplot_script(const std::filesystem::path& dir, const std::string& script_name,
-                               const std::string& script);
+class OutputDirectory;
+
+// How long gnuplot may run before it is stopped (nlobs run --plot-timeout).
+inline constexpr std::chrono::milliseconds kDefaultPlotTimeout{120'000};
+
+// Writes `script` as dir/script_name and runs gnuplot on it with the directory as its working
+// directory (stderr to gnuplot.log), stopping it after `timeout`. The script names its outputs
+// by OutputDirectory::external(); the caller commits or discards them. Returns an empty string
+// on success, else why it failed: the first line of gnuplot's message, the timeout, or the
+// system's reason it could not start.
+std::string run_gnuplot_script(OutputDirectory& dir, const std::string& script_name,
+                               const std::string& script,
+                               std::chrono::milliseconds timeout = kDefaultPlotTimeout);
 
 }  // namespace nlobs::cli

@@ -4,6 +4,8 @@
 #include <cstdint>
 #include <limits>
 
+#include "nlobs/solvers/status.hpp"
+
 namespace nlobs::cli {
 
 std::string json_excerpt(const nlohmann::json& value) {
@@ -18,9 +20,9 @@ nlohmann::json parse_json(std::istream& in, const std::string& where) {
       [&](int depth, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
         if (event == nlohmann::json::parse_event_t::key) last_key = parsed.get<std::string>();
         if (depth >= kMaxJsonDepth) {  // the top level is depth 0
-          throw std::invalid_argument(where + ": nested deeper than " +
-                                      std::to_string(kMaxJsonDepth) + " levels" +
-                                      (last_key.empty() ? "" : " (under key '" + last_key + "')"));
+          throw std::invalid_argument(
+              where + ": nested deeper than " + std::to_string(kMaxJsonDepth) + " levels" +
+              (last_key.empty() ? "" : " (under key " + quoted_excerpt(last_key) + ")"));
         }
         return true;
       };
@@ -28,6 +30,12 @@ nlohmann::json parse_json(std::istream& in, const std::string& where) {
     return nlohmann::json::parse(in, limit);
   } catch (const nlohmann::json::parse_error& e) {
     throw std::invalid_argument(where + ": not valid JSON: " + e.what());
+  } catch (const nlohmann::json::out_of_range& e) {
+    // A number beyond a double ("1e400", out_of_range.406): the key it came under says where.
+    // The key read last: the number's own, or (in an array) the one before it.
+    throw std::invalid_argument(
+        where + ": " + (last_key.empty() ? "" : "near key " + quoted_excerpt(last_key) + ": ") +
+        "a number is out of the range of a double (" + e.what() + ")");
   }
 }
 

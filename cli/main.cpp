@@ -4,13 +4,17 @@
 
 #include <CLI/CLI.hpp>
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <iostream>
+#include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "list_command.hpp"
+#include "output_directory.hpp"
 #include "reference/mgh_suite.hpp"
 #include "run_command.hpp"
 #include "scenario.hpp"
@@ -27,6 +31,31 @@ std::vector<std::string> specs_or(const std::string& list, std::vector<std::stri
 }  // namespace
 
 namespace {
+
+constexpr int kCommandLineError = 1;  // an unknown option, a value that does not parse
+constexpr int kRunError = 2;          // a scenario, data file or computation that failed
+
+// A finite number in [min, max] (CLI::Range lets NaN through: every comparison with it is false),
+// with the same message for inf and nan.
+CLI::Validator finite_in(double min, double max, const std::string& description) {
+  return CLI::Validator(
+      [min, max](std::string& text) {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        const bool ok =
+            end != text.c_str() && *end == '\0' && std::isfinite(v) && v >= min && v <= max;
+        if (ok) return std::string();
+        std::ostringstream os;
+        os << "'" << text.substr(0, 40) << "' is not a finite number ";
+        if (max == std::numeric_limits<double>::max()) {
+          os << ">= " << min;
+        } else {
+          os << "in " << min << ".." << max;
+        }
+        return os.str();
+      },
+      description);
+}
 
 // --seed: decimal digits only, within the generator's 64-bit range (no sign, no wrap-around,
 // no saturation).
@@ -90,13 +119,17 @@ int main(int argc, char** argv) {
   CLI::Option* steps_opt = run->add_option("--steps", steps, "Number of samples")
                                ->check(CLI::Range(1L, nlobs::cli::kMaxSteps));
   CLI::Option* noise_opt =
-      run->add_option("--noise", noise, "Std. deviation of Gaussian measurement noise");
+      run->add_option("--noise", noise, "Std. deviation of Gaussian measurement noise")
+          ->check(finite_in(0.0, std::numeric_limits<double>::max(), "SIGMA >= 0"));
   CLI::Option* seed_opt = run->add_option("--seed", seed, "Seed of the noise generator");
   run->add_option("--out", run_options.out_dir,
                   "Directory for summary.json, trajectories.csv and PNG plots");
   run->add_option("--sweep", run_options.sweep,
                   "KEY=v1,v2,...: theta (high_gain: peaking vs noise), horizon or "
                   "sample_period (modulating), or a model parameter (re-simulated)");
+  run->add_option("--plot-timeout", run_options.plot_timeout,
+                  "Seconds gnuplot may take before the plots are skipped (default 120)")
+      ->check(finite_in(1e-3, 86400.0, "SECONDS in 0.001..86400"));
   run->add_option("--data", run_options.data_file,
                   "Observe recorded measurements (CSV: t, y1..yp[, u1..um]) instead of simulating");
 
@@ -105,10 +138,17 @@ int main(int argc, char** argv) {
   std::string list_what;
   list->add_option("what", list_what, "models | engines | observers | scenarios (default: all)");
 
-  CLI11_PARSE(app, argc, argv);
+  // Exit status 1: the command line itself is wrong (docs/cli.md); 2: the run failed.
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : kCommandLineError;  // --help and --version exit 0
+  }
   // Ceres logs failed evaluations through glog even when told to be silent; the statuses in
   // our tables already say what happened.
   FLAGS_minloglevel = google::GLOG_FATAL;
+  // An interrupted run leaves no temporary files in its output directory.
+  nlobs::cli::install_interrupt_cleanup();
 
   try {
     if (*chua) {
@@ -136,14 +176,21 @@ int main(int argc, char** argv) {
     } else if (*run) {
       if (*steps_opt) run_options.steps = steps;
       if (*noise_opt) run_options.noise = noise;
-      if (*seed_opt) run_options.seed = parse_seed(seed);
+      if (*seed_opt) {
+        try {
+          run_options.seed = parse_seed(seed);
+        } catch (const std::invalid_argument& e) {
+          std::cerr << "nlobs: error: " << e.what() << '\n';
+          return kCommandLineError;
+        }
+      }
       nlobs::cli::run_scenario(scenario, run_options, std::cout, std::cerr);
     } else if (*list) {
       nlobs::cli::print_list(list_what, std::cout);
     }
   } catch (const std::exception& e) {
     std::cerr << "nlobs: error: " << e.what() << '\n';
-    return 2;
+    return kRunError;
   }
   return 0;
 }

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "gnuplot.hpp"
+#include "run_outputs.hpp"
 #include "run_support.hpp"
 
 namespace nlobs::cli {
@@ -205,8 +206,6 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
     }
   }
   if (options.out_dir.empty()) return;
-  const fs::path dir = output_directory(options.out_dir);
-  write_atomically(dir / "sweep.csv", csv.str());
   std::ostringstream blocks;
   blocks << std::setprecision(10);
   for (const std::string& name : names) {
@@ -219,43 +218,37 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
     }
     blocks << "\n\n";
   }
-  write_atomically(dir / "sweep.dat", blocks.str());
-  out << "wrote " << (dir / "sweep.csv").string() << ", sweep.dat";
-  if (have_gnuplot()) {
-    const bool positive = std::all_of(values.begin(), values.end(), [](double v) { return v > 0; });
-    std::ostringstream g;
-    // Only the observers that have the column's quantity (η, a bound) get a line for it.
-    const auto has = [&](const std::string& name, double Row::*field) {
-      return std::any_of(rows.begin(), rows.end(), [&](const Row& row) {
-        return row.name == name && std::isfinite(row.*field);
-      });
-    };
-    const auto series = [&](int column, const std::string& suffix, double Row::*field) {
-      std::string text;
-      for (size_t i = 0; i < names.size(); ++i) {
-        if (!has(names[i], field)) continue;
-        text += (text.empty() ? "" : ", ") + std::string("'sweep.dat' index ") + std::to_string(i) +
-                " using 1:" + std::to_string(column) + " with linespoints title " +
-                gnuplot_quoted(names[i] + suffix);
-      }
-      return text;
-    };
-    std::ostringstream title;
-    title << key << " sweep: " << s.name << " (noise " << s.noise << ")";
-    g << "set terminal pngcairo noenhanced size 1000,800\nset output 'sweep.png'\n"
-      << "set multiplot layout 2,1 title " << gnuplot_quoted(title.str()) << "\n"
-      << (positive ? "set logscale xy\n" : "set logscale y\n")
-      << "set grid\nset key outside right\n"
-      << "set xlabel " << gnuplot_quoted(key)
-      << "\nset ylabel 'RMS error of x2 (derivative) after settling'\nplot "
-      << series(2, "", &Row::x2) << "\nset ylabel 'max ||eta - etahat|| from one horizon'\nplot "
-      << series(3, "", &Row::eta_abs);
-    const std::string bounds = series(5, " Theorem 1 bound", &Row::bound);
-    if (!bounds.empty()) g << ", " << bounds;
-    g << "\nunset multiplot\n";
-    plot_sweep(dir, g.str(), out, err);
-  }
-  out << '\n';
+  const bool positive = std::all_of(values.begin(), values.end(), [](double v) { return v > 0; });
+  std::ostringstream g;
+  // Only the observers that have the column's quantity (η, a bound) get a line for it.
+  const auto has = [&](const std::string& name, double Row::*field) {
+    return std::any_of(rows.begin(), rows.end(), [&](const Row& row) {
+      return row.name == name && std::isfinite(row.*field);
+    });
+  };
+  const auto series = [&](int column, const std::string& suffix, double Row::*field) {
+    std::string text;
+    for (size_t i = 0; i < names.size(); ++i) {
+      if (!has(names[i], field)) continue;
+      text += (text.empty() ? "" : ", ") + std::string("'sweep.dat' index ") + std::to_string(i) +
+              " using 1:" + std::to_string(column) + " with linespoints title " +
+              gnuplot_quoted(names[i] + suffix);
+    }
+    return text;
+  };
+  std::ostringstream title;
+  title << key << " sweep: " << s.name << " (noise " << s.noise << ")";
+  g << "set multiplot layout 2,1 title " << gnuplot_quoted(title.str()) << "\n"
+    << (positive ? "set logscale xy\n" : "set logscale y\n") << "set grid\nset key outside right\n"
+    << "set xlabel " << gnuplot_quoted(key)
+    << "\nset ylabel 'RMS error of x2 (derivative) after settling'\nplot "
+    << series(2, "", &Row::x2) << "\nset ylabel 'max ||eta - etahat|| from one horizon'\nplot "
+    << series(3, "", &Row::eta_abs);
+  const std::string bounds = series(5, " Theorem 1 bound", &Row::bound);
+  if (!bounds.empty()) g << ", " << bounds;
+  g << "\nunset multiplot\n";
+  OutputDirectory dir(options.out_dir);
+  write_sweep_files(dir, csv.str(), blocks.str(), g.str(), plot_timeout(options), out, err);
 }
 
 }  // namespace nlobs::cli

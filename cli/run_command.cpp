@@ -13,9 +13,11 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "data_file.hpp"
 #include "gnuplot.hpp"
 #include "modulating_report.hpp"
 #include "nlobs/observers/simulation.hpp"
+#include "run_outputs.hpp"
 #include "run_support.hpp"
 #include "scenario.hpp"
 
@@ -23,103 +25,6 @@ namespace nlobs::cli {
 namespace {
 
 namespace fs = std::filesystem;
-
-}  // namespace
-
-// Writes through a temporary name and renames at the end: nothing half-written looks complete.
-void write_atomically(const fs::path& path, const std::string& content) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw std::runtime_error("cannot write " + tmp.string());
-    out << content;
-    if (!out) throw std::runtime_error("writing " + tmp.string() + " failed");
-  }
-  fs::rename(tmp, path);
-}
-
-std::string csv_field(std::string_view text) {
-  if (text.find_first_of(",\"\r\n") == std::string_view::npos) return std::string(text);
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"') out += '"';  // RFC 4180: a quote inside a quoted field is doubled
-    out += c;
-  }
-  return out + "\"";
-}
-
-namespace {
-
-// Recorded measurements: columns t, y1..yp[, u1..um]; an optional header line.
-Measurements read_data(const std::string& file, const AnyModel& model) {
-  std::ifstream in(file);
-  if (!in) throw std::invalid_argument("cannot read data file '" + file + "'");
-  const Eigen::Index p = model.outputs(), m = model.inputs();
-  std::vector<std::vector<double>> rows;
-  std::string line;
-  long number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty()) continue;
-    std::vector<std::string> cells;
-    std::stringstream ss(line);
-    for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
-    std::vector<double> values;
-    bool numeric = true;
-    for (const std::string& c : cells) {
-      char* end = nullptr;
-      const double v = std::strtod(c.c_str(), &end);
-      // An empty cell or "nan" is a missing measurement; anything else must parse fully.
-      std::string trimmed = c;
-      trimmed.erase(0, trimmed.find_first_not_of(" \t"));
-      if (trimmed.empty() || trimmed == "nan" || trimmed == "NaN") {
-        values.push_back(std::nan(""));
-        continue;
-      }
-      if (end == c.c_str() || *end != '\0') {
-        numeric = false;
-        break;
-      }
-      values.push_back(v);
-    }
-    if (!numeric) {
-      if (rows.empty() && number == 1) continue;  // header
-      throw std::invalid_argument(file + ":" + std::to_string(number) +
-                                  ": malformed row (a cell is not a number): '" + line + "'");
-    }
-    const size_t expected = static_cast<size_t>(1 + p + m);
-    if (values.size() != expected) {
-      std::ostringstream os;
-      os << file << ":" << number << ": expected " << expected << " columns (t, " << p << " outputs"
-         << (m ? ", " + std::to_string(m) + " inputs" : "") << "), got " << values.size();
-      throw std::invalid_argument(os.str());
-    }
-    if (!std::isfinite(values[0])) {
-      throw std::invalid_argument(file + ":" + std::to_string(number) + ": time is missing");
-    }
-    for (Eigen::Index j = 0; j < m; ++j) {
-      if (!std::isfinite(values[static_cast<size_t>(1 + p + j)])) {
-        throw std::invalid_argument(file + ":" + std::to_string(number) + ": input u" +
-                                    std::to_string(j + 1) + " is missing");
-      }
-    }
-    rows.push_back(std::move(values));
-  }
-  if (rows.empty()) throw std::invalid_argument(file + ": no data rows");
-  Measurements data;
-  const Eigen::Index k = static_cast<Eigen::Index>(rows.size());
-  data.t.resize(k);
-  data.y.resize(p, k);
-  data.u.resize(m, k);
-  for (Eigen::Index i = 0; i < k; ++i) {
-    const auto& r = rows[static_cast<size_t>(i)];
-    data.t[i] = r[0];
-    for (Eigen::Index j = 0; j < p; ++j) data.y(j, i) = r[static_cast<size_t>(1 + j)];
-    for (Eigen::Index j = 0; j < m; ++j) data.u(j, i) = r[static_cast<size_t>(1 + p + j)];
-  }
-  return data;
-}
 
 }  // namespace
 
@@ -388,58 +293,11 @@ nlohmann::json summary_json(const Scenario& s, const Measurements& data, const R
   return j;
 }
 
-std::string trajectories_csv(const Measurements& data, const RunResult& r) {
-  std::ostringstream os;
-  os << std::setprecision(12);
-  const Eigen::Index n = r.estimates.empty() ? data.x.rows() : r.estimates.front().rows();
-  os << "t";
-  if (data.has_truth()) {
-    for (Eigen::Index i = 0; i < n; ++i) os << ",x" << i + 1;
-  }
-  // Observer names hold commas ("window:ceres,N=6"): RFC 4180 quoting keeps one field each.
-  for (const auto& m : r.metrics) {
-    for (Eigen::Index i = 0; i < n; ++i)
-      os << "," << csv_field(m.name + ".x" + std::to_string(i + 1));
-  }
-  for (size_t o = 0; o < r.extra_names.size(); ++o) {
-    for (const auto& e : r.extra_names[o]) {
-      os << "," << csv_field(r.metrics[o].name + ".signal." + e);
-    }
-  }
-  os << '\n';
-  for (Eigen::Index k = 0; k < data.steps(); ++k) {
-    os << data.t[k];
-    if (data.has_truth()) {
-      for (Eigen::Index i = 0; i < n; ++i) os << ',' << data.x(i, k);
-    }
-    for (const auto& e : r.estimates) {
-      for (Eigen::Index i = 0; i < n; ++i) os << ',' << e(i, k);
-    }
-    for (const auto& e : r.extras) {
-      for (Eigen::Index i = 0; i < e.rows(); ++i) os << ',' << e(i, k);
-    }
-    os << '\n';
-  }
-  return os.str();
-}
-
-// The step norm per iteration at the first window, one block per window estimator.
-std::string first_window_csv(const RunResult& r, std::vector<std::string>* names) {
-  std::ostringstream os;
-  os << std::setprecision(12) << "# observer iteration step_norm\n";
-  for (const auto& m : r.metrics) {
-    if (!m.first_window || m.first_window->trace.empty()) continue;
-    names->push_back(m.name);
-    for (const TraceEntry& t : m.first_window->trace) {
-      os << gnuplot_data_token(m.name) << ' ' << t.iteration << ' ' << std::max(t.step_norm, 1e-300)
-         << '\n';
-    }
-    os << "\n\n";  // gnuplot index separator
-  }
-  return os.str();
-}
-
 }  // namespace
+
+std::chrono::milliseconds plot_timeout(const RunOptions& options) {
+  return std::chrono::milliseconds(static_cast<long long>(std::ceil(options.plot_timeout * 1e3)));
+}
 
 bool have_gnuplot() {
   return find_gnuplot().has_value();
@@ -453,24 +311,6 @@ Measurements simulate_scenario(const Scenario& s, const AnyModel& model) {
   sim.sample_time = model.sample_time() > 0 ? model.sample_time() : 1.0;
   sim.input = [&s, &model](long k) { return scenario_input(s, model, k); };
   return simulate(model, s.x0, sim);
-}
-
-fs::path output_directory(const std::string& out_dir) {
-  const fs::path dir = fs::absolute(out_dir);
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw std::runtime_error("cannot create " + dir.string() + ": " + ec.message());
-  return dir;
-}
-
-void plot_sweep(const fs::path& dir, const std::string& script, std::ostream& out,
-                std::ostream& err) {
-  const std::string failure = run_gnuplot_script(dir, "sweep.gp", script);
-  if (failure.empty()) {
-    out << ", sweep.png";
-  } else {
-    err << "nlobs: warning: no sweep.png: " << failure << '\n';
-  }
 }
 
 std::vector<double> parse_sweep_values(const std::string& key, const std::string& list,
@@ -496,148 +336,6 @@ std::vector<double> parse_sweep_values(const std::string& key, const std::string
 }
 
 namespace {
-
-// One colour and dash pattern per observer, the same in every plot of a run: line style
-// kFirstObserverStyle + o (the truth is black). Eight colours, then the same with dashes.
-constexpr long kFirstObserverStyle = 100;
-
-void define_observer_styles(std::ostream& g, long observers) {
-  static const char* const kColours[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e",
-                                         "#9467bd", "#8c564b", "#e377c2", "#17becf"};
-  for (long o = 0; o < observers; ++o) {
-    g << "set style line " << kFirstObserverStyle + o << " lc rgb '" << kColours[o % 8] << "' dt "
-      << 1 + (o / 8) % 5 << " lw 1.5\n";
-  }
-  g << "set style line 99 lc rgb 'black' lw 2\n";
-}
-
-std::string observer_style(long o) {
-  return " ls " + std::to_string(kFirstObserverStyle + o);
-}
-
-// PNG plots through gnuplot: estimates vs truth, errors, and the first window's convergence.
-// Every name from the scenario (observers, signals) goes into the script through
-// gnuplot_quoted(); files are named relative to dir, where gnuplot runs. `failure`: why gnuplot
-// failed, or empty.
-std::vector<std::string> plot(const fs::path& dir, const Measurements& data, const RunResult& r,
-                              const std::vector<std::string>& traced, std::string* failure) {
-  std::vector<std::string> written;
-  const Eigen::Index n = r.estimates.empty() ? 0 : r.estimates.front().rows();
-  const long observers = static_cast<long>(r.metrics.size());
-  const long offset = data.has_truth() ? n : 0;
-  std::ostringstream g;
-  g << "set datafile separator ','\nset key outside right\nset grid\n"
-    << "set terminal pngcairo noenhanced size 1200," << 300 * std::max<Eigen::Index>(n, 1) << "\n";
-  define_observer_styles(g, observers);
-  g << "set output 'states.png'\nset multiplot layout " << n << ",1\n";
-  for (Eigen::Index i = 0; i < n; ++i) {
-    g << "set ylabel 'x" << i + 1 << "'\n";
-    // The truth's range plus half of it on each side: an estimate's transient spikes (a PI
-    // bank's pole crossing) must not flatten the comparison; errors.png shows them in full.
-    if (data.has_truth() && data.x.cols() > 0) {
-      const double lo = data.x.row(i).minCoeff(), hi = data.x.row(i).maxCoeff();
-      const double margin = std::max(0.5 * (hi - lo), 1e-3 * std::max(1.0, std::abs(hi)));
-      g << "set yrange [" << lo - margin << ":" << hi + margin << "]\n";
-    }
-    g << "plot ";
-    if (data.has_truth())
-      g << "'trajectories.csv' using 1:" << i + 2 << " with lines ls 99 title 'true', ";
-    for (long o = 0; o < observers; ++o) {
-      g << "'trajectories.csv' using 1:" << 2 + offset + o * n + i << " with lines"
-        << observer_style(o) << " title " << gnuplot_quoted(r.metrics[static_cast<size_t>(o)].name)
-        << (o + 1 < observers ? ", " : "\n");
-    }
-  }
-  g << "unset multiplot\nset autoscale y\n";
-  written.push_back("states.png");
-  if (data.has_truth()) {
-    // Each panel from 1e-16 to 1e3 times the truth's scale (its range, or its size when it is
-    // constant): one diverging observer must not squeeze the others into a line. An observer
-    // whose error leaves the panel is drawn clipped and says so in its key entry.
-    g << "set output 'errors.png'\nset logscale y\n"
-      << "set format y '1e%L'\nset multiplot layout " << n << ",1\n";
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const double lo = data.x.row(i).minCoeff(), hi = data.x.row(i).maxCoeff();
-      const double size = std::max(std::abs(lo), std::abs(hi));
-      const double spread = std::max(hi - lo, 1e-3 * size);
-      const double scale = spread > 0.0 && std::isfinite(spread) ? spread : 1.0;
-      const double top = 1e3 * scale;
-      g << "set yrange [" << 1e-16 * scale << ":" << top << "]\nset ylabel '|x" << i + 1
-        << " - xhat" << i + 1 << "|'\nplot ";
-      for (long o = 0; o < observers; ++o) {
-        const Eigen::ArrayXd error =
-            (data.x.row(i) - r.estimates[static_cast<size_t>(o)].row(i)).array().abs();
-        const bool left = !(error.isFinite().all() && error.maxCoeff() <= top);
-        g << "'trajectories.csv' using 1:(abs($" << i + 2 << " - $" << 2 + offset + o * n + i
-          << ")+1e-16) with lines" << observer_style(o) << " title "
-          << gnuplot_quoted(r.metrics[static_cast<size_t>(o)].name +
-                            (left ? " (beyond the panel)" : ""))
-          << (o + 1 < observers ? ", " : "\n");
-      }
-    }
-    g << "unset multiplot\nunset logscale y\nset format y '% h'\nset autoscale y\n";
-    written.push_back("errors.png");
-  }
-  // Further signals of observers that publish them (PI banks: η̂, η̂₁ per channel, ...).
-  long column = 2 + offset + observers * n;
-  for (size_t o = 0; o < r.extra_names.size(); ++o) {
-    const auto& names = r.extra_names[o];
-    if (names.empty()) continue;
-    const std::string file = "signals_" + std::to_string(o + 1) + ".png";
-    g << "set terminal pngcairo noenhanced size 1200," << 250 * names.size() << "\nset output "
-      << gnuplot_quoted(file) << "\nset multiplot layout " << names.size() << ",1 title "
-      << gnuplot_quoted(r.metrics[o].name) << "\n";
-    for (const auto& name : names) {
-      g << "set ylabel " << gnuplot_quoted(name) << "\nplot 'trajectories.csv' using 1:" << column++
-        << " with lines notitle\n";
-    }
-    g << "unset multiplot\n";
-    written.push_back(file);
-  }
-  // Seed 004's Figs. 3 and 6 (‖z − ẑ‖) and seed 003's canonical error ‖η − η̂‖ on a log scale.
-  for (const auto& [extra, label] :
-       {std::pair<std::string, std::string>{"z_error", "||z - zhat||_2"},
-        {"eta_error", "||eta - etahat||_2"}}) {
-    std::vector<std::pair<long, std::string>> columns;
-    std::vector<long> style_of;  // the observer of each column
-    for (size_t o = 0, c = static_cast<size_t>(2 + offset + observers * n);
-         o < r.extra_names.size(); c += r.extra_names[o].size(), ++o) {
-      const auto& names = r.extra_names[o];
-      const auto at = std::find(names.begin(), names.end(), extra);
-      if (at != names.end()) {
-        columns.emplace_back(static_cast<long>(c) + (at - names.begin()), r.metrics[o].name);
-        style_of.push_back(static_cast<long>(o));
-      }
-    }
-    if (columns.empty()) continue;
-    const std::string file = extra + ".png";
-    g << "set terminal pngcairo noenhanced size 1000,600\nset output " << gnuplot_quoted(file)
-      << "\nset logscale y\nset xlabel 't'\nset ylabel " << gnuplot_quoted(label) << "\nplot ";
-    for (size_t i = 0; i < columns.size(); ++i) {
-      g << "'trajectories.csv' using 1:($" << columns[i].first << "+1e-16) with lines"
-        << observer_style(style_of[i]) << " title " << gnuplot_quoted(columns[i].second)
-        << (i + 1 < columns.size() ? ", " : "\n");
-    }
-    g << "unset logscale y\nunset xlabel\n";
-    written.push_back(file);
-  }
-  if (!traced.empty()) {
-    g << "set datafile separator whitespace\nset terminal pngcairo noenhanced size 1000,600\n"
-      << "set output 'first_window.png'\nset logscale y\n"
-      << "set xlabel 'iteration'\nset ylabel 'step norm (max)'\nplot ";
-    for (size_t i = 0; i < traced.size(); ++i) {
-      long o = 0;  // the traced observer's index, for its style
-      while (o < observers && r.metrics[static_cast<size_t>(o)].name != traced[i]) ++o;
-      g << "'first_window.dat' index " << i << " using 2:3 with linespoints"
-        << observer_style(o < observers ? o : 0) << " title " << gnuplot_quoted(traced[i])
-        << (i + 1 < traced.size() ? ", " : "\n");
-    }
-    written.push_back("first_window.png");
-  }
-  *failure = run_gnuplot_script(dir, "plots.gp", g.str());
-  if (!failure->empty()) written.clear();
-  return written;
-}
 
 // --sweep theta=v1,v2,…: the high_gain observers once per θ on the same data (seed 004's
 // peaking/noise trade-off: peaking grows as θ shrinks, noise amplification too). Other keys
@@ -716,8 +414,6 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
     }
   }
   if (options.out_dir.empty()) return;
-  const fs::path dir = output_directory(options.out_dir);
-  write_atomically(dir / "sweep.csv", csv.str());
   // One block per observer (sweep.dat, gnuplot's index): sweep.csv interleaves them per θ.
   std::ostringstream blocks;
   blocks << std::setprecision(10);
@@ -731,30 +427,24 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
     }
     blocks << "\n\n";
   }
-  write_atomically(dir / "sweep.dat", blocks.str());
-  out << "wrote " << (dir / "sweep.csv").string() << ", sweep.dat";
-  if (have_gnuplot()) {
-    std::ostringstream g;
-    const auto series = [&](int column, const std::string& suffix) {
-      std::string text;
-      for (size_t i = 0; i < names.size(); ++i) {
-        text += (i ? ", " : "") + std::string("'sweep.dat' index ") + std::to_string(i) +
-                " using 1:" + std::to_string(column) + " with linespoints title " +
-                gnuplot_quoted(names[i] + suffix);
-      }
-      return text;
-    };
-    std::ostringstream title;
-    title << "theta sweep: " << s.name << " (noise " << s.noise << ")";
-    g << "set terminal pngcairo noenhanced size 1000,800\nset output 'sweep.png'\n"
-      << "set multiplot layout 2,1 title " << gnuplot_quoted(title.str())
-      << "\nset logscale xy\nset grid\nset key outside right\n"
-      << "set xlabel 'theta'\nset ylabel 'max ||zhat|| (peaking)'\nplot " << series(2, "")
-      << "\nset ylabel 'RMS error after settling'\nplot " << series(3, " z") << ", "
-      << series(4, " x") << "\nunset multiplot\n";
-    plot_sweep(dir, g.str(), out, err);
-  }
-  out << '\n';
+  const auto series = [&](int column, const std::string& suffix) {
+    std::string text;
+    for (size_t i = 0; i < names.size(); ++i) {
+      text += (i ? ", " : "") + std::string("'sweep.dat' index ") + std::to_string(i) +
+              " using 1:" + std::to_string(column) + " with linespoints title " +
+              gnuplot_quoted(names[i] + suffix);
+    }
+    return text;
+  };
+  std::ostringstream title, g;
+  title << "theta sweep: " << s.name << " (noise " << s.noise << ")";
+  g << "set multiplot layout 2,1 title " << gnuplot_quoted(title.str())
+    << "\nset logscale xy\nset grid\nset key outside right\n"
+    << "set xlabel 'theta'\nset ylabel 'max ||zhat|| (peaking)'\nplot " << series(2, "")
+    << "\nset ylabel 'RMS error after settling'\nplot " << series(3, " z") << ", "
+    << series(4, " x") << "\nunset multiplot\n";
+  OutputDirectory dir(options.out_dir);
+  write_sweep_files(dir, csv.str(), blocks.str(), g.str(), plot_timeout(options), out, err);
 }
 
 }  // namespace
@@ -770,10 +460,19 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
     s.steps = *options.steps;
   }
   if (options.noise) {
-    if (!(*options.noise >= 0.0)) throw std::invalid_argument("--noise must be >= 0");
+    if (!(*options.noise >= 0.0) || !std::isfinite(*options.noise)) {
+      std::ostringstream os;
+      os << "--noise " << *options.noise << " is not a finite number >= 0";
+      throw std::invalid_argument(os.str());
+    }
     s.noise = *options.noise;
   }
   if (options.seed) s.seed = *options.seed;
+  if (!(options.plot_timeout > 0.0 && options.plot_timeout <= 86400.0)) {
+    std::ostringstream os;
+    os << "plot timeout " << options.plot_timeout << " s is out of range: must be in (0, 86400]";
+    throw std::invalid_argument(os.str());
+  }
   const AnyModel model = scenario_model(s);
 
   Measurements data;
@@ -783,7 +482,7 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
     if (!data.stop_message.empty()) err << "nlobs: simulation " << data.stop_message << '\n';
     if (data.steps() == 0) throw std::runtime_error("the simulation produced no samples");
   } else {
-    data = read_data(options.data_file, model);
+    data = read_measurements_csv(options.data_file, model.outputs(), model.inputs());
     source = options.data_file;
   }
 
@@ -852,28 +551,15 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
   print_bounds(bounds, out);
 
   if (!options.out_dir.empty()) {
-    const fs::path dir = output_directory(options.out_dir);
-    write_atomically(dir / "trajectories.csv", trajectories_csv(data, r));
-    std::vector<std::string> traced;
-    write_atomically(dir / "first_window.dat", first_window_csv(r, &traced));
-    write_atomically(dir / "scenario.json", to_json(s).dump(2) + "\n");
-    std::vector<std::string> plots;
-    if (have_gnuplot()) {
-      // Best-effort: the data files above are complete whatever gnuplot does.
-      std::string failure;
-      plots = plot(dir, data, r, traced, &failure);
-      if (!failure.empty()) {
-        warnings.push_back("no PNG plots: " + failure);
-        err << "nlobs: warning: " << warnings.back() << '\n';
-      }
-    } else {
-      err << "nlobs: gnuplot not found: no PNG plots (apt-get install gnuplot-nox)\n";
-    }
+    OutputDirectory dir(options.out_dir);  // summary.json removed: incomplete from here
+    const std::vector<std::string> plots =
+        write_run_files(dir, s, data, r, plot_timeout(options), warnings, err);
+    dir.remove_stale_files();
     // Last: summary.json marks a complete output directory.
-    write_atomically(
-        dir / "summary.json",
-        summary_json(s, data, r, source, bounds, warnings, horizon_indices).dump(2) + "\n");
-    out << "wrote " << (dir / "summary.json").string() << ", trajectories.csv, scenario.json";
+    dir.write("summary.json",
+              summary_json(s, data, r, source, bounds, warnings, horizon_indices).dump(2) + "\n");
+    out << "wrote " << (dir.path() / "summary.json").string()
+        << ", trajectories.csv, plot_data.csv, scenario.json";
     for (const auto& p : plots) out << ", " << p;
     out << '\n';
   }

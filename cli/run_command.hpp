@@ -1,6 +1,6 @@
 #pragma once
 // `nlobs run SCENARIO [--steps N] [--noise SIGMA] [--seed S] [--out DIR] [--data FILE.csv]
-//  [--sweep KEY=v1,v2,...]`.
+//  [--sweep KEY=v1,v2,...] [--plot-timeout SECONDS]`.
 #include <cstdint>
 #include <iosfwd>
 #include <optional>
@@ -19,6 +19,9 @@ struct RunOptions {
   // "PARAMETER=…": a model parameter, re-simulated per value. Prints and writes (with --out)
   // sweep.csv, sweep.dat and sweep.png instead of the usual outputs.
   std::string sweep{};
+  // Seconds gnuplot may take to draw a run's (or a sweep's) plots before it is stopped and the
+  // plots are skipped with a warning: (0, 86400].
+  double plot_timeout = 120.0;
 };
 
 // Prints the table to `out` (progress and notices to `err`); writes the files when asked.

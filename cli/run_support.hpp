@@ -1,5 +1,6 @@
 #pragma once
 // What `nlobs run`'s parts share (run_command.cpp, modulating_report.cpp).
+#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -9,24 +10,19 @@
 #include <vector>
 
 #include "nlobs/observers/simulation.hpp"
+#include "run_command.hpp"
 #include "scenario.hpp"
 
 namespace nlobs::cli {
 
-// Writes through a temporary name and renames at the end: nothing half-written looks complete.
-void write_atomically(const std::filesystem::path& path, const std::string& content);
 // `text` as one RFC 4180 field: quoted (inner quotes doubled) when it holds a comma, a quote,
 // CR or LF; as it is otherwise.
 std::string csv_field(std::string_view text);
 nlohmann::json number_or_null(double v);
 std::string fmt(double v, const char* f = "%.3e");  // "-" for non-finite values
 bool have_gnuplot();                                // on PATH (gnuplot.hpp)
-// --out DIR made absolute and created (gnuplot runs inside it: scripts name files relative to it).
-std::filesystem::path output_directory(const std::string& out_dir);
-// sweep.png from `script` (run_gnuplot_script, gnuplot.hpp): ", sweep.png" to `out` when drawn,
-// else a warning naming why to `err` (plots are best-effort).
-void plot_sweep(const std::filesystem::path& dir, const std::string& script, std::ostream& out,
-                std::ostream& err);
+// RunOptions::plot_timeout as a duration (validated by run_scenario: > 0, at most a day).
+std::chrono::milliseconds plot_timeout(const RunOptions& options);
 // "v1,v2,…" of `--sweep key=…`: finite numbers (> 0 when `positive`), at least one.
 std::vector<double> parse_sweep_values(const std::string& key, const std::string& list,
                                        bool positive);

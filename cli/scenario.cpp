@@ -1,10 +1,12 @@
 #include "scenario.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
 
+#include "input_file.hpp"
 #include "json_reader.hpp"
 #include "model_catalog.hpp"
 #include "nlobs/observers/baselines.hpp"
@@ -311,13 +313,14 @@ Scenario load_scenario(const std::string& name_or_file) {
   if (auto it = builtin_texts().find(name_or_file); it != builtin_texts().end()) {
     return parse_scenario(nlohmann::json::parse(it->second), "built-in scenario " + it->first);
   }
-  std::ifstream in(name_or_file);
-  if (!in) {
+  std::error_code ec;
+  if (!std::filesystem::exists(name_or_file, ec) && !ec) {  // an error: open_input_file says it
     std::string list;
     for (const auto& s : builtin_scenarios()) list += (list.empty() ? "" : ", ") + s;
     throw std::invalid_argument("'" + name_or_file + "' is neither a built-in scenario (" + list +
-                                ") nor a readable JSON file");
+                                ") nor a JSON file");
   }
+  std::ifstream in = open_input_file(name_or_file, "scenario file");
   return parse_scenario(parse_json(in, name_or_file), name_or_file);
 }
 

@@ -1,10 +1,22 @@
 // Runs the nlobs executable and checks the contract of `nlobs solve chua-window --json`.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
+#include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <thread>
+#include <vector>
+
+#include "cli_test_files.hpp"
 
 namespace {
 
@@ -137,6 +149,87 @@ TEST(Cli, ListEngines) {
     EXPECT_NE(r.out.find(e), std::string::npos) << e;
   }
   EXPECT_NE(run("list nothing").status, 0);
+}
+
+// Exit status 1: the command line is wrong; 2: the run failed (docs/cli.md).
+TEST(Cli, ExitStatusSaysWhetherTheCommandLineOrTheRunFailed) {
+  for (const char* args :
+       {"run chua-fp --steps abc", "run chua-fp --steps 0", "run chua-fp --seed -1",
+        "run chua-fp --noise inf", "run chua-fp --noise nan", "run chua-fp --noise -1",
+        "run chua-fp --bogus", "run", "run chua-fp --plot-timeout 0",
+        "run chua-fp --plot-timeout nan"}) {
+    const CliRun r = run(args);
+    EXPECT_EQ(r.status, 1) << args << ": " << r.out;
+  }
+  // inf and nan get the same message.
+  const std::string inf = run("run chua-fp --noise inf").out,
+                    nan = run("run chua-fp --noise nan").out;
+  EXPECT_NE(inf.find("'inf' is not a finite number >= 0"), std::string::npos) << inf;
+  EXPECT_NE(nan.find("'nan' is not a finite number >= 0"), std::string::npos) << nan;
+  for (const char* args : {"run no-such-scenario", "run chua-fp --data /nonexistent.csv",
+                           "run /tmp", "solve chua-window --engines bogus"}) {
+    const CliRun r = run(args);
+    EXPECT_EQ(r.status, 2) << args << ": " << r.out;
+    EXPECT_NE(r.out.find("nlobs: error: "), std::string::npos) << r.out;
+  }
+  EXPECT_NE(run("run /tmp").out.find("scenario file '/tmp' is a directory"), std::string::npos);
+  EXPECT_EQ(run("--help").status, 0);
+  // An engine spec echoed in an error is an excerpt.
+  const CliRun spec =
+      run("solve chua-window --no-reference --engines anderson:" + std::string(5000, 'm') + "=1");
+  EXPECT_EQ(spec.status, 2);
+  EXPECT_LT(spec.out.size(), 2000U) << spec.out.size();
+}
+
+// SIGTERM while gnuplot writes a PNG: the handler stops gnuplot, removes every temporary and the
+// process ends by the signal; the data files written before are whole, and summary.json absent.
+TEST(Cli, SigtermLeavesNoTemporaryFiles) {
+  namespace fs = std::filesystem;
+  const fs::path bin = nlobs::test::scratch_path("nlobs_test_cli", "slow_gnuplot_bin");
+  const fs::path dir = nlobs::test::scratch_path("nlobs_test_cli", "interrupted");
+  fs::remove_all(dir);
+  fs::remove(dir.parent_path() / "gnuplot.pid");
+  fs::create_directories(bin);
+  // It starts the first PNG its script names, then never finishes.
+  nlobs::test::write_file(bin / "gnuplot",
+                          "#!/bin/sh\n"
+                          "out=$(sed -n \"s/^set output '\\(.*\\)'$/\\1/p\" \"$1\" | head -n 1)\n"
+                          "echo $$ > ../gnuplot.pid\nprintf partial > \"$out\"\n"
+                          "exec /bin/sleep 60\n");
+  fs::permissions(bin / "gnuplot", fs::perms::owner_all);
+  std::string program = NLOBS_CLI_PATH, run_word = "run", scenario = "chua-fp", steps = "--steps",
+              count = "300", out = "--out", where = dir.string();
+  std::vector<char*> argv = {program.data(), run_word.data(), scenario.data(), steps.data(),
+                             count.data(),   out.data(),      where.data(),    nullptr};
+  std::string path = "PATH=" + bin.string() + ":/usr/bin:/bin";
+  std::vector<char*> env = {path.data(), nullptr};
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), env.data()), 0);
+  posix_spawn_file_actions_destroy(&actions);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (!fs::exists(dir / "states.png.tmp") && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_TRUE(fs::exists(dir / "states.png.tmp")) << "the fake gnuplot never started";
+  ::kill(pid, SIGTERM);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << status;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    EXPECT_NE(e.path().extension(), ".tmp") << e.path();
+    EXPECT_NE(e.path().extension(), ".png") << e.path();
+  }
+  EXPECT_FALSE(fs::exists(dir / "summary.json"));
+  EXPECT_GT(fs::file_size(dir / "trajectories.csv"), 1000U);
+  // The handler stopped gnuplot (and reaped it) before the process ended.
+  std::ifstream pid_file(dir.parent_path() / "gnuplot.pid");
+  pid_t gnuplot = 0;
+  ASSERT_TRUE(pid_file >> gnuplot);
+  EXPECT_NE(::kill(gnuplot, 0), 0) << "gnuplot " << gnuplot << " still runs";
 }
 
 }  // namespace

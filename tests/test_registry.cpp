@@ -96,7 +96,7 @@ TEST(EngineRegistry, ErrorsListWhatIsValid) {
   EXPECT_NE(unknown.find("unknown engine 'bogus'"), std::string::npos) << unknown;
   EXPECT_NE(unknown.find("steffensen"), std::string::npos) << unknown;
   const std::string option = message_of([&] { registry.create("anderson:depth=3"); });
-  EXPECT_NE(option.find("unknown option(s) depth"), std::string::npos) << option;
+  EXPECT_NE(option.find("unknown option(s) 'depth'"), std::string::npos) << option;
   EXPECT_NE(option.find("damping"), std::string::npos) << option;  // lists valid options
   EXPECT_NE(
       message_of([&] { registry.create("anderson:m=abc"); }).find("'m=abc' is not an integer"),
@@ -116,8 +116,9 @@ TEST(EngineRegistry, ErrorsListWhatIsValid) {
             std::string::npos);
   EXPECT_NE(message_of([&] { registry.create("newton:linesearch=maybe"); }).find("not 0/1"),
             std::string::npos);
-  EXPECT_NE(message_of([&] { registry.create("steffensen:fast"); }).find("unknown option(s) fast"),
-            std::string::npos);
+  EXPECT_NE(
+      message_of([&] { registry.create("steffensen:fast"); }).find("unknown option(s) 'fast'"),
+      std::string::npos);
 }
 
 // A user's engine: damped Picard, registered under its own name.
@@ -253,7 +254,7 @@ TEST(EngineRegistry, OneRegistrationAtDynamicServesEverySize) {
   // Its options are checked as at Dynamic.
   EXPECT_NE(message_of([] {
               EngineRegistry<5>::global().create("relaxed:q=1");
-            }).find("unknown option(s) q"),
+            }).find("unknown option(s) 'q'"),
             std::string::npos);
 }
 
@@ -377,6 +378,22 @@ TEST(EngineRegistry, FactoriesThatReturnNothingAreNamed) {
       message_of([] { EngineRegistry<5>::global().create("nothing"); }).find("returned no engine"),
       std::string::npos);
   EXPECT_NE(message_of([] { DynamicSizeEngine<2> e(nullptr); }).find("null"), std::string::npos);
+}
+
+// User text in messages: quoted, control characters visible, cut (never inside a UTF-8
+// character), so a hostile megabyte-long spec gives a one-line error.
+TEST(QuotedExcerpt, ShortVisibleAndWholeCharacters) {
+  EXPECT_EQ(quoted_excerpt("m=3"), "'m=3'");
+  EXPECT_EQ(quoted_excerpt(std::string("a\nb\0c", 5)), "'a\\x0ab\\x00c'");
+  EXPECT_EQ(quoted_excerpt(std::string(100, 'x')), "'" + std::string(60, 'x') + "...'");
+  // "é" is two bytes; a cut after the first would leave half a character.
+  EXPECT_EQ(quoted_excerpt("abcdé", 5), "'abcd...'");
+  EXPECT_EQ(quoted_excerpt("abcdé", 6), "'abcdé'");
+  auto& registry = EngineRegistry<1>::global();
+  const std::string e =
+      message_of([&] { registry.create("anderson:" + std::string(100000, 'q') + "=1"); });
+  EXPECT_LT(e.size(), 1500U) << e.size();
+  EXPECT_NE(e.find("unknown option(s) 'qqq"), std::string::npos) << e.substr(0, 300);
 }
 
 }  // namespace

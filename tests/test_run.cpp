@@ -13,8 +13,10 @@
 #include <iomanip>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
+#include "cli_test_files.hpp"
 #include "gnuplot.hpp"
 #include "nlobs/models/discretization.hpp"
 #include "nlobs/models/systems.hpp"
@@ -31,10 +33,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path scratch(const std::string& name) {
-  const fs::path p =
-      fs::temp_directory_path() / ("nlobs_test_run_" + std::to_string(::getpid())) / name;
-  fs::create_directories(p.parent_path());
-  return p;
+  return test::scratch_path("nlobs_test_run", name);
 }
 
 std::string error_of(const std::string& scenario, const RunOptions& o = {}) {
@@ -48,7 +47,7 @@ std::string error_of(const std::string& scenario, const RunOptions& o = {}) {
 }
 
 void write(const fs::path& p, const std::string& text) {
-  std::ofstream(p) << text;
+  test::write_file(p, text);
 }
 
 // Every record of a CSV file as parsed by libcsv in strict RFC 4180 mode (not our reader).
@@ -178,7 +177,7 @@ TEST(Run, ScenarioFileErrorsNameTheFileAndKey) {
   j = to_json(load_scenario("chua-fp"));
   j["observers"][0]["engine"] = "picard:m=3";
   write(f, j.dump());
-  EXPECT_NE(error_of(f.string()).find("unknown option(s) m"), std::string::npos);
+  EXPECT_NE(error_of(f.string()).find("unknown option(s) 'm'"), std::string::npos);
 
   write(f, "{ not json");
   EXPECT_NE(error_of(f.string()).find("not valid JSON"), std::string::npos);
@@ -278,8 +277,10 @@ TEST(RunSafety, HostileNamesAndPathsRunNoCommand) {
           << out.str() << err.str();
       EXPECT_EQ(err.str().find("warning: no"), std::string::npos) << err.str();
     }
+    // The run's marker; the sweep that follows writes sweep.csv last and removes the run's files.
+    EXPECT_EQ(fs::exists(dir / "summary.json"), sweep.empty());
+    EXPECT_EQ(fs::exists(dir / "trajectories.csv"), sweep.empty());
   }
-  EXPECT_TRUE(fs::exists(dir / "summary.json"));
   // The payload name (a quote, newlines) is one RFC 4180 field of sweep.csv, read back intact.
   const auto records = csv_records(dir / "sweep.csv");
   ASSERT_EQ(records.size(), 3u);  // header, θ = 0.1 and 0.2 for the one high-gain observer
@@ -331,22 +332,17 @@ TEST(RunSafety, OutOfRangeIntegersNameTheKeyAndTheRange) {
 
 // Plots are best-effort: a gnuplot that fails costs the PNGs and a warning, not the run's data.
 TEST(RunSafety, AFailingGnuplotLeavesTheDataAndAWarning) {
-  const fs::path bin = scratch("fake_gnuplot_bin");
-  fs::create_directories(bin);
-  write(bin / "gnuplot",
-        "#!/bin/sh\necho '         plot x' >&2\n"
-        "echo '\"'\"$1\"'\" line 7: all points y value undefined!' >&2\nexit 1\n");
-  fs::permissions(bin / "gnuplot", fs::perms::owner_all);
-  const char* old_path = std::getenv("PATH");
-  const std::string saved = old_path != nullptr ? old_path : "";
-  ::setenv("PATH", bin.c_str(), 1);
+  std::optional<test::FakeProgramOnPath> fake;
+  fake.emplace(scratch("fake_gnuplot_bin"), "gnuplot",
+               "#!/bin/sh\necho '         plot x' >&2\n"
+               "echo '\"'\"$1\"'\" line 7: all points y value undefined!' >&2\nexit 1\n");
   const fs::path dir = scratch("failing_plots");
   std::ostringstream out, err;
   RunOptions o;
   o.steps = 50;
   o.out_dir = dir.string();
   EXPECT_NO_THROW(run_scenario("chua-fp", o, out, err));
-  ::setenv("PATH", saved.c_str(), 1);
+  fake.reset();
   EXPECT_TRUE(fs::exists(dir / "summary.json"));
   EXPECT_TRUE(fs::exists(dir / "trajectories.csv"));
   EXPECT_NE(err.str().find("warning: no PNG plots: gnuplot failed (\"plots.gp\" line 7: all "
@@ -395,7 +391,7 @@ TEST(Run, RecordedDataWithMissingSamplesAndNoTruth) {
 
   write(data, "t,y1\n0,1.0\n0.05,abc\n");
   const std::string e = error_of("chua-fp", {.data_file = data.string()});
-  EXPECT_NE(e.find(data.string() + ":3: malformed row"), std::string::npos) << e;
+  EXPECT_NE(e.find(data.string() + ":3: cell 2 'abc' is not a number"), std::string::npos) << e;
   write(data, "0,1.0,2.0\n");
   EXPECT_NE(error_of("chua-fp", {.data_file = data.string()}).find("expected 2 columns"),
             std::string::npos);

@@ -13,25 +13,28 @@ EngineSpec parse_engine_spec(std::string_view text) {
   spec.text = std::string(text);
   const size_t colon = text.find(':');
   spec.name = std::string(text.substr(0, colon));
-  if (spec.name.empty()) throw InvalidInput("engine spec '" + spec.text + "' has no engine name");
+  if (spec.name.empty())
+    throw InvalidInput("engine spec " + quoted_excerpt(spec.text) + " has no engine name");
   if (colon == std::string_view::npos) return spec;
   std::string_view rest = text.substr(colon + 1);
   while (true) {
     const size_t comma = rest.find(',');
     const std::string_view item = rest.substr(0, comma);
-    if (item.empty()) throw InvalidInput("engine spec '" + spec.text + "' has an empty item");
+    if (item.empty())
+      throw InvalidInput("engine spec " + quoted_excerpt(spec.text) + " has an empty item");
     const size_t eq = item.find('=');
     if (eq == std::string_view::npos) {
       spec.words.emplace_back(item);
     } else {
       std::string key(item.substr(0, eq)), value(item.substr(eq + 1));
       if (key.empty() || value.empty()) {
-        throw InvalidInput("engine spec '" + spec.text + "': item '" + std::string(item) +
-                           "' needs key=value");
+        throw InvalidInput("engine spec " + quoted_excerpt(spec.text) + ": item " +
+                           quoted_excerpt(item) + " needs key=value");
       }
       for (const auto& kv : spec.values) {
         if (kv.first == key) {
-          throw InvalidInput("engine spec '" + spec.text + "' sets '" + key + "' twice");
+          throw InvalidInput("engine spec " + quoted_excerpt(spec.text) + " sets " +
+                             quoted_excerpt(key) + " twice");
         }
       }
       spec.values.emplace_back(std::move(key), std::move(value));
@@ -47,8 +50,8 @@ EngineSpecReader::EngineSpecReader(const EngineSpec& spec, std::vector<EngineOpt
 
 void EngineSpecReader::fail(const std::string& what) const {
   std::ostringstream os;
-  os << "engine spec '" << spec_.text << "': " << what << "; valid options of '" << spec_.name
-     << "': ";
+  os << "engine spec " << quoted_excerpt(spec_.text) << ": " << what << "; valid options of '"
+     << spec_.name << "': ";
   if (valid_.empty()) os << "(none)";
   for (size_t i = 0; i < valid_.size(); ++i) {
     os << (i ? ", " : "") << valid_[i].key << " (" << valid_[i].description << ")";
@@ -73,7 +76,7 @@ std::optional<double> EngineSpecReader::number(const std::string& key) {
   errno = 0;
   const double v = std::strtod(t->c_str(), &end);
   if (end == t->c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
-    fail("'" + key + "=" + *t + "' is not a finite number");
+    fail(quoted_excerpt(key + "=" + *t) + " is not a finite number");
   }
   return v;
 }
@@ -84,10 +87,11 @@ std::optional<int> EngineSpecReader::integer(const std::string& key, int min, in
   char* end = nullptr;
   errno = 0;
   const long v = std::strtol(t->c_str(), &end, 10);
-  if (end == t->c_str() || *end != '\0') fail("'" + key + "=" + *t + "' is not an integer");
+  if (end == t->c_str() || *end != '\0')
+    fail(quoted_excerpt(key + "=" + *t) + " is not an integer");
   if (errno == ERANGE || v < min || v > max) {
-    fail("'" + key + "=" + *t + "' is out of range: must be in " + std::to_string(min) + ".." +
-         std::to_string(max));
+    fail(quoted_excerpt(key + "=" + *t) + " is out of range: must be in " + std::to_string(min) +
+         ".." + std::to_string(max));
   }
   return static_cast<int>(v);
 }
@@ -97,7 +101,7 @@ std::optional<bool> EngineSpecReader::boolean(const std::string& key) {
   if (!t) return std::nullopt;
   if (*t == "1" || *t == "true" || *t == "on") return true;
   if (*t == "0" || *t == "false" || *t == "off") return false;
-  fail("'" + key + "=" + *t + "' is not 0/1, true/false or on/off");
+  fail(quoted_excerpt(key + "=" + *t) + " is not 0/1, true/false or on/off");
 }
 
 std::optional<std::string> EngineSpecReader::word(const std::vector<std::string>& allowed) {
@@ -107,7 +111,7 @@ std::optional<std::string> EngineSpecReader::word(const std::vector<std::string>
   if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), w) == allowed.end()) {
     std::string list;
     for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-    fail("'" + w + "' is not one of: " + list);
+    fail(quoted_excerpt(w) + " is not one of: " + list);
   }
   word_used_ = true;
   return w;
@@ -116,10 +120,11 @@ std::optional<std::string> EngineSpecReader::word(const std::vector<std::string>
 void EngineSpecReader::finish() const {
   std::string unknown;
   for (size_t i = 0; i < spec_.values.size(); ++i) {
-    if (!used_values_[i]) unknown += (unknown.empty() ? "" : ", ") + spec_.values[i].first;
+    if (!used_values_[i])
+      unknown += (unknown.empty() ? "" : ", ") + quoted_excerpt(spec_.values[i].first);
   }
   if (!word_used_) {
-    for (const auto& w : spec_.words) unknown += (unknown.empty() ? "" : ", ") + w;
+    for (const auto& w : spec_.words) unknown += (unknown.empty() ? "" : ", ") + quoted_excerpt(w);
   }
   if (!unknown.empty()) fail("unknown option(s) " + unknown);
 }

@@ -1,5 +1,7 @@
 #include "nlobs/solvers/status.hpp"
 
+#include <algorithm>
+
 namespace nlobs {
 
 std::string_view to_string(Status status) {
@@ -26,6 +28,27 @@ std::string_view to_string(Status status) {
       return "solver_failure";
   }
   return "unknown";
+}
+
+std::string quoted_excerpt(std::string_view text, std::size_t max_length) {
+  std::size_t cut = std::min(text.size(), max_length);
+  // Never inside a UTF-8 sequence: back up over continuation bytes (10xxxxxx) at the cut.
+  while (cut > 0 && cut < text.size() && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) {
+    --cut;
+  }
+  std::string out = "'";
+  for (const char c : text.substr(0, cut)) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f) {
+      static const char* const kHex = "0123456789abcdef";
+      out += "\\x";
+      out += kHex[u >> 4];
+      out += kHex[u & 15];
+    } else {
+      out += c;
+    }
+  }
+  return out + (cut < text.size() ? "...'" : "'");
 }
 
 }  // namespace nlobs

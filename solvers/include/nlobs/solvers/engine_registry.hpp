@@ -169,7 +169,7 @@ std::unique_ptr<Engine<N>> EngineRegistry<N>::create(std::string_view spec_text,
   if (!entry) {
     std::string list;
     for (const auto& name : names()) list += (list.empty() ? "" : ", ") + name;
-    throw InvalidInput("unknown engine '" + spec.name + "'; valid engines: " + list);
+    throw InvalidInput("unknown engine " + quoted_excerpt(spec.name) + "; valid engines: " + list);
   }
   std::vector<EngineOptionInfo> valid = entry->options;
   valid.insert(valid.end(), common_options().begin(), common_options().end());

@@ -1,5 +1,6 @@
 #pragma once
 // Why a solve ended. Every engine reports exactly one of these.
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -28,5 +29,11 @@ class InvalidInput : public std::invalid_argument {
  public:
   explicit InvalidInput(const std::string& what) : std::invalid_argument(what) {}
 };
+
+// How user text (an engine spec, a CSV cell) appears in an error message: single-quoted, cut
+// to max_length characters ("..." after: a hostile megabyte stays one line), control characters
+// written as \xNN.
+inline constexpr std::size_t kExcerptLength = 60;
+std::string quoted_excerpt(std::string_view text, std::size_t max_length = kExcerptLength);
 
 }  // namespace nlobs

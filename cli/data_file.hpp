@@ -1,0 +1,29 @@
+#pragma once
+// Recorded measurements for `nlobs run --data FILE.csv`: columns t, y1..yp[, u1..um].
+//
+// The format, checked line by line (every error names FILE:LINE):
+// * a UTF-8 byte-order mark at the start is skipped; blank lines are skipped; CRLF is accepted;
+// * an optional header as the first line, recognised only when no cell is a number or empty
+//   (then it must have the data's column count); any other line that is not all numbers is an
+//   error naming the cell;
+// * y cells: a number, or a missing measurement written as an empty cell (the last one too) or
+//   `nan`; an infinite or out-of-range value (`inf`, `1e400`) is an error;
+// * t and u cells: finite numbers; times strictly increase.
+#include <Eigen/Core>
+#include <iosfwd>
+#include <string>
+
+#include "nlobs/observers/simulation.hpp"
+
+namespace nlobs::cli {
+
+// Reads `in` (named `name` in messages) for a model with `outputs` outputs and `inputs` inputs.
+// Throws std::invalid_argument naming name:line and what was wrong; nothing is returned then.
+Measurements parse_measurements_csv(std::istream& in, const std::string& name, Eigen::Index outputs,
+                                    Eigen::Index inputs);
+
+// The same from a file; a missing file, a directory or an unreadable file is named as such.
+Measurements read_measurements_csv(const std::string& file, Eigen::Index outputs,
+                                   Eigen::Index inputs);
+
+}  // namespace nlobs::cli

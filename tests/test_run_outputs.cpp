@@ -1,0 +1,215 @@
+// The output directory's promises (docs/cli.md "Output directories"): temporary names, summary.json
+// removed first and written last, stale nlobs files removed and nothing else, no temporary left
+// (exceptions, a gnuplot that hangs), write errors with the system's reason; and the reduced
+// plot data that keeps every excursion.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli_test_files.hpp"
+#include "output_directory.hpp"
+#include "run_command.hpp"
+#include "run_outputs.hpp"
+#include "run_support.hpp"
+
+namespace nlobs::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path scratch(const std::string& name) {
+  return test::scratch_path("nlobs_test_outputs", name);
+}
+
+std::vector<std::string> files_in(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+bool has(const std::vector<std::string>& names, const std::string& name) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+bool any_temporary(const fs::path& dir) {
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (e.path().extension() == ".tmp") return true;
+  }
+  return false;
+}
+
+TEST(OutputDirectory, SummaryFirstRemovedStaleNlobsFilesOnly) {
+  const fs::path dir = scratch("stale");
+  fs::create_directories(dir / "errors.png");  // a directory by an nlobs name is the user's
+  for (const char* f :
+       {"summary.json", "sweep.csv", "signals_3.png", "states.png", "states.png.tmp",
+        "trajectories.csv.tmp", "notes.txt", "signals_x.png", "my.tmp"}) {
+    test::write_file(dir / f, "old");
+  }
+  OutputDirectory out(dir.string());
+  // From the start the directory no longer claims to be complete; old temporaries are gone.
+  EXPECT_FALSE(fs::exists(dir / "summary.json"));
+  EXPECT_FALSE(fs::exists(dir / "sweep.csv"));  // a sweep's marker too
+  EXPECT_FALSE(fs::exists(dir / "states.png.tmp"));
+  EXPECT_FALSE(fs::exists(dir / "trajectories.csv.tmp"));
+  out.write("trajectories.csv", "t\n0\n");
+  out.remove_stale_files();
+  out.write("summary.json", "{}");
+  EXPECT_EQ(files_in(dir),
+            (std::vector<std::string>{"errors.png", "my.tmp", "notes.txt", "signals_x.png",
+                                      "summary.json", "trajectories.csv"}));
+}
+
+TEST(OutputDirectory, UncommittedAndExternalTemporariesAreRemoved) {
+  const fs::path dir = scratch("uncommitted");
+  {
+    OutputDirectory out(dir.string());
+    {
+      OutputDirectory::Writer w = out.open("trajectories.csv");
+      w.stream() << "half";
+      EXPECT_TRUE(fs::exists(dir / "trajectories.csv.tmp"));
+    }  // dropped, e.g. by an exception
+    EXPECT_FALSE(fs::exists(dir / "trajectories.csv.tmp"));
+    EXPECT_FALSE(fs::exists(dir / "trajectories.csv"));
+    const std::string name = out.external("states.png");
+    EXPECT_EQ(name, "states.png.tmp");
+    test::write_file(dir / name, "png");  // as gnuplot would
+    test::write_file(dir / out.external("errors.png"), "png");
+  }  // destroyed before commit_external()
+  EXPECT_TRUE(files_in(dir).empty()) << files_in(dir).size();
+  OutputDirectory out(dir.string());
+  test::write_file(dir / out.external("states.png"), "png");
+  out.external("errors.png");  // never drawn: not renamed, nothing left
+  EXPECT_EQ(out.commit_external(), std::vector<std::string>{"states.png"});
+  EXPECT_EQ(files_in(dir), std::vector<std::string>{"states.png"});
+}
+
+TEST(OutputDirectory, WriteErrorsGiveTheSystemsReason) {
+  const fs::path dir = scratch("vanishing");
+  OutputDirectory out(dir.string());
+  fs::remove_all(dir);
+  try {
+    out.write("summary.json", "{}");
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("summary.json.tmp: No such file or directory"),
+              std::string::npos)
+        << e.what();
+  }
+  const fs::path file = scratch("a-file");
+  test::write_file(file, "x");
+  try {
+    OutputDirectory bad((file / "sub").string());
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot create"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("Not a directory"), std::string::npos) << e.what();
+  }
+}
+
+TEST(PlotRows, ShortTablesWhole_LongOnesKeepEveryExtreme) {
+  std::vector<double> t(100'000), v(100'000, 1.0), gaps(100'000, 0.0);
+  for (size_t k = 0; k < t.size(); ++k) t[k] = 0.01 * static_cast<double>(k);
+  v[54'321] = 50.0;  // a one-sample spike
+  v[77'777] = -3.0;
+  for (size_t k = 0; k < 1000; ++k) gaps[k] = NAN;  // a signal not published yet
+  const ColumnTable table{3, 100'000, [&](Eigen::Index j, Eigen::Index k) {
+                            const auto i = static_cast<size_t>(k);
+                            return j == 0 ? t[i] : j == 1 ? v[i] : gaps[i];
+                          }};
+  std::ostringstream out;
+  write_plot_rows(out, "t,v,g", table);
+  std::istringstream in(out.str());
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "t,v,g");
+  long rows = 0, nan_rows = 0;
+  double high = -1e300, low = 1e300, last_t = -1.0;
+  while (std::getline(in, line)) {
+    ++rows;
+    std::stringstream ss(line);
+    std::string a, b, c;
+    std::getline(ss, a, ',');
+    std::getline(ss, b, ',');
+    std::getline(ss, c, ',');
+    const double time = std::stod(a), value = std::stod(b);
+    EXPECT_GE(time, last_t);
+    last_t = time;
+    high = std::max(high, value);
+    low = std::min(low, value);
+    nan_rows += c == "nan";
+  }
+  EXPECT_EQ(rows, kPlotRows);
+  EXPECT_EQ(high, 50.0);
+  EXPECT_EQ(low, -3.0);
+  EXPECT_EQ(last_t, t.back());
+  EXPECT_EQ(nan_rows, 2 * (1000 / 50));  // 50 samples a span: the first 20 spans have no value
+
+  std::ostringstream whole;
+  write_plot_rows(whole, "t,v,g", ColumnTable{3, 10, [&](Eigen::Index j, Eigen::Index k) {
+                                                return table.value(j, k);
+                                              }});
+  const std::string text = whole.str();
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 11);
+}
+
+TEST(RunOutputs, ASecondRunLeavesNothingOfTheFirst) {
+  const fs::path dir = scratch("two-runs");
+  std::ostringstream out, err;
+  // pi-linear writes signals_N.png (its banks publish extras); chua-fp writes none.
+  run_scenario("pi-linear", {.steps = 200, .out_dir = dir.string()}, out, err);
+  if (have_gnuplot()) {  // the run's own signal plots are kept (and named in its "wrote" line)
+    EXPECT_TRUE(fs::exists(dir / "signals_1.png"));
+    EXPECT_NE(out.str().find("signals_1.png"), std::string::npos) << out.str();
+  }
+  test::write_file(dir / "signals_9.png", "stale");
+  test::write_file(dir / "mine.txt", "the user's");
+  run_scenario("chua-fp", {.steps = 60, .out_dir = dir.string()}, out, err);
+  const auto names = files_in(dir);
+  for (const auto& n : names) EXPECT_EQ(n.rfind("signals_", 0), std::string::npos) << n;
+  EXPECT_TRUE(has(names, "mine.txt"));
+  EXPECT_FALSE(any_temporary(dir));
+  std::ifstream in(dir / "summary.json");
+  EXPECT_EQ(nlohmann::json::parse(in)["scenario"], "chua-fp");
+  EXPECT_TRUE(has(names, "plot_data.csv"));
+}
+
+TEST(RunOutputs, AGnuplotThatHangsIsStoppedAndTheRunCompletes) {
+  std::optional<test::FakeProgramOnPath> fake;
+  // It starts its PNG, then never finishes.
+  fake.emplace(scratch("hanging_bin"), "gnuplot",
+               "#!/bin/sh\nprintf partial > states.png.tmp\nexec /bin/sleep 60\n");
+  const fs::path dir = scratch("hanging");
+  std::ostringstream out, err;
+  RunOptions o;
+  o.steps = 50;
+  o.out_dir = dir.string();
+  o.plot_timeout = 0.5;
+  EXPECT_NO_THROW(run_scenario("chua-fp", o, out, err));
+  fake.reset();
+  EXPECT_NE(err.str().find("gnuplot did not finish within 0.5 s and was stopped"),
+            std::string::npos)
+      << err.str();
+  EXPECT_TRUE(fs::exists(dir / "summary.json"));
+  EXPECT_FALSE(fs::exists(dir / "states.png"));
+  EXPECT_FALSE(any_temporary(dir));
+  o.plot_timeout = 0.0;
+  try {
+    run_scenario("chua-fp", o, out, err);
+    ADD_FAILURE() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("plot timeout 0 s is out of range"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace nlobs::cli
