@@ -8,7 +8,7 @@ WERROR     ?= OFF
 JOBS       ?= 2
 CMAKE_ARGS ?=
 
-.PHONY: all deps configure build build-cli test demo bench sanitize format format-check clean \
+.PHONY: all deps configure build build-cli test demo bench sanitize fuzz format format-check clean \
         compile-cost
 
 all: build
@@ -41,6 +41,16 @@ sanitize: deps
 	cmake --build build-asan -j $(JOBS)
 	ctest --test-dir build-asan --output-on-failure -j $(JOBS)
 
+# libFuzzer (clang) on the scenario and --data readers, FUZZ_SECONDS per target, seeded, from
+# tests/fuzz/corpus; ASan + UBSan on; a finding fails the target (docs/fuzzing.md).
+FUZZ_SECONDS ?= 300
+fuzz:
+	@./scripts/ensure-deps.sh fuzz
+	cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER=clang++ -DNLOBS_FUZZ=ON \
+	      -DNLOBS_SANITIZE=ON -DNLOBS_BUILD_TESTS=OFF -DNLOBS_BUILD_BENCH=OFF $(CMAKE_ARGS)
+	cmake --build build-fuzz -j $(JOBS) --target fuzz_scenario fuzz_data_csv
+	./scripts/run-fuzz build-fuzz $(FUZZ_SECONDS)
+
 format: deps
 	find solvers observers models bench cli tests examples -name '*.hpp' -o -name '*.cpp' | xargs clang-format -i
 
@@ -52,4 +62,4 @@ compile-cost: deps
 	./scripts/compile-cost --jobs $(JOBS)
 
 clean:
-	rm -rf $(BUILD) build-asan build-cost
+	rm -rf $(BUILD) build-asan build-cost build-fuzz

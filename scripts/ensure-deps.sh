@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages nlobs needs (see docs/dependencies.md for why each is here).
 # Usage: scripts/ensure-deps.sh            -> packages for build + test + demo
+#        scripts/ensure-deps.sh fuzz       -> the same and clang (libFuzzer) for make fuzz
 # Exit 1 with a clear message when packages are missing and cannot be installed.
 set -euo pipefail
 
@@ -25,6 +26,9 @@ packages=(
   libcsv-dev           # tests: an independent RFC 4180 reader parses our CSV output back
   libbenchmark-dev     # Google Benchmark
 )
+if [ "${1:-}" = fuzz ]; then
+  packages+=(clang)    # libFuzzer and its sanitizer runtimes (make fuzz)
+fi
 
 missing=()
 for p in "${packages[@]}"; do
