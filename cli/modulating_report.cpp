@@ -178,6 +178,7 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
     }
     auto observers = named([&] { return make_observers(run, model, false); });
     RunResult r = run_observers(*d, observers, settle_index);
+    make_names_unique(r);
     add_coordinate_errors(*d, observers, r);
     if (names.empty()) {
       for (const ObserverMetrics& m : r.metrics) names.push_back(m.name);

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <ostream>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -295,6 +296,22 @@ nlohmann::json summary_json(const Scenario& s, const Measurements& data, const R
 
 }  // namespace
 
+void make_names_unique(RunResult& r) {
+  std::set<std::string> taken;
+  for (const ObserverMetrics& m : r.metrics) taken.insert(m.name);
+  std::set<std::string> seen;
+  for (ObserverMetrics& m : r.metrics) {
+    if (seen.insert(m.name).second) continue;
+    std::string renamed;
+    for (int copy = 2; renamed.empty() || taken.count(renamed); ++copy) {
+      renamed = m.name + " #" + std::to_string(copy);
+    }
+    taken.insert(renamed);
+    seen.insert(renamed);
+    m.name = renamed;
+  }
+}
+
 std::chrono::milliseconds plot_timeout(const RunOptions& options) {
   return std::chrono::milliseconds(static_cast<long long>(std::ceil(options.plot_timeout * 1e3)));
 }
@@ -387,6 +404,7 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
     for (ObserverSpec& o : run.observers) o.high_gain.theta = theta;
     auto observers = make_observers(run, model, false);
     RunResult r = run_observers(data, observers, settle_index);
+    make_names_unique(r);
     add_coordinate_errors(data, observers, r);
     if (names.empty()) {
       for (const ObserverMetrics& m : r.metrics) names.push_back(m.name);
@@ -534,6 +552,7 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
         << " observer steps" << std::flush;
   });
   if (printed) err << '\n';
+  make_names_unique(r);
   // What the run itself found (a window map that does not contract, a singular guess).
   for (const auto& o : observers) {
     for (const auto& w : o->warnings()) {

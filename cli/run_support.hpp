@@ -21,6 +21,9 @@ std::string csv_field(std::string_view text);
 nlohmann::json number_or_null(double v);
 std::string fmt(double v, const char* f = "%.3e");  // "-" for non-finite values
 bool have_gnuplot();                                // on PATH (gnuplot.hpp)
+// Two observers of one name (two `ekf` entries) become "ekf" and "ekf #2" in every report, CSV
+// column and plot: otherwise their columns, rows and keys would be indistinguishable.
+void make_names_unique(RunResult& r);
 // RunOptions::plot_timeout as a duration (validated by run_scenario: > 0, at most a day).
 std::chrono::milliseconds plot_timeout(const RunOptions& options);
 // "v1,v2,…" of `--sweep key=…`: finite numbers (> 0 when `positive`), at least one.

@@ -211,5 +211,28 @@ TEST(RunOutputs, AGnuplotThatHangsIsStoppedAndTheRunCompletes) {
   }
 }
 
+// Two observers of one name (two EKFs with different covariances) were indistinguishable: the
+// same columns in trajectories.csv, the same key in plots, two summary entries of one name.
+TEST(RunOutputs, ObserversOfOneNameAreToldApart) {
+  const fs::path f = scratch("two-ekfs.json");
+  test::write_file(f, R"({"name": "two-ekfs", "model": {"name": "modified-chua", "step": 0.05},
+    "x0": [1, 2.1428, -0.1648], "initial_guess": [5, 10, -5], "steps": 40,
+    "observers": [{"type": "ekf"}, {"type": "ekf", "initial_covariance": [[10, 0, 0], [0, 10, 0], [0, 0, 10]]},
+                  {"type": "ekf"}]})");
+  const fs::path dir = scratch("two-ekfs");
+  std::ostringstream out, err;
+  run_scenario(f.string(), {.out_dir = dir.string()}, out, err);
+  std::ifstream in(dir / "summary.json");
+  const auto summary = nlohmann::json::parse(in);
+  std::vector<std::string> names;
+  for (const auto& o : summary["observers"]) names.push_back(o["name"]);
+  EXPECT_EQ(names, (std::vector<std::string>{"ekf", "ekf #2", "ekf #3"}));
+  std::ifstream csv(dir / "trajectories.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_NE(header.find(",ekf.x1,ekf.x2,ekf.x3,ekf #2.x1,"), std::string::npos) << header;
+  EXPECT_NE(header.find("ekf #3.x3"), std::string::npos) << header;
+}
+
 }  // namespace
 }  // namespace nlobs::cli
