@@ -37,9 +37,7 @@ Cell classify(std::string_view raw, std::string& buffer) {
   char* end = nullptr;
   const double v = std::strtod(buffer.c_str(), &end);
   // The whole cell, embedded NUL bytes included ("1\0abc" is not the number 1).
-  if (end != buffer.c_str() + buffer.size() || buffer.empty() || end == buffer.c_str()) {
-    return {CellKind::kText, NAN};
-  }
+  if (end != buffer.c_str() + buffer.size()) return {CellKind::kText, NAN};
   if (std::isnan(v)) return {CellKind::kMissing, NAN};
   // ERANGE with ±HUGE_VAL: an overflow ("1e400"); with a tiny result an underflow, which is
   // the closest double and kept.

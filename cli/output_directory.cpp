@@ -70,6 +70,10 @@ extern "C" void remove_temporaries_and_reraise(int signal_number) {
   ::raise(signal_number);
 }
 
+std::string temporary_name(const std::string& name) {
+  return name + std::string(kTemporarySuffix);
+}
+
 std::string reason(int error) {
   return error != 0 ? std::strerror(error) : "input/output error";
 }
@@ -170,7 +174,7 @@ void OutputDirectory::Writer::commit() {
                              s.final_path.string() + ": " + ec.message());
   }
   unregister_temporary(s.slot);
-  s.owner->committed(s.name);
+  s.owner->note_written(s.name);
   state_.reset();
 }
 
@@ -187,7 +191,7 @@ OutputDirectory::OutputDirectory(const std::string& path) : path_(fs::absolute(p
   remove_file(path_ / "summary.json");
   remove_file(path_ / "sweep.csv");
   for (const std::string& name : output_file_names()) {
-    remove_file(path_ / (name + std::string(kTemporarySuffix)));
+    remove_file(path_ / temporary_name(name));
   }
 }
 
@@ -203,7 +207,7 @@ OutputDirectory::Writer OutputDirectory::open(const std::string& name) {
   state->owner = this;
   state->name = name;
   state->final_path = path_ / name;
-  state->temporary = path_ / (name + std::string(kTemporarySuffix));
+  state->temporary = path_ / temporary_name(name);
   std::error_code ignored;
   fs::remove(state->temporary, ignored);  // never write through a link left under that name
   state->slot = register_temporary(state->temporary);
@@ -224,52 +228,43 @@ void OutputDirectory::write(const std::string& name, std::string_view content) {
 }
 
 std::string OutputDirectory::external(const std::string& name) {
-  const std::string temporary = name + std::string(kTemporarySuffix);
+  const std::string temporary = temporary_name(name);
   std::error_code ignored;
   fs::remove(path_ / temporary, ignored);
-  if (std::find(external_.begin(), external_.end(), name) == external_.end()) {
-    external_.push_back(name);
-    register_temporary(path_ / temporary);
-  }
+  const bool known = std::any_of(external_.begin(), external_.end(),
+                                 [&](const External& e) { return e.name == name; });
+  if (!known) external_.push_back({name, register_temporary(path_ / temporary)});
   return temporary;
 }
 
 std::vector<std::string> OutputDirectory::commit_external() {
   std::vector<std::string> renamed;
-  for (const std::string& name : external_) {
-    const fs::path temporary = path_ / (name + std::string(kTemporarySuffix));
+  for (const External& e : external_) {
+    const fs::path temporary = path_ / temporary_name(e.name);
     std::error_code ec;
     if (!fs::is_regular_file(temporary, ec)) continue;
-    fs::rename(temporary, path_ / name, ec);
+    fs::rename(temporary, path_ / e.name, ec);
     if (ec) {
-      throw std::runtime_error("cannot rename " + temporary.string() + " to " + name + ": " +
+      throw std::runtime_error("cannot rename " + temporary.string() + " to " + e.name + ": " +
                                ec.message());
     }
-    committed(name);
-    renamed.push_back(name);
+    note_written(e.name);
+    renamed.push_back(e.name);
   }
   discard_external();  // unregisters; the renamed ones are gone already
   return renamed;
 }
 
 void OutputDirectory::discard_external() {
-  for (const std::string& name : external_) {
-    const fs::path temporary = path_ / (name + std::string(kTemporarySuffix));
+  for (const External& e : external_) {
     std::error_code ignored;
-    fs::remove(temporary, ignored);
-    const std::lock_guard<std::mutex> lock(g_slots_mutex);
-    for (Slot& slot : g_slots) {
-      if (slot.used.load() && temporary.native() == slot.path.data()) slot.used.store(false);
-    }
+    fs::remove(path_ / temporary_name(e.name), ignored);
+    unregister_temporary(e.slot);
   }
   external_.clear();
 }
 
 void OutputDirectory::note_written(const std::string& name) {
-  committed(name);
-}
-
-void OutputDirectory::committed(const std::string& name) {
   if (std::find(written_.begin(), written_.end(), name) == written_.end()) {
     written_.push_back(name);
   }

@@ -69,18 +69,21 @@ class OutputDirectory {
   std::string external(const std::string& name);
   std::vector<std::string> commit_external();
   void discard_external();
-  // A file written outside this class under its final name (gnuplot.log): not stale.
+  // A file this run has written (gnuplot.log, under its final name; every committed file):
+  // not stale.
   void note_written(const std::string& name);
 
   // Removes the nlobs files of earlier runs that this run has not written.
   void remove_stale_files();
 
  private:
-  void committed(const std::string& name);
-
   std::filesystem::path path_;
   std::vector<std::string> written_;
-  std::vector<std::string> external_;  // final names whose temporaries gnuplot writes
+  struct External {
+    std::string name;  // the final name; gnuplot writes temporary_name(name)
+    int slot;          // in the signal handler's table, or -1
+  };
+  std::vector<External> external_;
 };
 
 }  // namespace nlobs::cli
