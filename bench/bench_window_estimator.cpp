@@ -34,10 +34,10 @@ void window_step(benchmark::State& state, const char* engine) {
   solver.stop.step_tolerance = 1e-8;
   solver.stop.residual_tolerance = 1e-8;
   nlobs::WindowEstimatorOptions options;
+  options.initial_estimate = Eigen::Vector3d(5.0, 10.0, -5.0);
   options.gain = state.range(0) == 0 ? nlobs::WindowGain::kIdentity : nlobs::WindowGain::kNewton;
-  nlobs::WindowEstimator<Chua> estimator(nlobs::paper_modified_chua(),
-                                         nlobs::EngineRegistry<3>::global().create(engine, solver),
-                                         engine, Eigen::Vector3d(5.0, 10.0, -5.0), options);
+  nlobs::WindowEstimator<Chua> estimator(nlobs::paper_modified_chua(), options,
+                                         nlobs::EngineRegistry<3>::global().create(engine, solver));
   const Eigen::VectorXd no_input(0);
   // Past the first windows: the steady state of a run.
   for (long k = 0; k < 50; ++k) estimator.step(k, data.y.col(k), no_input);

@@ -647,8 +647,8 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& s, const A
           options.stop.step_tolerance = *o.tol;
           options.stop.residual_tolerance = *o.tol;
         }
-        auto& registry = EngineRegistry<Dynamic>::global();
         WindowEstimatorOptions window_options;
+        window_options.initial_estimate = start;
         window_options.window = o.window;
         window_options.warm_start =
             o.warm_start == "previous" ? WarmStart::kPrevious : WarmStart::kPropagated;
@@ -657,22 +657,32 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& s, const A
                               : o.psi == "scalar" ? WindowGain::kScalar
                                                   : WindowGain::kAuto;
         window_options.gain_scale = o.psi_scale;
-        auto estimator = std::make_unique<WindowEstimator<AnyModel>>(
-            model, registry.create(o.engine, options), o.engine, start, window_options);
+        auto estimator = make_window_estimator(model, o.engine, window_options, options);
         if (trace_first_window) {
           options.record_trace = true;
-          estimator->set_first_window_engine(registry.create(o.engine, options));
+          estimator->set_first_window_engine(
+              EngineRegistry<Dynamic>::global().create(o.engine, options));
         }
         out.push_back(std::move(estimator));
       } else if (o.type == "luenberger") {
-        out.push_back(std::make_unique<LuenbergerObserver<AnyModel>>(design, o.gain, start));
+        LuenbergerOptions options;
+        options.initial_estimate = start;
+        options.gain = o.gain;
+        out.push_back(std::make_unique<LuenbergerObserver<AnyModel>>(design, std::move(options)));
       } else if (o.type == "sliding_mode") {
-        out.push_back(
-            std::make_unique<SlidingModeObserver<AnyModel>>(design, o.q, o.r, o.gamma, start));
+        SlidingModeOptions options;
+        options.initial_estimate = start;
+        options.q = o.q;
+        options.r = o.r;
+        options.gamma = o.gamma;
+        out.push_back(std::make_unique<SlidingModeObserver<AnyModel>>(design, std::move(options)));
       } else {
-        out.push_back(std::make_unique<ExtendedKalmanFilter<AnyModel>>(
-            design, start,
-            EkfOptions{o.process_covariance, o.measurement_covariance, o.initial_covariance}));
+        EkfOptions options;
+        options.initial_estimate = start;
+        options.process_covariance = o.process_covariance;
+        options.measurement_covariance = o.measurement_covariance;
+        options.initial_covariance = o.initial_covariance;
+        out.push_back(std::make_unique<ExtendedKalmanFilter<AnyModel>>(design, std::move(options)));
       }
     } catch (const InvalidInput& e) {
       throw std::invalid_argument(where + ": " + e.what());

@@ -150,10 +150,10 @@ TEST(Allocations, WindowEstimatorStepAllocatesNothing) {
       solver.stop.step_tolerance = 1e-8;
       solver.stop.residual_tolerance = 1e-8;
       WindowEstimatorOptions options;
+      options.initial_estimate = Eigen::Vector3d(5.0, 10.0, -5.0);
       options.gain = gain;
-      WindowEstimator<Chua> estimator(paper_modified_chua(),
-                                      EngineRegistry<3>::global().create(engine, solver), engine,
-                                      Eigen::Vector3d(5.0, 10.0, -5.0), options);
+      WindowEstimator<Chua> estimator(paper_modified_chua(), options,
+                                      EngineRegistry<3>::global().create(engine, solver));
       const Eigen::VectorXd no_input(0);
       Eigen::VectorXd y(1);
       for (long k = 0; k < 10; ++k) {  // the first windows: Ψ chosen, workspaces sized

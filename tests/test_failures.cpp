@@ -199,10 +199,9 @@ SolverOptions window_solver_options() {
 std::unique_ptr<WindowEstimator<Rossler>> rossler_estimator(const std::string& spec,
                                                             WindowGain gain) {
   WindowEstimatorOptions options;
+  options.initial_estimate = Eigen::Vector3d::Zero();
   options.gain = gain;
-  return std::make_unique<WindowEstimator<Rossler>>(
-      Rossler{}, EngineRegistry<3>::global().create(spec, window_solver_options()), spec,
-      Eigen::Vector3d::Zero(), options);
+  return make_window_estimator(Rossler{}, spec, options, window_solver_options());
 }
 
 int total_failures(const ObserverMetrics& m) {
@@ -329,8 +328,9 @@ TEST(TracedCase, AFailedSolveIsNotTheNextWarmStart) {
   {  // N = 3 (Rössler): solves at k = 2 (usable), 3 (fails), 4.
     auto engine = std::make_unique<ScriptedEngine<3>>(std::vector<int>{1});
     ScriptedEngine<3>* scripted = engine.get();
-    WindowEstimator<Rossler> estimator(Rossler{}, std::move(engine), "scripted",
-                                       Eigen::Vector3d(-3.5, 2.5, 0.1));
+    WindowEstimatorOptions options;
+    options.initial_estimate = Eigen::Vector3d(-3.5, 2.5, 0.1);
+    WindowEstimator<Rossler> estimator(Rossler{}, options, std::move(engine));
     const Measurements data = rossler_data(5);
     for (long k = 0; k < 5; ++k) estimator.step(k, data.y.col(k), Eigen::VectorXd(0));
     ASSERT_EQ(scripted->guesses.size(), 3u);
@@ -349,9 +349,9 @@ TEST(TracedCase, AFailedSolveIsNotTheNextWarmStart) {
     auto engine = std::make_unique<ScriptedEngine<1>>(std::vector<int>{1});
     ScriptedEngine<1>* scripted = engine.get();
     WindowEstimatorOptions options;
+    options.initial_estimate = Vector<1>::Zero();
     options.gain = WindowGain::kIdentity;
-    WindowEstimator<Scaled1> estimator(Scaled1{}, std::move(engine), "scripted", Vector<1>::Zero(),
-                                       options);
+    WindowEstimator<Scaled1> estimator(Scaled1{}, options, std::move(engine));
     for (long k = 0; k < 3; ++k) {
       const double x = 2.0 * std::pow(0.9, static_cast<double>(k));
       estimator.step(k, Eigen::VectorXd::Constant(1, 3.0 * x), Eigen::VectorXd(0));
@@ -374,9 +374,9 @@ TEST(SingularGuess, LorenzEquilibriumWarnsAndIsLeft) {
   so.sample_time = 0.01;
   const Measurements data = simulate(lorenz, Eigen::Vector3d(1.0, 1.0, 1.0), so);
   std::vector<std::unique_ptr<Observer>> observers;
-  observers.push_back(std::make_unique<WindowEstimator<Discretized<Lorenz>>>(
-      lorenz, EngineRegistry<3>::global().create("newton", window_solver_options()), "newton",
-      Eigen::Vector3d::Zero()));
+  WindowEstimatorOptions options;
+  options.initial_estimate = Eigen::Vector3d::Zero();
+  observers.push_back(make_window_estimator(lorenz, "newton", options, window_solver_options()));
   const RunResult r = run_observers(data, observers);
   const auto warnings = observers[0]->warnings();
   ASSERT_FALSE(warnings.empty());
@@ -397,12 +397,12 @@ TEST(ContractionWarning, OnANonContractingSquareWindow) {
   const Measurements data = simulate(Scaled1{}, Eigen::VectorXd::Constant(1, 2.0), so);
   const auto run = [&](WindowGain gain, double scale) {
     WindowEstimatorOptions options;
+    options.initial_estimate = Vector<1>::Zero();
     options.gain = gain;
     options.gain_scale = scale;
     std::vector<std::unique_ptr<Observer>> observers;
-    observers.push_back(std::make_unique<WindowEstimator<Scaled1>>(
-        Scaled1{}, EngineRegistry<1>::global().create("picard", window_solver_options()), "picard",
-        Vector<1>::Zero(), options));
+    observers.push_back(
+        make_window_estimator(Scaled1{}, "picard", options, window_solver_options()));
     const RunResult r = run_observers(data, observers);
     return std::make_pair(observers[0]->warnings(), r);
   };
@@ -424,17 +424,15 @@ TEST(ContractionWarning, OnANonContractingSquareWindow) {
   EXPECT_LE(newton.metrics[0].iterations_max, 2);  // Ψ = (∂H)⁻¹ exact on a linear window
 
   WindowEstimatorOptions longer;  // Ψ has no meaning for a least-squares window
+  longer.initial_estimate = Vector<1>::Zero();
   longer.window = 3;
   longer.gain = WindowGain::kNewton;
-  EXPECT_THROW(WindowEstimator<Scaled1>(Scaled1{}, EngineRegistry<1>::global().create("ceres"),
-                                        "ceres", Vector<1>::Zero(), longer),
-               InvalidInput);
+  EXPECT_THROW(make_window_estimator(Scaled1{}, "ceres", longer), InvalidInput);
   WindowEstimatorOptions bad;
+  bad.initial_estimate = Vector<1>::Zero();
   bad.gain = WindowGain::kScalar;
   bad.gain_scale = 0.0;
-  EXPECT_THROW(WindowEstimator<Scaled1>(Scaled1{}, EngineRegistry<1>::global().create("picard"),
-                                        "picard", Vector<1>::Zero(), bad),
-               InvalidInput);
+  EXPECT_THROW(make_window_estimator(Scaled1{}, "picard", bad), InvalidInput);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -456,8 +454,10 @@ TEST(Baselines, LuenbergerWithAnUnstableGainCountsFailuresAndStaysFinite) {
   so.steps = 1500;
   const Measurements data = simulate(Linear2{}, Eigen::Vector2d(1.0, -1.0), so);
   std::vector<std::unique_ptr<Observer>> observers;
-  observers.push_back(std::make_unique<LuenbergerObserver<Linear2>>(
-      Linear2{}, Eigen::Vector2d(25.0, -40.0), Eigen::Vector2d::Zero()));
+  LuenbergerOptions options;
+  options.initial_estimate = Eigen::Vector2d::Zero();
+  options.gain = Eigen::Vector2d(25.0, -40.0);
+  observers.push_back(std::make_unique<LuenbergerObserver<Linear2>>(Linear2{}, options));
   const RunResult r = run_observers(data, observers);
   EXPECT_TRUE(r.estimates[0].allFinite());
   ASSERT_GT(r.metrics[0].failures.count("non_finite_estimate"), 0u);
@@ -473,13 +473,19 @@ TEST(Baselines, EkfAndSlidingModeUnderAbsurdNoiseStayFinite) {
   so.noise_std = 1e200;
   const Measurements data = simulate(Rossler{}, Eigen::Vector3d(-4.0, 3.0, 0.05), so);
   std::vector<std::unique_ptr<Observer>> observers;
-  observers.push_back(
-      std::make_unique<ExtendedKalmanFilter<Rossler>>(Rossler{}, Eigen::Vector3d::Zero()));
-  observers.push_back(std::make_unique<SlidingModeObserver<Rossler>>(
-      Rossler{}, Eigen::Vector3d(1.0, 1.0, 1.0), Eigen::Vector3d(1.0, 1.0, 1.0), 0.1,
-      Eigen::Vector3d::Zero()));
-  observers.push_back(std::make_unique<LuenbergerObserver<Rossler>>(
-      Rossler{}, Eigen::Vector3d(1.0, 0.5, 0.2), Eigen::Vector3d::Zero()));
+  EkfOptions ekf;
+  ekf.initial_estimate = Eigen::Vector3d::Zero();
+  observers.push_back(std::make_unique<ExtendedKalmanFilter<Rossler>>(Rossler{}, ekf));
+  SlidingModeOptions sliding;
+  sliding.initial_estimate = Eigen::Vector3d::Zero();
+  sliding.q = Eigen::Vector3d(1.0, 1.0, 1.0);
+  sliding.r = Eigen::Vector3d(1.0, 1.0, 1.0);
+  sliding.gamma = 0.1;
+  observers.push_back(std::make_unique<SlidingModeObserver<Rossler>>(Rossler{}, sliding));
+  LuenbergerOptions luenberger;
+  luenberger.initial_estimate = Eigen::Vector3d::Zero();
+  luenberger.gain = Eigen::Vector3d(1.0, 0.5, 0.2);
+  observers.push_back(std::make_unique<LuenbergerObserver<Rossler>>(Rossler{}, luenberger));
   const RunResult r = run_observers(data, observers);
   for (size_t i = 0; i < observers.size(); ++i) {
     EXPECT_TRUE(r.estimates[i].allFinite()) << r.metrics[i].name;
@@ -534,9 +540,10 @@ TEST(Harness, FirstFailureHoldsTheEnginesStatusAndMessage) {
   so.steps = 20;
   const Measurements data = simulate(Unobservable{}, Eigen::Vector2d(1.0, 2.0), so);
   std::vector<std::unique_ptr<Observer>> observers;
-  observers.push_back(std::make_unique<WindowEstimator<Unobservable>>(
-      Unobservable{}, EngineRegistry<2>::global().create("newton", window_solver_options()),
-      "newton", Eigen::Vector2d(0.5, 0.5)));
+  WindowEstimatorOptions options;
+  options.initial_estimate = Eigen::Vector2d(0.5, 0.5);
+  observers.push_back(
+      make_window_estimator(Unobservable{}, "newton", options, window_solver_options()));
   const RunResult r = run_observers(data, observers);
   const std::string& first = r.metrics[0].first_failure;
   EXPECT_NE(first.find("k = 1"), std::string::npos) << first;

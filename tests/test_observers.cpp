@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
+#include <string>
 
 #include "nlobs/models/modified_chua.hpp"
 #include "nlobs/models/systems.hpp"
@@ -10,6 +12,7 @@
 #include "nlobs/observers/simulation.hpp"
 #include "nlobs/observers/window_estimator.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
+#include "nlobs/solvers/newton_engine.hpp"
 
 namespace nlobs {
 namespace {
@@ -62,9 +65,11 @@ std::unique_ptr<Observer> window_estimator(const std::string& spec, double tol, 
   SolverOptions o;
   o.stop.step_tolerance = tol;
   o.stop.residual_tolerance = tol;
-  return std::make_unique<WindowEstimator<Chua>>(paper_modified_chua(),
-                                                 EngineRegistry<3>::global().create(spec, o), spec,
-                                                 kGuess, WindowEstimatorOptions{window, warm});
+  WindowEstimatorOptions options;
+  options.initial_estimate = kGuess;
+  options.window = window;
+  options.warm_start = warm;
+  return make_window_estimator(paper_modified_chua(), spec, options, o);
 }
 
 TEST(WindowEstimator, NoiseFreeRecoveryByEveryEngine) {
@@ -118,18 +123,18 @@ TEST(WindowEstimator, MissingMeasurementSkipsAndRecovers) {
 }
 
 TEST(WindowEstimator, SquareEnginesRefuseLongWindows) {
-  SolverOptions o;
+  WindowEstimatorOptions options;
+  options.initial_estimate = kGuess;
+  options.window = 6;
   try {
-    WindowEstimator<Chua> e(paper_modified_chua(), EngineRegistry<3>::global().create("picard"),
-                            "picard", kGuess, {6});
+    make_window_estimator(paper_modified_chua(), "picard", options);
     FAIL();
   } catch (const InvalidInput& e) {
     EXPECT_NE(std::string(e.what()).find("use ceres or nlopt"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(
-      WindowEstimator<Chua>(paper_modified_chua(), EngineRegistry<3>::global().create("newton"),
-                            "newton", Eigen::Vector3d(NAN, 0, 0)),
-      InvalidInput);
+  options.window = 0;
+  options.initial_estimate = Eigen::Vector3d(NAN, 0, 0);
+  EXPECT_THROW(make_window_estimator(paper_modified_chua(), "newton", options), InvalidInput);
 }
 
 TEST(WindowEstimator, PropagatedWarmStartNeedsFewerIterations) {
@@ -164,9 +169,9 @@ TEST(WindowEstimator, MultiOutputWindowByLeastSquares) {
   so.stop.step_tolerance = 1e-12;
   so.stop.residual_tolerance = 1e-12;
   std::vector<std::unique_ptr<Observer>> observers;
-  observers.push_back(std::make_unique<WindowEstimator<Chaotic>>(
-      model, EngineRegistry<3>::global().create("ceres", so), "ceres",
-      Eigen::Vector3d(-1.0, -0.5, -1.5)));
+  WindowEstimatorOptions options;
+  options.initial_estimate = Eigen::Vector3d(-1.0, -0.5, -1.5);
+  observers.push_back(make_window_estimator(model, "ceres", options, so));
   EXPECT_EQ(observers[0]->window(), 2);
   const auto r = run_observers(data, observers);
   EXPECT_LT((r.estimates[0].rightCols(49) - data.x.rightCols(49)).cwiseAbs().maxCoeff(), 1e-8);
@@ -191,9 +196,9 @@ TEST(WindowEstimator, OneSampleWindowWhenTheOutputIsTheState) {
   const FullOutput model;
   const Measurements data = simulate(model, Eigen::Vector2d(0.5, 0.2), o);
   std::vector<std::unique_ptr<Observer>> observers;
-  observers.push_back(std::make_unique<WindowEstimator<FullOutput>>(
-      model, EngineRegistry<2>::global().create("newton:tol=1e-13"), "newton",
-      Eigen::Vector2d(0.0, 0.0)));
+  WindowEstimatorOptions options;
+  options.initial_estimate = Eigen::Vector2d(0.0, 0.0);
+  observers.push_back(make_window_estimator(model, "newton:tol=1e-13", options));
   EXPECT_EQ(observers[0]->window(), 1);
   const auto r = run_observers(data, observers);
   EXPECT_LT((r.estimates[0] - data.x).cwiseAbs().maxCoeff(), 1e-12);
@@ -204,7 +209,10 @@ TEST(Baselines, LuenbergerErrorFollowsALC) {
   const Linear2 model;
   const Eigen::Vector2d gain(0.5, 0.3);
   const Eigen::Vector2d x0(1.0, -1.0), guess(0.0, 0.0);
-  LuenbergerObserver<Linear2> obs(model, gain, guess);
+  LuenbergerOptions options;
+  options.initial_estimate = guess;
+  options.gain = gain;
+  LuenbergerObserver<Linear2> obs(model, options);
   Eigen::Matrix2d alc = model.a;
   alc.col(0) -= gain;
   Eigen::Vector2d x = x0, e = x0 - guess;
@@ -215,17 +223,20 @@ TEST(Baselines, LuenbergerErrorFollowsALC) {
     e = alc * e;
     x = model.f(x, Linear2::Input(u), k);
   }
-  EXPECT_THROW(LuenbergerObserver<Linear2>(model, Eigen::Vector3d::Ones(), guess), InvalidInput);
+  options.gain = Eigen::Vector3d::Ones();
+  EXPECT_THROW(LuenbergerObserver<Linear2>(model, options), InvalidInput);
 }
 
 TEST(Baselines, EkfOnALinearSystemIsTheKalmanFilter) {
   // Noise-free linear system: the EKF converges to the state; with an exact initial state it
   // stays exact.
   const Linear2 model;
-  ExtendedKalmanFilter<Linear2> ekf(
-      model, Eigen::Vector2d(0.0, 0.0),
-      {Eigen::Matrix2d::Identity() * 1e-8, Eigen::MatrixXd::Constant(1, 1, 1e-6),
-       Eigen::Matrix2d::Identity()});
+  EkfOptions options;
+  options.initial_estimate = Eigen::Vector2d(0.0, 0.0);
+  options.process_covariance = Eigen::Matrix2d::Identity() * 1e-8;
+  options.measurement_covariance = Eigen::MatrixXd::Constant(1, 1, 1e-6);
+  options.initial_covariance = Eigen::Matrix2d::Identity();
+  ExtendedKalmanFilter<Linear2> ekf(model, options);
   Eigen::Vector2d x(1.0, -1.0);
   double last = 0.0;
   for (long k = 0; k < 60; ++k) {
@@ -234,21 +245,128 @@ TEST(Baselines, EkfOnALinearSystemIsTheKalmanFilter) {
     x = model.f(x, Linear2::Input(u), k);
   }
   EXPECT_LT(last, 1e-6);
-  EXPECT_THROW(ExtendedKalmanFilter<Linear2>(model, Eigen::Vector2d::Zero(),
-                                             {-Eigen::Matrix2d::Identity(), {}, {}}),
-               InvalidInput);
+  options.process_covariance = -Eigen::Matrix2d::Identity();
+  EXPECT_THROW(ExtendedKalmanFilter<Linear2>(model, options), InvalidInput);
 }
 
 TEST(Baselines, SlidingModeSaturates) {
   const Linear2 model;
   const Eigen::Vector2d q(0.0, 0.0), r(1.0, 0.0);
-  SlidingModeObserver<Linear2> smo(model, q, r, 0.5, Eigen::Vector2d(0.0, 0.0));
+  SlidingModeOptions options;
+  options.initial_estimate = Eigen::Vector2d(0.0, 0.0);
+  options.q = q;
+  options.r = r;
+  options.gamma = 0.5;
+  SlidingModeObserver<Linear2> smo(model, options);
   // y − ŷ = 10 ≫ γ: the correction is R · sat(20) = R.
   smo.step(0, Eigen::VectorXd::Constant(1, 10.0), Eigen::VectorXd::Zero(1));
   const ObserverStep& s = smo.step(1, Eigen::VectorXd::Constant(1, 0.0), Eigen::VectorXd::Zero(1));
   EXPECT_NEAR(s.estimate[0], 1.0, 1e-15);
-  EXPECT_THROW(SlidingModeObserver<Linear2>(model, q, r, 0.0, Eigen::Vector2d::Zero()),
+  options.gamma = 0.0;
+  EXPECT_THROW(SlidingModeObserver<Linear2>(model, options), InvalidInput);
+}
+
+// Names in reports: the registry's spec, the engine's own name, or the options' name.
+TEST(WindowEstimator, TakesItsLabelFromTheEngine) {
+  WindowEstimatorOptions options;
+  options.initial_estimate = kGuess;
+  EXPECT_EQ(make_window_estimator(paper_modified_chua(), "newton:tol=1e-10", options)->name(),
+            "window:newton:tol=1e-10");
+  EXPECT_EQ(make_window_estimator(paper_modified_chua(), "newton", options)->engine(), "newton");
+  WindowEstimator<Chua> direct(paper_modified_chua(), options,
+                               std::make_unique<NewtonEngine<3>>(NewtonOptions{}));
+  EXPECT_EQ(direct.name(), "window:newton");
+  options.window = 6;
+  EXPECT_EQ(make_window_estimator(paper_modified_chua(), "ceres", options)->name(),
+            "window:ceres,N=6");
+  options.name = "my estimator";
+  EXPECT_EQ(make_window_estimator(paper_modified_chua(), "ceres", options)->name(), "my estimator");
+  EXPECT_THROW(WindowEstimator<Chua>(paper_modified_chua(), options, nullptr), InvalidInput);
+  EXPECT_THROW(make_window_estimator(paper_modified_chua(), "no-such-engine", options),
                InvalidInput);
+}
+
+// Each options struct names the field it refuses.
+std::string refusal(const std::function<void()>& build) {
+  try {
+    build();
+  } catch (const InvalidInput& e) {
+    return e.what();
+  }
+  return "(accepted)";
+}
+
+TEST(ObserverOptions, ValidateNamesTheField) {
+  const Linear2 model;
+  WindowEstimatorOptions window;  // no initial estimate
+  EXPECT_NE(refusal([&] {
+              make_window_estimator(model, "newton", window);
+            }).find("WindowEstimatorOptions::initial_estimate"),
+            std::string::npos);
+  window.initial_estimate = Eigen::Vector3d::Zero();  // 3 entries for 2 states
+  EXPECT_NE(refusal([&] { make_window_estimator(model, "newton", window); }).find("has 3 entries"),
+            std::string::npos);
+  window.initial_estimate = Eigen::Vector2d::Zero();
+  window.window = -1;
+  EXPECT_NE(refusal([&] { window.validate(); }).find("WindowEstimatorOptions::window = -1"),
+            std::string::npos);
+
+  LuenbergerOptions luenberger;
+  luenberger.initial_estimate = Eigen::Vector2d::Zero();
+  EXPECT_NE(refusal([&] {
+              LuenbergerObserver<Linear2>(model, luenberger);
+            }).find("LuenbergerOptions::gain must be given"),
+            std::string::npos);
+  luenberger.gain = Eigen::Vector2d(NAN, 0.0);
+  EXPECT_NE(refusal([&] { luenberger.validate(); }).find("every entry finite"), std::string::npos);
+  luenberger.gain = Eigen::Vector2d(0.5, 0.3);
+  luenberger.name.clear();
+  EXPECT_NE(refusal([&] { luenberger.validate(); }).find("LuenbergerOptions::name"),
+            std::string::npos);
+
+  SlidingModeOptions sliding;
+  sliding.initial_estimate = Eigen::Vector2d::Zero();
+  sliding.q = sliding.r = Eigen::Vector2d(0.1, 0.1);
+  sliding.gamma = -2.0;
+  EXPECT_NE(refusal([&] {
+              SlidingModeObserver<Linear2>(model, sliding);
+            }).find("SlidingModeOptions::gamma = -2"),
+            std::string::npos);
+  sliding.gamma = 0.5;
+  sliding.q = Eigen::Vector3d::Zero();  // n × p = 2 × 1 wanted
+  EXPECT_NE(refusal([&] { SlidingModeObserver<Linear2>(model, sliding); }).find("q must be"),
+            std::string::npos);
+
+  EkfOptions ekf;
+  ekf.initial_estimate = Eigen::Vector2d::Zero();
+  ekf.measurement_covariance = Eigen::MatrixXd::Constant(1, 2, 1.0);  // not square
+  EXPECT_NE(refusal([&] { ekf.validate(); }).find("measurement_covariance R (1x2)"),
+            std::string::npos);
+  ekf.measurement_covariance = Eigen::MatrixXd::Constant(1, 1, 1e-4);
+  ekf.initial_covariance = Eigen::Matrix3d::Identity();  // valid alone, wrong size for n = 2
+  EXPECT_EQ(refusal([&] { ekf.validate(); }), "(accepted)");
+  EXPECT_NE(refusal([&] { ExtendedKalmanFilter<Linear2>(model, ekf); }).find("initial_covariance"),
+            std::string::npos);
+  ekf.initial_covariance.resize(0, 0);
+  ekf.name = "tuned ekf";
+  EXPECT_EQ(ExtendedKalmanFilter<Linear2>(model, ekf).name(), "tuned ekf");
+}
+
+// t_k = k·T: T from the options, else the model's step, else 1.
+TEST(Harness, SampleTimeComesFromTheModelUnlessGiven) {
+  SimulationOptions o;
+  o.steps = 5;
+  const Chua chua = paper_modified_chua();
+  EXPECT_DOUBLE_EQ(simulate(chua, kTrue, o).t[4], 4.0 * chua.step());
+  EXPECT_DOUBLE_EQ(simulate(Linear2{}, Eigen::Vector2d::Zero(), o).t[4], 4.0);
+  const AnyModel any("modified-chua", chua, 0.25);
+  EXPECT_DOUBLE_EQ(simulate(any, kTrue, o).t[4], 1.0);
+  o.sample_time = 0.5;
+  EXPECT_DOUBLE_EQ(simulate(chua, kTrue, o).t[4], 2.0);
+  o.sample_time = 0.0;
+  EXPECT_THROW(simulate(chua, kTrue, o), InvalidInput);
+  o.sample_time = NAN;
+  EXPECT_THROW(simulate(chua, kTrue, o), InvalidInput);
 }
 
 TEST(Harness, MseOnAHandCheckableCase) {
@@ -283,8 +401,9 @@ TEST(AnyModel, MatchesTheStaticModelIncludingJacobians) {
   EXPECT_LT((any.f(x, Eigen::VectorXd(0), 3) - model.f(kTrue, {}, 3)).norm(), 1e-15);
   // A window estimator over the run-time model recovers the state too.
   std::vector<std::unique_ptr<Observer>> observers;
-  observers.push_back(std::make_unique<WindowEstimator<AnyModel>>(
-      any, EngineRegistry<Dynamic>::global().create("newton:tol=1e-12"), "newton", kGuess));
+  WindowEstimatorOptions options;
+  options.initial_estimate = kGuess;
+  observers.push_back(make_window_estimator(any, "newton:tol=1e-12", options));
   const Measurements data = chua_data(20);
   const auto r = run_observers(data, observers);
   EXPECT_LT((r.estimates[0].col(19) - data.x.col(19)).norm(), 1e-8);

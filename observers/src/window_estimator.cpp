@@ -27,6 +27,12 @@ void WindowEstimatorOptions::validate() const {
        << " must be finite and nonzero (Psi = gain_scale I must be invertible)";
     throw InvalidInput(os.str());
   }
+  if (initial_estimate.size() == 0 || !initial_estimate.allFinite()) {
+    std::ostringstream os;
+    os << "WindowEstimatorOptions::initial_estimate = [" << initial_estimate.transpose()
+       << "] must be the model's n states, finite";
+    throw InvalidInput(os.str());
+  }
 }
 
 }  // namespace nlobs

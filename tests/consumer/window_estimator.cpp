@@ -20,12 +20,12 @@ int main() {
   solver.stop.step_tolerance = 1e-12;
   solver.stop.residual_tolerance = 1e-12;
   const Eigen::Vector3d guess(0.5, 1.0, 0.0);
+  nlobs::WindowEstimatorOptions options;
+  options.initial_estimate = guess;
   std::vector<std::unique_ptr<nlobs::Observer>> observers;
   observers.push_back(std::make_unique<nlobs::WindowEstimator<Chua>>(
-      model, std::make_unique<nlobs::CeresEngine<3>>(nlobs::CeresOptions{}, solver), "ceres",
-      guess));
-  observers.push_back(std::make_unique<nlobs::WindowEstimator<Chua>>(
-      model, nlobs::EngineRegistry<3>::global().create("newton", solver), "newton", guess));
+      model, options, std::make_unique<nlobs::CeresEngine<3>>(nlobs::CeresOptions{}, solver)));
+  observers.push_back(nlobs::make_window_estimator(model, "newton", options, solver));
   const auto run = nlobs::run_observers(data, observers);
   int failures = 0;
   for (size_t i = 0; i < observers.size(); ++i) {

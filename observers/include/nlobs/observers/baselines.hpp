@@ -2,7 +2,9 @@
 // The classic observers the window estimators are compared with (METHODS §1), for any discrete
 // model x⁺ = f(x, u, k), y = h(x). Each reports x̂_k from the samples up to k − 1 (Luenberger,
 // sliding mode: eq. 89 form, x̂_{k+1} = f(x̂_k) + correction(y_k)) or up to k (EKF: filtered).
-#include <Eigen/Cholesky>
+// Each is built as X(model, XOptions): the options hold the name, the initial estimate and the
+// gains; XOptions::validate() (called by the constructor) checks what the options alone can
+// tell, the constructor the sizes against the model.
 #include <Eigen/LU>
 #include <cmath>
 #include <sstream>
@@ -28,18 +30,41 @@ inline void require_shape(const char* who, const char* what, const Eigen::Matrix
 
 }  // namespace detail
 
+struct LuenbergerOptions {
+  std::string name = "luenberger";   // in reports
+  Eigen::VectorXd initial_estimate;  // x̂_0: n finite numbers (required)
+  Eigen::MatrixXd gain;              // L: n × p, finite (required)
+  // Throws InvalidInput naming the field: an empty name, an initial estimate or gain that is
+  // empty or not finite.
+  void validate() const;
+};
+
+struct SlidingModeOptions {
+  std::string name = "sliding_mode";  // in reports
+  Eigen::VectorXd initial_estimate;   // x̂_0: n finite numbers (required)
+  Eigen::MatrixXd q;                  // Q: n × p linear gain, finite (required)
+  Eigen::MatrixXd r;                  // R: n × p switching gain, finite (required)
+  double gamma = 1.0;                 // γ > 0: the boundary layer of sat(e / γ)
+  // Throws InvalidInput naming the field: as LuenbergerOptions, and γ ≤ 0 or not finite.
+  void validate() const;
+};
+
 // x̂⁺ = f(x̂, u, k) + L (y − h(x̂)), constant gain L (n × p). A next estimate that is not finite
 // (an unstable gain, a model that overflows) is not taken: the step says so, x̂ stays.
 template <DiscreteModel Model>
 class LuenbergerObserver final : public Observer {
  public:
-  LuenbergerObserver(Model model, Eigen::MatrixXd gain, Eigen::VectorXd initial)
-      : model_(std::move(model)), gain_(std::move(gain)), initial_(std::move(initial)) {
-    detail::require_shape("luenberger", "the gain L", gain_, model_.states(), model_.outputs());
-    detail::require_shape("luenberger", "the initial estimate", initial_, model_.states(), 1);
+  LuenbergerObserver(Model model, LuenbergerOptions options)
+      : model_(std::move(model)),
+        name_(std::move(options.name)),
+        gain_(std::move(options.gain)),
+        initial_(std::move(options.initial_estimate)) {
+    LuenbergerOptions{name_, initial_, gain_}.validate();
+    detail::require_shape("LuenbergerOptions", "gain L", gain_, model_.states(), model_.outputs());
+    detail::require_shape("LuenbergerOptions", "initial_estimate", initial_, model_.states(), 1);
     reset();
   }
-  std::string name() const override { return "luenberger"; }
+  std::string name() const override { return name_; }
   void reset() override { x_ = initial_; }
   const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
     step_.estimate = x_;
@@ -61,6 +86,7 @@ class LuenbergerObserver final : public Observer {
     return model_.h(ModelVector<double, Model::kStates>(x));
   }
   Model model_;
+  std::string name_;
   Eigen::MatrixXd gain_;
   Eigen::VectorXd initial_, x_;
   ObserverStep step_;
@@ -71,22 +97,20 @@ class LuenbergerObserver final : public Observer {
 template <DiscreteModel Model>
 class SlidingModeObserver final : public Observer {
  public:
-  SlidingModeObserver(Model model, Eigen::MatrixXd q, Eigen::MatrixXd r, double gamma,
-                      Eigen::VectorXd initial)
+  SlidingModeObserver(Model model, SlidingModeOptions options)
       : model_(std::move(model)),
-        q_(std::move(q)),
-        r_(std::move(r)),
-        gamma_(gamma),
-        initial_(std::move(initial)) {
-    detail::require_shape("sliding_mode", "Q", q_, model_.states(), model_.outputs());
-    detail::require_shape("sliding_mode", "R", r_, model_.states(), model_.outputs());
-    detail::require_shape("sliding_mode", "the initial estimate", initial_, model_.states(), 1);
-    if (!(gamma_ > 0.0) || !std::isfinite(gamma_)) {
-      throw InvalidInput("sliding_mode: gamma = " + std::to_string(gamma_) + " must be > 0");
-    }
+        name_(std::move(options.name)),
+        q_(std::move(options.q)),
+        r_(std::move(options.r)),
+        gamma_(options.gamma),
+        initial_(std::move(options.initial_estimate)) {
+    SlidingModeOptions{name_, initial_, q_, r_, gamma_}.validate();
+    detail::require_shape("SlidingModeOptions", "q", q_, model_.states(), model_.outputs());
+    detail::require_shape("SlidingModeOptions", "r", r_, model_.states(), model_.outputs());
+    detail::require_shape("SlidingModeOptions", "initial_estimate", initial_, model_.states(), 1);
     reset();
   }
-  std::string name() const override { return "sliding_mode"; }
+  std::string name() const override { return name_; }
   void reset() override { x_ = initial_; }
   const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
     step_.estimate = x_;
@@ -106,6 +130,7 @@ class SlidingModeObserver final : public Observer {
 
  private:
   Model model_;
+  std::string name_;
   Eigen::MatrixXd q_, r_;
   double gamma_;
   Eigen::VectorXd initial_, x_;
@@ -118,16 +143,22 @@ class SlidingModeObserver final : public Observer {
 // An update or prediction that is not finite is not taken (the step says so): the estimate
 // keeps its last finite value, and a non-finite predicted covariance restarts from P0.
 struct EkfOptions {
+  std::string name = "ekf";                // in reports
+  Eigen::VectorXd initial_estimate;        // x̂_0: n finite numbers (required)
   Eigen::MatrixXd process_covariance;      // Q (n × n); empty: 1e-6 I
   Eigen::MatrixXd measurement_covariance;  // R (p × p); empty: 1e-4 I
   Eigen::MatrixXd initial_covariance;      // P0 (n × n); empty: I
+  // Throws InvalidInput naming the field: an empty name, an initial estimate that is empty or
+  // not finite, a covariance given but not square, finite, symmetric positive semi-definite.
+  void validate() const;
 };
 
 template <DiscreteModel Model>
 class ExtendedKalmanFilter final : public Observer {
  public:
-  ExtendedKalmanFilter(Model model, Eigen::VectorXd initial, EkfOptions options = {})
-      : model_(std::move(model)), initial_(std::move(initial)) {
+  ExtendedKalmanFilter(Model model, EkfOptions options)
+      : model_(std::move(model)), name_(options.name), initial_(options.initial_estimate) {
+    options.validate();
     const Eigen::Index n = model_.states(), p = model_.outputs();
     q_ = options.process_covariance.size()
              ? options.process_covariance
@@ -137,24 +168,13 @@ class ExtendedKalmanFilter final : public Observer {
              : Eigen::MatrixXd(1e-4 * Eigen::MatrixXd::Identity(p, p));
     p0_ = options.initial_covariance.size() ? options.initial_covariance
                                             : Eigen::MatrixXd(Eigen::MatrixXd::Identity(n, n));
-    detail::require_shape("ekf", "the initial estimate", initial_, n, 1);
-    detail::require_shape("ekf", "process_covariance Q", q_, n, n);
-    detail::require_shape("ekf", "measurement_covariance R", r_, p, p);
-    detail::require_shape("ekf", "initial_covariance P0", p0_, n, n);
-    const char* names[] = {"process_covariance Q", "measurement_covariance R",
-                           "initial_covariance P0"};
-    const Eigen::MatrixXd* mats[] = {&q_, &r_, &p0_};
-    for (int i = 0; i < 3; ++i) {
-      const Eigen::LDLT<Eigen::MatrixXd> ldlt(*mats[i]);
-      if (!mats[i]->isApprox(mats[i]->transpose()) || ldlt.info() != Eigen::Success ||
-          !ldlt.isPositive()) {
-        throw InvalidInput(std::string("ekf: ") + names[i] +
-                           " must be symmetric positive semi-definite");
-      }
-    }
+    detail::require_shape("EkfOptions", "initial_estimate", initial_, n, 1);
+    detail::require_shape("EkfOptions", "process_covariance Q", q_, n, n);
+    detail::require_shape("EkfOptions", "measurement_covariance R", r_, p, p);
+    detail::require_shape("EkfOptions", "initial_covariance P0", p0_, n, n);
     reset();
   }
-  std::string name() const override { return "ekf"; }
+  std::string name() const override { return name_; }
   void reset() override {
     x_ = initial_;
     p_ = p0_;
@@ -230,6 +250,7 @@ class ExtendedKalmanFilter final : public Observer {
   }
 
   Model model_;
+  std::string name_;
   Eigen::VectorXd initial_, x_;
   Eigen::MatrixXd q_, r_, p0_, p_;
   ObserverStep step_;

@@ -37,15 +37,36 @@ struct SimulationOptions {
   long steps = 400;
   double noise_std = 0.0;  // σ of additive Gaussian noise on every output
   std::uint64_t seed = 1;
-  double sample_time = 1.0;                           // t_k = k · sample_time
+  // T of t_k = k·T. Unset: the model's sample_time() (AnyModel, when it is not 0 = unknown) or
+  // step() (Discretized, SampledModel) where it has one, else 1 (samples that are indices).
+  std::optional<double> sample_time = std::nullopt;
   std::function<Eigen::VectorXd(long k)> input = {};  // u_k; empty: no inputs
 };
 
-// Throws InvalidInput for steps < 1, σ < 0 or non-finite, or an x0 of the wrong size.
+// The T of t_k = k·T that simulate() uses: options.sample_time, else the model's, else 1.
+template <DiscreteModel Model>
+double simulation_sample_time(const Model& model, const SimulationOptions& o) {
+  if (o.sample_time) return *o.sample_time;
+  if constexpr (requires { model.sample_time(); }) {
+    if (model.sample_time() != 0.0) return static_cast<double>(model.sample_time());
+  } else if constexpr (requires { model.step(); }) {
+    return static_cast<double>(model.step());
+  }
+  return 1.0;
+}
+
+// Throws InvalidInput for steps < 1, σ < 0 or non-finite, a sample time that is not finite and
+// > 0, or an x0 of the wrong size.
 template <DiscreteModel Model>
 Measurements simulate(const Model& model, const Eigen::VectorXd& x0, const SimulationOptions& o) {
   const Eigen::Index n = model.states(), p = model.outputs(), m = model.inputs();
   if (o.steps < 1) throw InvalidInput("simulate: steps must be >= 1");
+  const double sample_time = simulation_sample_time(model, o);
+  if (!(sample_time > 0.0) || !std::isfinite(sample_time)) {
+    std::ostringstream os;
+    os << "simulate: SimulationOptions::sample_time = " << sample_time << " must be finite and > 0";
+    throw InvalidInput(os.str());
+  }
   if (!(o.noise_std >= 0.0) || !std::isfinite(o.noise_std)) {
     throw InvalidInput("simulate: noise_std must be finite and >= 0");
   }
@@ -79,7 +100,7 @@ Measurements simulate(const Model& model, const Eigen::VectorXd& x0, const Simul
     }
     if (!violation.empty()) {
       std::ostringstream os;
-      os << "stopped at sample " << k << " (t = " << static_cast<double>(k) * o.sample_time
+      os << "stopped at sample " << k << " (t = " << static_cast<double>(k) * sample_time
          << "): " << violation;
       data.stop_message = os.str();
       data.x.conservativeResize(n, k);
@@ -91,7 +112,7 @@ Measurements simulate(const Model& model, const Eigen::VectorXd& x0, const Simul
     const Eigen::VectorXd u = o.input ? o.input(k) : Eigen::VectorXd::Zero(m);
     if (u.size() != m) throw InvalidInput("simulate: the input signal has the wrong size");
     data.x.col(k) = x;
-    data.t[k] = static_cast<double>(k) * o.sample_time;
+    data.t[k] = static_cast<double>(k) * sample_time;
     data.u.col(k) = u;
     if (o.noise_std > 0.0) {
       for (Eigen::Index i = 0; i < p; ++i) y[i] += o.noise_std * noise(rng);

@@ -16,16 +16,21 @@
 // Warm start of a solve that follows a usable one: the previous solution w* (the paper's
 // choice) or its propagation f(w*) to the next window's first sample (measured better; the
 // default, docs/observers.md). The engine's Summary of each solve is exposed per step.
+//
+//   auto estimator = make_window_estimator(model, "newton:tol=1e-10", options);  // by spec, or
+//   WindowEstimator<Model> estimator(model, options, std::make_unique<CeresEngine<3>>(...));
 #include <Eigen/LU>
 #include <cmath>
 #include <memory>
 #include <sstream>
 #include <string>
+#include <string_view>
 
 #include "nlobs/observers/observer.hpp"
 #include "nlobs/observers/output_window.hpp"
 #include "nlobs/observers/window_problems.hpp"
 #include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/engine_registry.hpp"
 #include "nlobs/solvers/spectral_radius.hpp"
 
 namespace nlobs {
@@ -49,11 +54,17 @@ enum class WindowGain {
 std::string_view to_string(WindowGain gain);
 
 struct WindowEstimatorOptions {
+  // Name in reports; empty: "window:<engine label>", with ",N=<N>" for a longer window.
+  std::string name;
+  // x̂[0], and the first window's guess for w = x̂[k−N+1]: n finite numbers (required).
+  Eigen::VectorXd initial_estimate;
   Eigen::Index window = 0;  // N; 0 = the square window n / p
   WarmStart warm_start = WarmStart::kPropagated;
   WindowGain gain = WindowGain::kAuto;  // Ψ (square windows only)
   double gain_scale = 1.0;              // Ψ = gain_scale · I for WindowGain::kScalar
-  // Throws InvalidInput for a negative window or a gain_scale that is 0 or not finite.
+  // Throws InvalidInput naming the field for a negative window, a gain_scale that is 0 or not
+  // finite, or an initial estimate that is empty or not finite. The constructor calls it and
+  // checks the sizes against the model.
   void validate() const;
 };
 
@@ -64,14 +75,17 @@ class WindowEstimator final : public Observer {
   using State = Vector<N>;
   using Gain = Matrix<N, N>;
 
-  // Throws InvalidInput for a window that cannot determine the state, an initial guess of the
-  // wrong size or not finite, a missing engine, invalid options, or a square-system engine on a
-  // longer window.
-  WindowEstimator(Model model, std::unique_ptr<Engine<N>> engine, std::string engine_spec,
-                  const State& initial_guess, WindowEstimatorOptions options = {});
+  // Throws InvalidInput for invalid options, a window that cannot determine the state, an
+  // initial estimate of the wrong size, a missing engine, or a square-system engine on a longer
+  // window. The engine's label() (its spec when it came from the registry) names it in reports.
+  WindowEstimator(Model model, WindowEstimatorOptions options, std::unique_ptr<Engine<N>> engine);
 
   std::string name() const override {
-    return "window:" + spec_ + (square_ ? "" : ",N=" + std::to_string(state_->window.length()));
+    if (!options_.name.empty()) return options_.name;
+    std::string out = "window:";
+    out += spec_;
+    if (!square_) out += ",N=" + std::to_string(state_->window.length());
+    return out;
   }
   // An engine for the first window after each reset only (e.g. one that records its trace for
   // a convergence plot), so that the engine of every other step stays lean.
@@ -144,22 +158,35 @@ class WindowEstimator final : public Observer {
   static constexpr double kSingularPivot = 1e-13;
 };
 
+// The one-line form: the engine named by a spec of EngineRegistry<N> ("newton:tol=1e-10"),
+// `base` supplying the stop criteria the spec does not set. Throws InvalidInput for an unknown
+// engine or option and everything the constructor refuses.
 template <DiscreteModel Model>
-WindowEstimator<Model>::WindowEstimator(Model model, std::unique_ptr<Engine<N>> engine,
-                                        std::string engine_spec, const State& initial_guess,
-                                        WindowEstimatorOptions options)
-    : options_(options),
+std::unique_ptr<WindowEstimator<Model>> make_window_estimator(Model model,
+                                                              std::string_view engine_spec,
+                                                              WindowEstimatorOptions options,
+                                                              SolverOptions base = {}) {
+  auto engine = EngineRegistry<Model::kStates>::global().create(engine_spec, std::move(base));
+  return std::make_unique<WindowEstimator<Model>>(std::move(model), std::move(options),
+                                                  std::move(engine));
+}
+
+template <DiscreteModel Model>
+WindowEstimator<Model>::WindowEstimator(Model model, WindowEstimatorOptions options,
+                                        std::unique_ptr<Engine<N>> engine)
+    : options_(std::move(options)),
       engine_(std::move(engine)),
-      spec_(std::move(engine_spec)),
-      initial_guess_(initial_guess),
-      state_(std::make_unique<Shared>(std::move(model), window_length(model, options))) {
+      state_(std::make_unique<Shared>(std::move(model), window_length(model, options_))) {
   if (!engine_) throw InvalidInput("WindowEstimator: no engine");
+  spec_ = engine_->label();
   const Eigen::Index n = state_->window.states();
-  if (initial_guess_.size() != n || !initial_guess_.allFinite()) {
+  if (options_.initial_estimate.size() != n) {
     std::ostringstream os;
-    os << "WindowEstimator: the initial guess must be " << n << " finite numbers";
+    os << "WindowEstimatorOptions::initial_estimate has " << options_.initial_estimate.size()
+       << " entries; the model has " << n << " states";
     throw InvalidInput(os.str());
   }
+  initial_guess_ = options_.initial_estimate;
   square_ = state_->window.rows() == n;
   // Built once; they read the window, which never moves (it lives behind a unique_ptr).
   if (square_) {

@@ -3,6 +3,7 @@
 // x holds the initial guess on entry and the engine's answer on return.
 #include <cmath>
 #include <sstream>
+#include <string>
 #include <string_view>
 
 #include "nlobs/solvers/library_sizes.hpp"
@@ -22,6 +23,10 @@ class Engine {
  public:
   virtual ~Engine() = default;
   virtual std::string_view name() const = 0;
+  // What reports call this engine: the spec it was made from ("anderson:m=3", set by
+  // EngineRegistry::create), else name(). Observers built on an engine take their label from it.
+  std::string label() const { return label_.empty() ? std::string(name()) : label_; }
+  void set_label(std::string label) { label_ = std::move(label); }
   // Throws InvalidInput for a dimension mismatch or a non-finite initial guess. Every other
   // outcome, including a non-finite G value, is a Status in the returned Summary.
   virtual Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) = 0;
@@ -42,6 +47,9 @@ class Engine {
  protected:
   explicit Engine(SolverOptions options) : options_(std::move(options)) { validate(options_.stop); }
   SolverOptions options_;
+
+ private:
+  std::string label_;
 };
 
 template <int N>

@@ -85,7 +85,8 @@ class EngineRegistry {
 
   std::vector<std::string> names() const;
 
-  // Builds the engine a spec names; `base` supplies stop criteria the spec does not set.
+  // Builds the engine a spec names; `base` supplies stop criteria the spec does not set. The
+  // engine's label() is the spec as given.
   // Throws InvalidInput for an unknown name (listing the valid ones) or option.
   std::unique_ptr<Engine<N>> create(std::string_view spec_text, SolverOptions base = {}) const;
 
@@ -181,6 +182,7 @@ std::unique_ptr<Engine<N>> EngineRegistry<N>::create(std::string_view spec_text,
   std::unique_ptr<Engine<N>> engine = entry->make(reader, std::move(base));
   reader.finish();
   if (!engine) throw InvalidInput("engine '" + spec.name + "': its factory returned no engine");
+  engine->set_label(std::string(spec_text));
   return engine;
 }
 

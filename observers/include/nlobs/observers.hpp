@@ -1,0 +1,19 @@
+#pragma once
+// Front door of the observer layer: the Observer interface and the harness (simulate,
+// run_observers), the window estimators (any engine × any output window), the baselines
+// (Luenberger, sliding mode, EKF) and the observers of the source papers (MVT, PI bank,
+// modulating-function, high-gain). Each family's own header is lighter where compile time
+// matters (docs/observers.md lists them).
+#include "nlobs/models.hpp"
+#include "nlobs/observers/any_model.hpp"
+#include "nlobs/observers/baselines.hpp"
+#include "nlobs/observers/finite_difference_observer.hpp"
+#include "nlobs/observers/high_gain_observer.hpp"
+#include "nlobs/observers/modulating_function_observer.hpp"
+#include "nlobs/observers/mvt_observer.hpp"
+#include "nlobs/observers/observer.hpp"
+#include "nlobs/observers/output_window.hpp"
+#include "nlobs/observers/pi_bank.hpp"
+#include "nlobs/observers/simulation.hpp"
+#include "nlobs/observers/window_estimator.hpp"
+#include "nlobs/solvers.hpp"
