@@ -1,4 +1,4 @@
-// Engines vs one G evaluation vs KINSOL on the modified-Chua window problem (METHODS §1).
+// Engines vs one G evaluation vs KINSOL on the modified-Chua window problem ([MGFF23]).
 // Each solve benchmark reports its iterations and evaluations as counters; bench_main.cpp
 // turns them into the two ratios the foundation issue asks for.
 #include <benchmark/benchmark.h>

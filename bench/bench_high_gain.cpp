@@ -1,4 +1,4 @@
-// The high-gain observer (seed 004), whole runs over recorded data so that the cost per step
+// The high-gain observer ([HG-EMB23]), whole runs over recorded data so that the cost per step
 // and the accuracy come from the same steps:
 //   BM_HighGainStep/<example>: µs per sample for each way of getting x̂ and α — the explicit
 //     inverse, the least-squares projection with a hand map (ceres::Jet Jacobian), the Taylor

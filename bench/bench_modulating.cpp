@@ -1,4 +1,4 @@
-// The modulating-function observer (seed 003): µs per sample over a recorded run of the LTI
+// The modulating-function observer ([MF-LTV]): µs per sample over a recorded run of the LTI
 // example (δ = 10 ms) as the horizon grows (the FIR is n(n+1) dot products of T/δ + 1 taps),
 // in FIR mode and in sampled-data mode (outputs every 0.1 s, the predictor between); and the
 // offline kernel design (minimal and noise-optimal degree). Counter: eta_error = ‖η − η̂‖ at

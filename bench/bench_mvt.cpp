@@ -1,4 +1,4 @@
-// One step of the MVT observer (seed 001) — a sample interval of RK4, four right-hand sides,
+// One step of the MVT observer ([BMH]) — a sample interval of RK4, four right-hand sides,
 // each solving β — on the paper's two examples, per β solver. The steps cycle over the first
 // 2 s of case 2 (chaotic) and of the robot with ê(0) ≠ x(0) − x̂(0), where ê is far from zero
 // and every β problem is a real one (later ê decays and rows reach tolerance at once).

@@ -1,5 +1,5 @@
 #pragma once
-// High-gain observers in embedded coordinates (seed 004) in scenarios:
+// High-gain observers in embedded coordinates ([HG-EMB23]) in scenarios:
 //   {"type": "high_gain", "N": 6, "theta": 0.1, "map": "ad", "alpha": "explicit", ...}
 // built from the scenario's continuous model by name (model_visit.hpp). Keys: docs/cli.md.
 #include <Eigen/Core>

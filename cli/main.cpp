@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
   CLI::App* solve = app.add_subcommand("solve", "Solve a built-in problem with several engines");
   solve->require_subcommand(1);
   CLI::App* chua = solve->add_subcommand(
-      "chua-window", "Modified-Chua window problem (METHODS §1) with each engine and KINSOL");
+      "chua-window", "Modified-Chua window problem ([MGFF23]) with each engine and KINSOL");
   std::string engines_arg;
   double tolerance = 1e-8;
   bool chua_json = false;

@@ -1,5 +1,5 @@
 #pragma once
-// Modulating-function observers (seed 003) in scenarios:
+// Modulating-function observers ([MF-LTV]) in scenarios:
 //   {"type": "modulating", "horizon": 1.0, "degree": 5, "sample_period": 0.1, ...}
 // built from the scenario's model by name: the catalogue models with a canonical form
 // (modulating_forms.hpp: lti-injection, pendulum). Keys: docs/cli.md.

@@ -1,5 +1,5 @@
 #pragma once
-// What `nlobs run` reports for modulating-function observers (seed 003): canonical-state errors
+// What `nlobs run` reports for modulating-function observers ([MF-LTV]): canonical-state errors
 // one horizon after start, Theorem 1's disturbance bound, and sweeps over the horizon, the
 // sampling period or a model parameter (the disturbance level of Fig. 9).
 #include <iosfwd>

@@ -1,5 +1,5 @@
 #pragma once
-// MVT observers (seed 001) in scenarios: {"type": "mvt", "error_guess": [...], ...}. The
+// MVT observers ([BMH]) in scenarios: {"type": "mvt", "error_guess": [...], ...}. The
 // observer needs the continuous model with AD, so it is built from the scenario's model by name
 // (model_visit.hpp), one MvtObserver<Model> per catalogue model.
 #include <Eigen/Core>

@@ -1,5 +1,5 @@
 #pragma once
-// The PI observer banks of seed 002's examples, by name, for scenario files (docs/cli.md):
+// The PI observer banks of [FFMG19]'s examples, by name, for scenario files (docs/cli.md):
 //   {"type": "pi_bank", "bank": "lander", "gains": [[6, 25], [49, 700]], ...}
 // Users build their own banks with the C++ API (nlobs/observers/pi_bank.hpp).
 #include <memory>

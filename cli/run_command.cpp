@@ -99,7 +99,7 @@ void add_coordinate_errors(const Measurements& data,
 
 namespace {
 
-// Per observer with a "z_error" extra: what seed 004's figures show.
+// Per observer with a "z_error" extra: what [HG-EMB23]'s figures show.
 struct EmbeddedMetrics {
   double max_zhat_norm = 0.0;  // the peaking
   double final_z_error = NAN;
@@ -354,7 +354,7 @@ std::vector<double> parse_sweep_values(const std::string& key, const std::string
 
 namespace {
 
-// --sweep theta=v1,v2,…: the high_gain observers once per θ on the same data (seed 004's
+// --sweep theta=v1,v2,…: the high_gain observers once per θ on the same data ([HG-EMB23]'s
 // peaking/noise trade-off: peaking grows as θ shrinks, noise amplification too). Other keys
 // are the modulating-function sweeps (modulating_report.cpp).
 void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& data,

@@ -260,7 +260,7 @@ std::string plot_script(OutputDirectory& dir, const Measurements& data, const Ru
     }
     g << "unset multiplot\n";
   }
-  // Seed 004's Figs. 3 and 6 (‖z − ẑ‖) and seed 003's canonical error ‖η − η̂‖ on a log scale.
+  // [HG-EMB23]'s Figs. 3 and 6 (‖z − ẑ‖) and [MF-LTV]'s canonical error ‖η − η̂‖ on a log scale.
   for (const auto& [extra, label] :
        {std::pair<std::string, std::string>{"z_error", "||z - zhat||_2"},
         {"eta_error", "||eta - etahat||_2"}}) {

@@ -32,7 +32,7 @@ nlohmann::json vector_json(const Eigen::VectorXd& v) {
   return std::vector<double>(v.data(), v.data() + v.size());
 }
 
-// The paper's experiment (METHODS §1). The paper omits the true state, the run length and
+// The paper's experiment ([MGFF23]). The paper omits the true state, the run length and
 // the noise: x0 = [1, 2.1428, -0.1648] reproduces its first-window fixed point; 400 samples
 // (20 s at T = 0.05); noise-free by default (--noise adds it).
 const char* kChuaFp = R"({
@@ -65,7 +65,7 @@ const char* kChuaFp = R"({
   }
 })";
 
-// Seed 002, example 3 (METHODS §3): f = 3 sin(πt) immersed as state x2, u = 2 sin(πt),
+// [FFMG19], example 3 ([FFMG19]): f = 3 sin(πt) immersed as state x2, u = 2 sin(πt),
 // gains (8, 15), γ(0) = 0. N = max|f'| = 3π. 10 s at the model's step 1 ms; after t = 2 s.
 // The EKF's own model assumes f constant (amplitude 0): it must track f through Q.
 const char* kPiLinear = R"({
@@ -85,7 +85,7 @@ const char* kPiLinear = R"({
   ]
 })";
 
-// Seed 002, example 4: the cubic Chua circuit, y = x2, x0 = (0.2, 0.2, 0.2), gains (25, 150),
+// [FFMG19], example 4: the cubic Chua circuit, y = x2, x0 = (0.2, 0.2, 0.2), gains (25, 150),
 // γ(0) = 0, x̂1(0) = 0. N = 3.5 bounds |d(x1 + x3)/dt| on this run (measured max 3.20, see
 // docs/observers.md). 50 s at 1 ms; after t = 10 s. chua-x3 is our alternative reconstruction.
 const char* kPiChua = R"({
@@ -103,7 +103,7 @@ const char* kPiChua = R"({
   ]
 })";
 
-// Seed 002, example 5: the lunar lander with f = exp(6 sin t) immersed as x4, u = 1,
+// [FFMG19], example 5: the lunar lander with f = exp(6 sin t) immersed as x4, u = 1,
 // x0 = (−700, 0, 1500), gains (6, 25) for x2 and (49, 700) for f, γ(0) = 0. Asked for 15 s at
 // 1 ms; the mass reaches zero near t = 13.05 s and the run stops there with the domain message.
 // N for f: max|d/dt exp(6 sin t)| = 588.2; x2' = g − σα/x3 is unbounded as x3 → 0, so no N.
@@ -126,7 +126,7 @@ const char* kPiLander = R"({
   ]
 })";
 
-// Seed 001, example 1 (METHODS §2): the chaotic system without linear term, y = (x1, x2),
+// [BMH], example 1 ([BMH]): the chaotic system without linear term, y = (x1, x2),
 // x0 = (−2, −1, −1), x̂0 = (−1, −0.5, −1.5), η = 1, 30 s at 1 ms (plant RK4, observer RK4 at the
 // sample step, y between samples by the cubic through the last four samples). Case 1:
 // ê0 = x0 − x̂0; case 2: ê0's third entry 0.2 instead of 0.5. The published structure and our
@@ -151,7 +151,7 @@ const char* kMvtChaotic = R"({
   ]
 })";
 
-// Seed 001, example 2: the flexible-joint robot, u = sin t, y = (x1, x2, x3), x0 = (3, 3, 3, 3),
+// [BMH], example 2: the flexible-joint robot, u = sin t, y = (x1, x2, x3), x0 = (3, 3, 3, 3),
 // x̂0 = (−1, −2, −0.5, −1), η = 1, 15 s at 1 ms. The paper's ê0 = x0 − x̂0, and one that misses
 // x4 by 1 (published and corrected).
 const char* kMvtRobot = R"({
@@ -175,7 +175,7 @@ const char* kMvtRobot = R"({
   ]
 })";
 
-// METHODS §5 / seed 004: the Duffing oscillator's hard start ẑ(0) = q6(0, 0) while x(0) is on an
+// [HG-EMB23]: the Duffing oscillator's hard start ẑ(0) = q6(0, 0) while x(0) is on an
 // orbit around the equilibrium (1, 0); P, R, ρ and θ are the paper's. The hand q6 (the maps from
 // the model give the same run, "map": "ad" 7× and "adolc" 100× slower).
 constexpr const char* kHgDuffing = R"({
@@ -219,7 +219,7 @@ constexpr const char* kHgOscillator = R"({
 })";
 
 // Lorenz, y = x1, N = 4: α = L_f^4 h along the prediction (α(z) is rational, singular on the
-// x3 axis); P from the box |x| ≤ (25, 30, 55) around the attractor (the paper's §6 recipe).
+// x3 axis); P from the box |x| ≤ (25, 30, 55) around the attractor ([HG-EMB23] §6).
 constexpr const char* kHgLorenz = R"({
   "name": "hg-lorenz",
   "model": {"name": "lorenz", "scheme": "rk4", "step": 0.001},
@@ -253,7 +253,7 @@ constexpr const char* kHgVdp = R"({
   ]
 })";
 
-// METHODS §4 / seed 003: y'' + 0.5 y' + y = sin y sampled every 10 ms with noise σ = 0.01. The
+// [MF-LTV]: y'' + 0.5 y' + y = sin y sampled every 10 ms with noise σ = 0.01. The
 // modulating-function observer (T = 1 s) on every sample and in sampled-data mode (outputs every
 // 0.1 s, the predictor between), beside backward differences and a least-squares window
 // estimator (20 samples) on the same data.

@@ -133,7 +133,7 @@ std::vector<SolveRow> solve_chua_window(const std::vector<std::string>& engines,
 void print_table(const std::vector<SolveRow>& rows, double tolerance, std::ostream& out) {
   char line[256];
   std::snprintf(line, sizeof line,
-                "modified-Chua window (METHODS §1): x_true = [1, 2.1428, -0.1648], "
+                "modified-Chua window ([MGFF23]): x_true = [1, 2.1428, -0.1648], "
                 "x0 = [5, 10, -5], tol = %g\n",
                 tolerance);
   out << line;

@@ -1,5 +1,5 @@
 #pragma once
-// `nlobs solve chua-window`: the modified-Chua window problem (METHODS §1) solved by each
+// `nlobs solve chua-window`: the modified-Chua window problem ([MGFF23]) solved by each
 // listed engine and, in the same run, by KINSOL's fixed-point, Anderson and Newton strategies.
 #include <Eigen/Core>
 #include <iosfwd>

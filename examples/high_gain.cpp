@@ -1,5 +1,5 @@
-// The high-gain observer in embedded coordinates (seed 004) on the Duffing oscillator's hard
-// start: ẑ(0) = q6(0, 0) while x circles the equilibrium (1, 0). q6 and α as METHODS §5 gives
+// The high-gain observer in embedded coordinates ([HG-EMB23]) on the Duffing oscillator's hard
+// start: ẑ(0) = q6(0, 0) while x circles the equilibrium (1, 0). q6 and α as [HG-EMB23] gives
 // them, x̂ by a Ceres least-squares projection.
 #include <cstdio>
 

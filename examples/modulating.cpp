@@ -1,4 +1,4 @@
-// The modulating-function observer (seed 003) on the LTI system with output injection
+// The modulating-function observer ([MF-LTV]) on the LTI system with output injection
 // y'' + 0.5 y' + y = sin y, from noisy samples (σ = 0.01, δ = 10 ms): the derivative y' one
 // horizon after start, beside backward differences of the same samples.
 #include <cmath>

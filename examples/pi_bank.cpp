@@ -1,4 +1,4 @@
-// A bank of model-free PI observers (seed 002, example 5): the lunar lander's velocity x2 = ẏ,
+// A bank of model-free PI observers ([FFMG19], example 5): the lunar lander's velocity x2 = ẏ,
 // its mass from ẋ2, and the unknown mass-loss term f from the mass — three stages, one bank.
 #include "nlobs/observers/pi_bank.hpp"
 

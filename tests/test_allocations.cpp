@@ -189,7 +189,7 @@ TEST(Allocations, MvtStepWithPerRowBetaAllocatesNothing) {
   EXPECT_GT(observer.ehat().norm(), 1e-3);  // the β problems were real ones
 }
 
-// A high-gain step with an explicit map, α and inverse (the oscillator of METHODS §5) on RK4:
+// A high-gain step with an explicit map, α and inverse (the oscillator of [HG-EMB23]) on RK4:
 // the embedded state is dynamic-size but allocated once, so the step allocates nothing.
 TEST(Allocations, HighGainStepWithExplicitFormsAllocatesNothing) {
   HighGainObserver<OscillatorNonlinearOutput>::Design d;

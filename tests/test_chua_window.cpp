@@ -1,4 +1,4 @@
-// The modified-Chua window problem of METHODS §1: model, window map against the paper's
+// The modified-Chua window problem of [MGFF23]: model, window map against the paper's
 // expanded formulas (eqs. 80, 86), and every engine on it.
 #include <gtest/gtest.h>
 
@@ -88,7 +88,7 @@ TEST(ChuaWindow, AllEnginesAgreeAtTightTolerance) {
   }
   for (const Vector<3>& a : solutions) {
     for (const Vector<3>& b : solutions) EXPECT_LT((a - b).lpNorm<Eigen::Infinity>(), 1e-6);
-    // Picard's error is about step/(1 − L) with L ≈ 0.973 (METHODS §1): still far below 1e-6.
+    // Picard's error is about step/(1 − L) with L ≈ 0.973 ([MGFF23]): still far below 1e-6.
     EXPECT_LT((a - kTrue).lpNorm<Eigen::Infinity>(), 1e-8);
   }
 }

@@ -1,4 +1,4 @@
-// High-gain observer in embedded coordinates (METHODS §5, seed 004): the observability maps by
+// High-gain observer in embedded coordinates ([HG-EMB23]): the observability maps by
 // AD against the hand expansions, the α identities, the smooth saturation, the gains, and the
 // observer's convergence and failure modes.
 #include <gtest/gtest.h>
@@ -116,7 +116,7 @@ TEST(ObservabilityMap, AdEqualsHandExpansions) {
   }
 }
 
-// d/dt z_N = L_f^N h(x) = α(q_N(x)) (METHODS §5), and the gradients agree by the chain rule.
+// d/dt z_N = L_f^N h(x) = α(q_N(x)) ([HG-EMB23]), and the gradients agree by the chain rule.
 template <typename Form, typename Model>
 void expect_alpha_identity(AdMap which, const Model& model, double scale) {
   constexpr int N = Form::kDimension;
@@ -324,7 +324,7 @@ TEST(SmoothSaturation, ValidateNamesTheField) {
             std::string::npos);
 }
 
-// The paper's §6: a box on x bounds z through q_N; P from it puts the box inside ‖z‖_P ≤ 1.
+// [HG-EMB23] §6: a box on x bounds z through q_N; P from it puts the box inside ‖z‖_P ≤ 1.
 TEST(SmoothSaturation, BoxBoundEnclosesTheImage) {
   const Eigen::Vector2d X(1.5, 0.9);
   const Eigen::VectorXd Z = embedded_box_bound(DuffingEmbedding{}, X);
@@ -474,7 +474,7 @@ TEST(HighGainObserver, CvodeFailureKeepsTheStateAndRecovers) {
   }
 }
 
-// METHODS §5's hard start: ẑ(0) = q6(0, 0) while x circles the equilibrium (1, 0).
+// [HG-EMB23]'s hard start: ẑ(0) = q6(0, 0) while x circles the equilibrium (1, 0).
 TEST(HighGainObserver, DuffingConvergesFromTheHardStart) {
   const double h = 1e-3;
   const Measurements data = simulate_continuous(Duffing{}, Eigen::Vector2d(1.2, 0.0), h, 12.0);

@@ -1,4 +1,4 @@
-// The modulating-function observer (seed 003, METHODS §4): kernels' boundary conditions and
+// The modulating-function observer ([MF-LTV]): kernels' boundary conditions and
 // exactness, the observer's exactness one horizon after start, its noise advantage over finite
 // differences, the sampled-data mode, Theorem 1's disturbance bound and the failure modes.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The MVT observer of seed 001: the β problem (identity, row decoupling, degenerate pairs), the
+// The MVT observer of [BMH]: the β problem (identity, row decoupling, degenerate pairs), the
 // paper's two cases on the chaotic example (published structure and our output injection), the
 // robot, the integrators, and bad input.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The PI observer of seed 002: the γ form against the direct form, the ultimate bounds against
+// The PI observer of [FFMG19]: the γ form against the direct form, the ultimate bounds against
 // closed forms and simulation, bank composition, and bad input.
 #include <gtest/gtest.h>
 

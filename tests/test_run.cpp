@@ -601,7 +601,7 @@ TEST(RunMvt, ScenariosRoundTripAndBadSpecsNameTheProblem) {
   EXPECT_NE(error_of(f.string()).find("C = [I_m 0]"), std::string::npos) << error_of(f.string());
 }
 
-// Seed 004's examples: ‖z − ẑ‖ below 1e-6 within the documented times, x̂ → x.
+// [HG-EMB23]'s examples: ‖z − ẑ‖ below 1e-6 within the documented times, x̂ → x.
 TEST(RunHighGain, OscillatorAndDuffingReachOneMicro) {
   const nlohmann::json osc = run_summary("hg-oscillator");
   for (const char* name : {"hg-inverse", "hg-projection"}) {
@@ -771,7 +771,7 @@ TEST(RunHighGain, ScenariosRoundTripAndBadSpecsNameTheProblem) {
   EXPECT_NE(error_of(f.string()).find("needs a hand α"), std::string::npos) << error_of(f.string());
 }
 
-// Seed 003's examples through the CLI: noise-free, exact to 1e-6 one horizon after start; under
+// [MF-LTV]'s examples through the CLI: noise-free, exact to 1e-6 one horizon after start; under
 // noise the derivative estimate far better than finite differences; the sampled-data observer
 // converges; Theorem 1's bound holds on the disturbed pendulum.
 TEST(RunModulating, ExactNoiseFreeAndBetterThanDifferencesUnderNoise) {

@@ -1,5 +1,5 @@
 #pragma once
-// The modified-Chua window problem of METHODS §1, shared by the CLI, tests and benchmarks:
+// The modified-Chua window problem of [MGFF23], shared by the CLI, tests and benchmarks:
 // true initial state [1.0, 2.1428, −0.1648], the window of its first three outputs, initial
 // guess [5, 10, −5]. Its fixed point is the true initial state.
 #include <Eigen/Core>

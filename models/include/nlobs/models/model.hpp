@@ -67,7 +67,7 @@ std::string domain_violation_of(const M& model, const ModelVector<double, M::kSt
 }
 
 // True when F(x, 0, t) changes with t at a few probe states: a time-varying model (observers
-// built for x' = f(x), such as the high-gain observer of METHODS §5, refuse it).
+// built for x' = f(x), such as the high-gain observer of [HG-EMB23], refuse it).
 template <ContinuousModel M>
 bool vector_field_depends_on_time(const M& model) {
   static_assert(M::kStates != Eigen::Dynamic && M::kInputs != Eigen::Dynamic,

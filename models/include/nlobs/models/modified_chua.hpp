@@ -1,5 +1,5 @@
 #pragma once
-// Modified Chua attractor (METHODS §1, paper eqs. 77–78):
+// Modified Chua attractor ([MGFF23], paper eqs. 77–78):
 //   x1' = α (x2 + b sin(π x1 / (2a) + d))
 //   x2' = x1 − x2 + x3
 //   x3' = −β x2,                y = x1

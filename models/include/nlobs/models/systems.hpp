@@ -1,6 +1,7 @@
 #pragma once
-// The dynamic systems of METHODS §2–§5, each with its documented parameters. Every function
-// is generic in the scalar (AD). Inputs, where a system has them, are plain doubles.
+// The dynamic systems of [BMH], [FFMG19], [MF-LTV], [HG-EMB23], each with its documented
+// parameters. Every function is generic in the scalar (AD). Inputs, where a system has them, are
+// plain doubles.
 #include <cmath>
 #include <functional>
 #include <sstream>
@@ -10,7 +11,7 @@
 
 namespace nlobs {
 
-// Cubic Chua circuit (METHODS §3, example 4), y = x2:
+// Cubic Chua circuit ([FFMG19], example 4), y = x2:
 //   x1' = a (x2 − x1 − m0 x1 − m1 x1³),  x2' = x1 − x2 + x3,  x3' = −b x2.
 struct CubicChuaParameters {
   double a = 9.5, b = 100.0 / 7.0, m0 = -8.0 / 7.0, m1 = 4.0 / 63.0;
@@ -31,7 +32,7 @@ struct CubicChua : ModelSizes<3, 0, 1> {
   }
 };
 
-// Lorenz system (METHODS §5), (σ, ρ, β) = (10, 28, 8/3), y = x1.
+// Lorenz system ([HG-EMB23]), (σ, ρ, β) = (10, 28, 8/3), y = x1.
 struct LorenzParameters {
   double sigma = 10.0, rho = 28.0, beta = 8.0 / 3.0;
 };
@@ -51,7 +52,7 @@ struct Lorenz : ModelSizes<3, 0, 1> {
   }
 };
 
-// Duffing oscillator (METHODS §5): x1' = x2, x2' = x1 − x1³, y = x2.
+// Duffing oscillator ([HG-EMB23]): x1' = x2, x2' = x1 − x1³, y = x2.
 struct Duffing : ModelSizes<2, 0, 1> {
   template <typename T>
   State<T> vector_field(const State<T>& x, const Input&, double) const {
@@ -63,8 +64,8 @@ struct Duffing : ModelSizes<2, 0, 1> {
   }
 };
 
-// Van der Pol oscillator (METHODS §5): x1' = x2, x2' = −x1 − μ x2 (x1² − 1), y = x2; μ = 1
-// gives METHODS' form −x1 − x2(x1² − 1), the standard oscillator with a stable limit cycle.
+// Van der Pol oscillator ([HG-EMB23]): x1' = x2, x2' = −x1 − μ x2 (x1² − 1), y = x2; μ = 1
+// gives the form −x1 − x2(x1² − 1), the standard oscillator with a stable limit cycle.
 struct VanDerPol : ModelSizes<2, 0, 1> {
   double mu = 1.0;
   template <typename T>
@@ -77,7 +78,7 @@ struct VanDerPol : ModelSizes<2, 0, 1> {
   }
 };
 
-// Harmonic oscillator with a nonlinear output (METHODS §5): x1' = x2, x2' = −x1,
+// Harmonic oscillator with a nonlinear output ([HG-EMB23]): x1' = x2, x2' = −x1,
 // y = x1² + x1.
 struct OscillatorNonlinearOutput : ModelSizes<2, 0, 1> {
   template <typename T>
@@ -90,7 +91,7 @@ struct OscillatorNonlinearOutput : ModelSizes<2, 0, 1> {
   }
 };
 
-// Chaotic system without linear term (METHODS §2, example 1), y = (x1, x2):
+// Chaotic system without linear term ([BMH], example 1), y = (x1, x2):
 //   x' = [ln(0.1 + exp(x2 − x1)), x1 x3, 0.2 − x1 x2].
 struct ChaoticNoLinear : ModelSizes<3, 0, 2> {
   template <typename T>
@@ -109,7 +110,7 @@ struct ChaoticNoLinear : ModelSizes<3, 0, 2> {
   }
 };
 
-// Flexible-joint robot (METHODS §2, example 2): x' = A x + B u + φ(x), y = (x1, x2, x3),
+// Flexible-joint robot ([BMH], example 2): x' = A x + B u + φ(x), y = (x1, x2, x3),
 // A rows [0 1 0 0], [−48.6 −1.25 48.6 0], [0 0 0 1], [19.5 0 −19.5 0], B = [0 21.6 0 0]ᵀ,
 // φ = [0 0 0 −3.33 sin x3]ᵀ.
 struct FlexibleJointRobotParameters {
@@ -133,7 +134,7 @@ struct FlexibleJointRobot : ModelSizes<4, 1, 3> {
   }
 };
 
-// Lunar lander (METHODS §3, example 5): x1' = x2, x2' = g − σαu/x3, x3' = −σu − f(t),
+// Lunar lander ([FFMG19], example 5): x1' = x2, x2' = g − σαu/x3, x3' = −σu − f(t),
 // y = x1; g = 1.63, σ = 50, α = 200, f(t) = exp(6 sin t) the unknown mass loss. Domain: the
 // mass x3 stays > 0 (it reaches zero in finite time).
 struct LunarLanderParameters {
@@ -163,7 +164,7 @@ struct LunarLander : ModelSizes<3, 1, 1> {
 };
 
 // The lander with its unknown mass-loss term f immersed as a fourth state, so that a run has
-// f's true values (seed 002, eq. 52): f = exp(c sin t) gives f' = c cos t · f, f(0) = 1.
+// f's true values ([FFMG19], eq. 52): f = exp(c sin t) gives f' = c cos t · f, f(0) = 1.
 // c = 0 makes f constant: the design model of an observer that only knows f varies slowly.
 struct LunarLanderImmersed : ModelSizes<4, 1, 1> {
   LunarLanderParameters p{};
@@ -186,7 +187,7 @@ struct LunarLanderImmersed : ModelSizes<4, 1, 1> {
   }
 };
 
-// Example 3 of seed 002 without its x1 (x1' = u never reaches y = x2): x' = u + f, y = x,
+// Example 3 of [FFMG19] without its x1 (x1' = u never reaches y = x2): x' = u + f, y = x,
 // with the unknown f = A sin(ωt) immersed as a second state (f' = Aω cos ωt, f(0) = 0).
 // A = 0 makes f constant: the design model of an observer that does not know f's shape.
 struct UnknownInputIntegrator : ModelSizes<2, 1, 1> {
@@ -201,7 +202,7 @@ struct UnknownInputIntegrator : ModelSizes<2, 1, 1> {
   }
 };
 
-// Second-order LTI system with a nonlinear output injection (METHODS §4, the modulating-function
+// Second-order LTI system with a nonlinear output injection ([MF-LTV], the modulating-function
 // paper's first example; its parameters were lost, these are the issue's):
 //   x1' = x2,  x2' = −a0 x1 − a1 x2 + gain · sin(y),  y = x1.
 struct LtiInjectionParameters {
@@ -221,7 +222,7 @@ struct LtiOutputInjection : ModelSizes<2, 0, 1> {
 };
 
 // Pendulum with time-varying friction and an unknown bounded horizontal acceleration
-// (METHODS §4; the paper's table was lost, these values are ours): θ = x1, y = θ,
+// ([MF-LTV]; the paper's table was lost, these values are ours): θ = x1, y = θ,
 //   x1' = x2,  x2' = −(g/l) sin x1 − c(t) x2 − (a(t)/l) cos x1,
 //   c(t) = c0 + c1 sin(ωc t),  a(t) = a_max sin(ωa t).
 struct PendulumParameters {

@@ -1,5 +1,5 @@
 #pragma once
-// The classic observers the window estimators are compared with (METHODS §1), for any discrete
+// The classic observers the window estimators are compared with ([MGFF23]), for any discrete
 // model x⁺ = f(x, u, k), y = h(x). Each reports x̂_k from the samples up to k − 1 (Luenberger,
 // sliding mode: eq. 89 form, x̂_{k+1} = f(x̂_k) + correction(y_k)) or up to k (EKF: filtered).
 // Each is built as X(model, XOptions): the options hold the name, the initial estimate and the

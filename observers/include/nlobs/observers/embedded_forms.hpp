@@ -1,5 +1,5 @@
 #pragma once
-// The embeddings of METHODS §5, expanded by hand (checked symbolically, and in the tests
+// The embeddings of [HG-EMB23], expanded by hand (checked symbolically, and in the tests
 // against the maps ADOL-C computes from the models): q_N for the Duffing oscillator (N = 6),
 // the oscillator with output x1² + x1 (N = 4), Lorenz (N = 4) and Van der Pol (N = 5); the
 // explicit α(z) = d/dt z_N of the normal form z' = (z2, …, zN, α(z)) for the first two, and the
@@ -24,7 +24,7 @@ struct DuffingEmbedding {
     z[5] = -27.0 * a5 * a2 + 51.0 * a5 + 126.0 * a3 * b2 - 25.0 * a3 - 66.0 * a * b2 + a;
     return z;
   }
-  // α = −9 z5 − 126 z1² z3 − 6 z3 − 441 z1 z2² + 6 z1³ + 16 z1 (METHODS §5)
+  // α = −9 z5 − 126 z1² z3 − 6 z3 − 441 z1 z2² + 6 z1³ + 16 z1 ([HG-EMB23])
   template <typename T>
   T alpha(const Eigen::Matrix<T, 6, 1>& z) const {
     return -9.0 * z[4] - 126.0 * z[0] * z[0] * z[2] - 6.0 * z[2] - 441.0 * z[0] * z[1] * z[1] +
@@ -45,7 +45,7 @@ struct OscillatorEmbedding {
     z[3] = -(8.0 * a + 1.0) * b;
     return z;
   }
-  // α = (2/3) z4² + (16/3) z2 z4 − 7 z3 + (32/3) z2² − 6 z1 (METHODS §5)
+  // α = (2/3) z4² + (16/3) z2 z4 − 7 z3 + (32/3) z2² − 6 z1 ([HG-EMB23])
   template <typename T>
   T alpha(const Eigen::Matrix<T, 4, 1>& z) const {
     return (2.0 / 3.0) * z[3] * z[3] + (16.0 / 3.0) * z[1] * z[3] - 7.0 * z[2] +

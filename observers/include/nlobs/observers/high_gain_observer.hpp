@@ -1,9 +1,9 @@
 #pragma once
-// High-gain observer in embedded observability coordinates (METHODS §5, seed 004).
+// High-gain observer in embedded observability coordinates ([HG-EMB23]).
 //
 // For x' = f(x), y = h(x) and z = q_N(x) = [h, L_f h, …, L_f^{N−1} h], the system reads as the
 // integrator chain z_i' = z_{i+1}, z_N' = α(z). The observer runs that chain with output
-// injection (METHODS §5):
+// injection ([HG-EMB23]):
 //   ẑ_i' = ẑ_{i+1} + (l_{N−i} / θ^i)(y − ẑ_1),   ẑ_N' = ᾱ(ẑ) + (l_0 / θ^N)(y − ẑ_1),
 // s^N + l_{N−1}s^{N−1} + … + l_0 Hurwitz (roots p_j; the linear error dynamics then has the roots
 // p_j / θ), ᾱ = s_{ρ²}(‖ẑ‖²_P / R²) α the smooth saturation (smooth_saturation.hpp). The state
@@ -12,7 +12,7 @@
 // inverse when the user has one. The projection can jump where local minima merge or split: jumps
 // larger than a threshold are counted.
 //
-// α: an explicit α(z) (embedded_forms.hpp has METHODS' Duffing and oscillator), or — for models
+// α: an explicit α(z) (embedded_forms.hpp has [HG-EMB23]'s Duffing and oscillator), or — for models
 // whose α is rational or unknown (Lorenz, Van der Pol) — L_f^N h evaluated along the model's
 // prediction x̄ from the last projection (x̄' = f(x̄), reset to x̂ at each sample). That is an
 // approximation: it equals z_N' exactly once x̂ = x, and is only as good as the projection before.
@@ -126,7 +126,7 @@ class HighGainObserver final : public Observer {
  public:
   static constexpr int n = Model::kStates;
   static_assert(n != Eigen::Dynamic, "HighGainObserver needs a model with a compile-time size");
-  static_assert(Model::kOutputs == 1, "the high-gain observer of METHODS §5 has one output");
+  static_assert(Model::kOutputs == 1, "the high-gain observer of [HG-EMB23] has one output");
   using State = ModelVector<double, n>;
 
   struct Design {
@@ -169,7 +169,7 @@ class HighGainObserver final : public Observer {
   const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override;
 
  private:
-  // The observer's right-hand side at t for the state s = (ẑ, x̄) with y(t) given: METHODS §5.
+  // The observer's right-hand side at t for the state s = (ẑ, x̄) with y(t) given: [HG-EMB23].
   // False (derivatives zero) when α or f is not finite there.
   bool derivatives(double t, const double* s, double y, double* ds);
 

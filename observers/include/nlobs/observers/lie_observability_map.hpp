@@ -9,7 +9,7 @@
 //
 // The model's vector field and output must be generic in the scalar (templates on T) and free
 // of value-dependent branches (a tape records one path; a different branch at x is reported
-// as a failure). Inputs are held at zero and time at 0: the maps are for x' = f(x) (METHODS §5).
+// as a failure). Inputs are held at zero and time at 0: the maps are for x' = f(x) ([HG-EMB23]).
 // Not thread-safe: ADOL-C's tapes are process-wide state; one map per thread.
 #include <adolc/adolc.h>
 

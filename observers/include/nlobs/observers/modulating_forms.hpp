@@ -1,5 +1,5 @@
 #pragma once
-// What a ModulatingFunctionObserver needs from a system (METHODS §4): its input–output equation
+// What a ModulatingFunctionObserver needs from a system ([MF-LTV]): its input–output equation
 // in the right-PDO form of the observability companion form (OCF),
 //   y⁽ⁿ⁾ + Σ_{i<n} (a_i(t) y)⁽ⁱ⁾ = Σ_{i<n} (b_i(t)ᵀ v)⁽ⁱ⁾,   v = v(t, y, u) known,
 // whose canonical state η (η_{n−1} = y) obeys

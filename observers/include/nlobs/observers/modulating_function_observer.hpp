@@ -1,5 +1,5 @@
 #pragma once
-// Modulating-function algebraic observer (seed 003, METHODS §4; derivation in
+// Modulating-function algebraic observer ([MF-LTV]; derivation in
 // docs/observers.md). For a form (modulating_forms.hpp) with g_i = a_i y − b_iᵀ v (g_n = y),
 // integrating the input–output equation against the unitary kernel φ_j by parts leaves
 //   η_j(t) = (−1)^{j+1} Σ_{i=0}^{n} (−1)^i ∫_{t−T}^{t} φ_j⁽ⁱ⁾(τ − t + T) g_i(τ) dτ,

@@ -1,5 +1,5 @@
 #pragma once
-// Polynomial unitary modulating functions (METHODS §4, after Jouffroy and Reger; derivation in
+// Polynomial unitary modulating functions ([MF-LTV], after Jouffroy and Reger; derivation in
 // docs/observers.md). On the horizon s ∈ [0, T] (s = τ − (t − T)) the kernel φ_j of the
 // canonical state η_j meets
 //   φ_j⁽ᵏ⁾(0) = 0,     k = 0…r−1  (left modulating function of order r ≥ n)

@@ -1,5 +1,5 @@
 #pragma once
-// The β problem of the MVT observer (METHODS §2, seed 001). For a pair (x̂, ê) the mean value
+// The β problem of the MVT observer ([BMH]). For a pair (x̂, ê) the mean value
 // theorem gives, row by row,
 //     F_i(x̂ + ê) − F_i(x̂) = ∇F_i(x̂ + β_i ê) · ê   for some β_i ∈ [0, 1],
 // so the residual X_i(β_i) = F_i(x̂ + ê) − F_i(x̂) − ∇F_i(x̂ + β_i ê) · ê has a root in [0, 1]

@@ -1,5 +1,5 @@
 #pragma once
-// Mean-value-theorem observer (METHODS §2, seed 001) for x' = F(x, u, t), y = C x, C = [I_m 0]:
+// Mean-value-theorem observer ([BMH]) for x' = F(x, u, t), y = C x, C = [I_m 0]:
 //
 //     x̂' = F(x̂, u) + Ḡ e1,             e1 = [y − C x̂ ; ê_{m+1..n}]
 //     ê' = (D − Ḡ) ê  [+ K ν]            ν  = (y − C x̂) − C ê       (output-injection variant)
@@ -101,7 +101,7 @@ class MvtObserver final : public Observer {
   const Jacobian& mvt_jacobian() const { return d_; }
   MvtBetaSolver<Model>& beta_solver() { return *beta_solver_; }
 
-  // The right-hand side (METHODS §2) at t for the state (x̂, ê), with y and u given: solves β
+  // The right-hand side ([BMH]) at t for the state (x̂, ê), with y and u given: solves β
   // (warm-started from the last β; β, Ḡ and D are updated) and returns false, with zero
   // derivatives, when y, u, F or ∂F is not finite — the first such reason since the last
   // step() is last_failure(). For continuous-time use without samples (an ODE solver of the

@@ -1,5 +1,5 @@
 #pragma once
-// Observability maps q_N(x) = [h, L_f h, …, L_f^{N−1} h] (METHODS §5): the embedding a high-gain
+// Observability maps q_N(x) = [h, L_f h, …, L_f^{N−1} h] ([HG-EMB23]): the embedding a high-gain
 // observer works in. One interface, two sources:
 //   LieObservabilityMap        from the model's f and h by Taylor-mode AD (ADOL-C), any model;
 //   ExplicitObservabilityMap   a map the user writes by hand, generic in its scalar (its

@@ -1,5 +1,5 @@
 #pragma once
-// The moving-horizon output window of METHODS §1: the last N samples of y (and u) in a ring
+// The moving-horizon output window of [MGFF23]: the last N samples of y (and u) in a ring
 // buffer, and the window map
 //   H(w) = [h(w), h(f(w, u_{k0}, k0)), …, h(f^{N−1}(w))] ∈ R^{N·p},  k0 = k − N + 1,
 // with the residual Y − H(w). N = n/p is the paper's square window; N > n/p overdetermines it.

@@ -1,5 +1,5 @@
 #pragma once
-// Banks of PI observers (seed 002, Remark 2 and eqs. 59–64): PI channels, algebraic signals
+// Banks of PI observers ([FFMG19], Remark 2 and eqs. 59–64): PI channels, algebraic signals
 // and integrators that read each other's outputs, composed once and run as one ODE.
 //
 //   PiBank bank(/*outputs=*/1, /*inputs=*/1);

@@ -1,5 +1,5 @@
 #pragma once
-// Gain guidance for the PI observer (METHODS §3, seed 002 eqs. 7–16): how large the estimation
+// Gain guidance for the PI observer ([FFMG19] eqs. 7–16): how large the estimation
 // error stays, ultimately, for gains (k_p, k_i) when |Ω| = |η̇| ≤ N (hypothesis H2).
 //
 // The error E = (e1, e2), e1 = η − η̂, e2' = e1, obeys eq. (7): E' = −K E + (Ω, 0)ᵀ with

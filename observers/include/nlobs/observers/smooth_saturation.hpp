@@ -1,13 +1,13 @@
 #pragma once
-// The smooth saturation of METHODS §5 that makes α globally Lipschitz:
+// The smooth saturation of [HG-EMB23] that makes α globally Lipschitz:
 //   ᾱ(z) = s_{ρ²}(‖z‖²_P / R²) α(z),   ‖z‖²_P = zᵀ P z,
 //   s_b(x) = 1 for x ≤ 1, 0 for x ≥ b, e^{1/(x−b)} / (e^{1/(x−b)} + e^{1/(1−x)}) between
 // (C^∞). ᾱ = α on ‖z‖_P ≤ R and 0 beyond ‖z‖_P = ρR: the transition runs between R and ρR, as
-// the paper states ("between 1 ≤ ‖z‖ ≤ 2, i.e. R = 1 and ρ = 2"); METHODS writes s_ρ, whose
-// transition would end at √ρ R — we follow the paper's words, see docs/observers.md.
-// And the paper's §6 recipe for P: a box |x_i| ≤ X_i around the invariant set maps into a box
-// |z_j| ≤ Z_j (here by interval arithmetic through the map — a rigorous enclosure, like the
-// paper's sum of |terms|), and ‖z‖²_P = Σ z_j² / (N Z_j²) ≤ 1 on it.
+// the paper states ("between 1 ≤ ‖z‖ ≤ 2, i.e. R = 1 and ρ = 2"); our working notes wrote s_ρ,
+// whose transition would end at √ρ R — we follow the paper's words, see docs/observers.md. And the
+// recipe of [HG-EMB23] §6 for P: a box |x_i| ≤ X_i around the invariant set maps into a box |z_j| ≤
+// Z_j (here by interval arithmetic through the map — a rigorous enclosure, like the paper's sum of
+// |terms|), and ‖z‖²_P = Σ z_j² / (N Z_j²) ≤ 1 on it.
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <boost/numeric/interval.hpp>

@@ -17,7 +17,7 @@
 // N = 8: 3.3× for the Jacobian). But N is a compile-time parameter:
 // make_taylor_observability_map dispatches a run-time N up to kMaxTaylorObservabilityOrder;
 // past it, ADOL-C.
-// Inputs are held at zero and time at 0: the maps are for x' = f(x) (METHODS §5).
+// Inputs are held at zero and time at 0: the maps are for x' = f(x) ([HG-EMB23]).
 #include <Eigen/Core>
 #include <array>
 #include <boost/math/differentiation/autodiff.hpp>

@@ -1,5 +1,5 @@
 #pragma once
-// Window estimator = any engine × any output window (METHODS §1). Once the window of N samples
+// Window estimator = any engine × any output window ([MGFF23]). Once the window of N samples
 // is full, at each k it solves for w = x̂[k−N+1] and outputs x̂[k] = f^{N−1}(w*):
 //   square window (N·p = n): G(w) = w + Ψ (Y − H(w)) with any engine (Picard, Aitken,
 //     Steffensen, Anderson, Newton, Ceres, NLopt); Ψ = I is the paper's form, Ψ = (∂H/∂w)⁻¹

@@ -1,5 +1,5 @@
 #pragma once
-// The problems a window poses (METHODS §1), built once and re-evaluated on whatever the window
+// The problems a window poses ([MGFF23]), built once and re-evaluated on whatever the window
 // holds at the time (the window must outlive them):
 //   square_window_problem:  G(w) = w + Ψ (Y − H(w))     (N·p = n; Ψ = I, the paper's form, when
 //                           no gain is given; any invertible Ψ has the same fixed points)

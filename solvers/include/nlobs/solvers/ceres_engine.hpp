@@ -353,7 +353,7 @@ template <int N>
 Summary CeresEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
   detail::check_initial_guess(name(), problem, x);
   Summary s = run<N>(detail::ResidualSource<N, N>(problem), x);
-  if (const auto& l = this->options_.stop.lipschitz_constant) {  // F = G − x: METHODS §1
+  if (const auto& l = this->options_.stop.lipschitz_constant) {  // F = G − x: [MGFF23]
     s.lipschitz_constant = l;
     s.error_bound = s.residual_norm / (1.0 - *l);
   }

@@ -1,5 +1,5 @@
 #pragma once
-// Contraction check on a box D = [lower, upper] (METHODS §1, the paper's Theorem 1). Samples D
+// Contraction check on a box D = [lower, upper] ([MGFF23], the paper's Theorem 1). Samples D
 // (its corners, its centre and seeded uniform points), evaluates ∂G there and reports
 //   - the largest ‖∂G‖∞ (max row sum): < 1 on a convex D makes G a contraction in the max norm
 //     (the rigorous condition), and

@@ -1,5 +1,5 @@
 #pragma once
-// The two problem forms of METHODS §1:
+// The two problem forms of [MGFF23]:
 //   fixed point  G: Rⁿ → Rⁿ,  find p = G(p)        (FixedPointProblem)
 //   root         F: Rⁿ → Rᵐ,  find F(x) = 0         (RootProblem)
 // Engines solve a FixedPointProblem; a square RootProblem becomes one through

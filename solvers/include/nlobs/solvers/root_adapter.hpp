@@ -1,5 +1,5 @@
 #pragma once
-// Root → fixed point (METHODS §1): G(x) = x + Ψ F(x), ∂G = I + Ψ ∂F.
+// Root → fixed point ([MGFF23]): G(x) = x + Ψ F(x), ∂G = I + Ψ ∂F.
 // Ψ = I is the paper's choice for the square window; a scalar ψ damps (ψ < 0 flips the sign
 // when ∂F ≈ +I); a matrix Ψ ≈ −(∂F)⁻¹ turns Picard into a chord/Newton-like iteration.
 #include <cmath>

@@ -1,5 +1,5 @@
 #pragma once
-// Stop criteria of METHODS §1 (paper §3.3), selectable and combinable. All norms are max norms.
+// Stop criteria of [MGFF23] (paper §3.3), selectable and combinable. All norms are max norms.
 #include <optional>
 
 namespace nlobs {

@@ -35,7 +35,7 @@ struct Summary {
   // steps contract, contraction_estimate (then lipschitz_is_estimate = true).
   std::optional<double> lipschitz_constant;
   bool lipschitz_is_estimate = false;
-  // ‖x − p‖∞ ≤ residual_norm / (1 − L) (METHODS §1): rigorous when L is a valid Lipschitz
+  // ‖x − p‖∞ ≤ residual_norm / (1 − L) ([MGFF23]): rigorous when L is a valid Lipschitz
   // constant of G on a convex set holding x and the fixed point p; an estimate otherwise.
   std::optional<double> error_bound;
   // A priori iteration count ⌈m / log10(1/L)⌉ (eq. 64), m = −log10 of the error (else step)

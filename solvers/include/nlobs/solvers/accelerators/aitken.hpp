@@ -1,5 +1,5 @@
 #pragma once
-// Aitken engine (paper §3.1): the Picard sequence x_{l+1} = G(x_l) runs unchanged; the
+// Aitken engine ([MGFF23] §3.1): the Picard sequence x_{l+1} = G(x_l) runs unchanged; the
 // engine's own sequence is its Δ² transform z_l = Aitken(x_l, x_{l+1}, x_{l+2}), which the stop
 // criteria watch and the engine returns. One G evaluation per iteration after the first.
 #include <string_view>

@@ -1,5 +1,5 @@
 #pragma once
-// Component-wise Aitken Δ² transform (METHODS §1):
+// Component-wise Aitken Δ² transform ([MGFF23]):
 //   z = x_l − (x_{l+1} − x_l)² / (x_{l+2} − 2x_{l+1} + x_l),
 // evaluated in the equivalent form anchored at the newest point,
 //   z = x_{l+2} − (x_{l+2} − x_{l+1})² / (x_{l+2} − 2x_{l+1} + x_l),

@@ -1,5 +1,5 @@
 #pragma once
-// No acceleration: the next point is G(x) (Picard, METHODS §1: w ← G(w)).
+// No acceleration: the next point is G(x) (Picard, [MGFF23]: w ← G(w)).
 #include <string_view>
 
 #include "nlobs/solvers/types.hpp"

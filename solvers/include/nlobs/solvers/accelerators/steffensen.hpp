@@ -1,5 +1,5 @@
 #pragma once
-// Steffensen (paper §3.2, eqs. 58–59): from p compute p1 = G(p), p2 = G(p1), restart from the
+// Steffensen ([MGFF23] §3.2, eqs. 58–59): from p compute p1 = G(p), p2 = G(p1), restart from the
 // Aitken value of (p, p1, p2). One iteration = one restart = two G evaluations.
 #include <string_view>
 
