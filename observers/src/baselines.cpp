@@ -25,10 +25,10 @@ void require_finite(const char* who, const char* field, const Eigen::MatrixXd& m
 // positive semi-definite.
 void require_covariance(const char* field, const Eigen::MatrixXd& m) {
   if (m.size() == 0) return;
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(m);
-  if (m.rows() == m.cols() && m.allFinite() && m.isApprox(m.transpose()) &&
-      ldlt.info() == Eigen::Success && ldlt.isPositive()) {
-    return;
+  // Square and finite first: the factorisation asserts (or reads out of bounds) otherwise.
+  if (m.rows() == m.cols() && m.allFinite() && m.isApprox(m.transpose())) {
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(m);
+    if (ldlt.info() == Eigen::Success && ldlt.isPositive()) return;
   }
   std::ostringstream os;
   os << "EkfOptions::" << field << " (" << m.rows() << "x" << m.cols()
