@@ -65,7 +65,7 @@ const char* kChuaFp = R"({
   }
 })";
 
-// [FFMG19], example 3 ([FFMG19]): f = 3 sin(πt) immersed as state x2, u = 2 sin(πt),
+// [FFMG19], example 3: f = 3 sin(πt) immersed as state x2, u = 2 sin(πt),
 // gains (8, 15), γ(0) = 0. N = max|f'| = 3π. 10 s at the model's step 1 ms; after t = 2 s.
 // The EKF's own model assumes f constant (amplitude 0): it must track f through Q.
 const char* kPiLinear = R"({
@@ -126,7 +126,7 @@ const char* kPiLander = R"({
   ]
 })";
 
-// [BMH], example 1 ([BMH]): the chaotic system without linear term, y = (x1, x2),
+// [BMH], example 1: the chaotic system without linear term, y = (x1, x2),
 // x0 = (−2, −1, −1), x̂0 = (−1, −0.5, −1.5), η = 1, 30 s at 1 ms (plant RK4, observer RK4 at the
 // sample step, y between samples by the cubic through the last four samples). Case 1:
 // ê0 = x0 − x̂0; case 2: ê0's third entry 0.2 instead of 0.5. The published structure and our

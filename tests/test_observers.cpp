@@ -147,7 +147,8 @@ TEST(WindowEstimator, PropagatedWarmStartNeedsFewerIterations) {
 }
 
 TEST(WindowEstimator, LongWindowAttenuatesNoiseInX3) {
-  // [MGFF23]: with N = n = 3 noise is amplified ~37× in x3; least squares on N = 6 cures it.
+  // With N = n = 3 noise is amplified ~37× in x3 (our working notes on [MGFF23]); least
+  // squares on N = 6 (ours) cures it.
   const Measurements data = chua_data(400, 0.01);
   std::vector<std::unique_ptr<Observer>> observers;
   observers.push_back(window_estimator("newton", 1e-10));

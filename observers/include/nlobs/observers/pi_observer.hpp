@@ -1,5 +1,5 @@
 #pragma once
-// The model-free PI reduced-order observer of [FFMG19] () for one auxiliary quantity
+// The model-free PI reduced-order observer of [FFMG19] for one auxiliary quantity
 //   η = a ṡ + b(u, y),   a constant, s a signal we have (an output, or an earlier estimate).
 //
 // The observer of eq. (3),  η̂' = k_p (η − η̂) + η̂₁,  η̂₁' = k_i (η − η̂),  needs ṡ. Lemma 1

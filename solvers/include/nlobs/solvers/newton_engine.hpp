@@ -1,6 +1,6 @@
 #pragma once
 // Newton's method on F(x) = G(x) − x (for a root problem adapted with Ψ = I this is F itself;
-// on the window problem it is the Moraal–Grizzle observer, [MGFF23]:
+// on the window problem it is the Moraal–Grizzle observer, [MG95]:
 // w ← w + (∂H/∂w)⁻¹ (Y − H(w))). The Jacobian J = ∂G − I comes from the problem (user-supplied
 // or AD) or from finite differences. Optional backtracking line search on ½‖F‖₂² (Armijo).
 // The residual at the returned point is always known: no extra evaluation.

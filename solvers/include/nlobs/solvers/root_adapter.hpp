@@ -1,6 +1,6 @@
 #pragma once
-// Root → fixed point ([MGFF23]): G(x) = x + Ψ F(x), ∂G = I + Ψ ∂F.
-// Ψ = I is the paper's choice for the square window; a scalar ψ damps (ψ < 0 flips the sign
+// Root → fixed point: G(x) = x + Ψ F(x), ∂G = I + Ψ ∂F.
+// Ψ = I is [MGFF23]'s choice for the square window; a scalar ψ damps (ψ < 0 flips the sign
 // when ∂F ≈ +I); a matrix Ψ ≈ −(∂F)⁻¹ turns Picard into a chord/Newton-like iteration.
 #include <cmath>
 #include <sstream>
