@@ -28,6 +28,13 @@ inline void require_shape(const char* who, const char* what, const Eigen::Matrix
   }
 }
 
+// The options after their validate(): for a constructor's initialiser list.
+template <typename Options>
+Options validated(Options options) {
+  options.validate();
+  return options;
+}
+
 }  // namespace detail
 
 struct LuenbergerOptions {
@@ -55,24 +62,22 @@ template <DiscreteModel Model>
 class LuenbergerObserver final : public Observer {
  public:
   LuenbergerObserver(Model model, LuenbergerOptions options)
-      : model_(std::move(model)),
-        name_(std::move(options.name)),
-        gain_(std::move(options.gain)),
-        initial_(std::move(options.initial_estimate)) {
-    LuenbergerOptions{name_, initial_, gain_}.validate();
-    detail::require_shape("LuenbergerOptions", "gain L", gain_, model_.states(), model_.outputs());
-    detail::require_shape("LuenbergerOptions", "initial_estimate", initial_, model_.states(), 1);
+      : model_(std::move(model)), options_(detail::validated(std::move(options))) {
+    detail::require_shape("LuenbergerOptions", "gain L", options_.gain, model_.states(),
+                          model_.outputs());
+    detail::require_shape("LuenbergerOptions", "initial_estimate", options_.initial_estimate,
+                          model_.states(), 1);
     reset();
   }
-  std::string name() const override { return name_; }
-  void reset() override { x_ = initial_; }
+  std::string name() const override { return options_.name; }
+  void reset() override { x_ = options_.initial_estimate; }
   const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
     step_.estimate = x_;
     step_.failure.clear();
     step_.failure_message.clear();
     step_.measurement_missing = !y.allFinite();
     Eigen::VectorXd next = f(x_, u, k);
-    if (!step_.measurement_missing) next += gain_ * (y - h(x_));
+    if (!step_.measurement_missing) next += options_.gain * (y - h(x_));
     accept_finite(next, x_, step_, name(), k);  // an unstable gain L overflows: say so
     return step_;
   }
@@ -86,9 +91,8 @@ class LuenbergerObserver final : public Observer {
     return model_.h(ModelVector<double, Model::kStates>(x));
   }
   Model model_;
-  std::string name_;
-  Eigen::MatrixXd gain_;
-  Eigen::VectorXd initial_, x_;
+  LuenbergerOptions options_;
+  Eigen::VectorXd x_;
   ObserverStep step_;
 };
 
@@ -98,20 +102,16 @@ template <DiscreteModel Model>
 class SlidingModeObserver final : public Observer {
  public:
   SlidingModeObserver(Model model, SlidingModeOptions options)
-      : model_(std::move(model)),
-        name_(std::move(options.name)),
-        q_(std::move(options.q)),
-        r_(std::move(options.r)),
-        gamma_(options.gamma),
-        initial_(std::move(options.initial_estimate)) {
-    SlidingModeOptions{name_, initial_, q_, r_, gamma_}.validate();
-    detail::require_shape("SlidingModeOptions", "q", q_, model_.states(), model_.outputs());
-    detail::require_shape("SlidingModeOptions", "r", r_, model_.states(), model_.outputs());
-    detail::require_shape("SlidingModeOptions", "initial_estimate", initial_, model_.states(), 1);
+      : model_(std::move(model)), options_(detail::validated(std::move(options))) {
+    const Eigen::Index n = model_.states(), p = model_.outputs();
+    detail::require_shape("SlidingModeOptions", "q", options_.q, n, p);
+    detail::require_shape("SlidingModeOptions", "r", options_.r, n, p);
+    detail::require_shape("SlidingModeOptions", "initial_estimate", options_.initial_estimate, n,
+                          1);
     reset();
   }
-  std::string name() const override { return name_; }
-  void reset() override { x_ = initial_; }
+  std::string name() const override { return options_.name; }
+  void reset() override { x_ = options_.initial_estimate; }
   const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
     step_.estimate = x_;
     step_.failure.clear();
@@ -122,7 +122,7 @@ class SlidingModeObserver final : public Observer {
     if (!step_.measurement_missing) {
       const Eigen::VectorXd e =
           y - Eigen::VectorXd(model_.h(ModelVector<double, Model::kStates>(x_)));
-      next += q_ * e + r_ * (e / gamma_).cwiseMax(-1.0).cwiseMin(1.0);
+      next += options_.q * e + options_.r * (e / options_.gamma).cwiseMax(-1.0).cwiseMin(1.0);
     }
     accept_finite(next, x_, step_, name(), k);
     return step_;
@@ -130,10 +130,8 @@ class SlidingModeObserver final : public Observer {
 
  private:
   Model model_;
-  std::string name_;
-  Eigen::MatrixXd q_, r_;
-  double gamma_;
-  Eigen::VectorXd initial_, x_;
+  SlidingModeOptions options_;
+  Eigen::VectorXd x_;
   ObserverStep step_;
 };
 
