@@ -61,7 +61,7 @@ void BM_HighGainStepOscillator(benchmark::State& state) {
       record(OscillatorNonlinearOutput{}, Eigen::Vector2d(-0.5, 0.0), 0.01, 20.0);
   const bool inverse = state.range(0) == 1;
   run<OscillatorNonlinearOutput>(state, data, [inverse] {
-    HighGainObserver<OscillatorNonlinearOutput>::Design d;
+    HighGainDesign d;
     d.map = std::make_shared<ExplicitObservabilityMap<OscillatorEmbedding>>();
     d.alpha = explicit_alpha<OscillatorEmbedding>();
     if (inverse) d.inverse = explicit_inverse<OscillatorEmbedding>();
@@ -69,8 +69,10 @@ void BM_HighGainStepOscillator(benchmark::State& state) {
     o.sample_time = 0.01;
     o.theta = 0.3;
     o.saturation = oscillator_saturation();
+    o.design = std::move(d);
+    o.initial_estimate = Eigen::Vector2d(-0.3, 0.0);
     return std::make_unique<HighGainObserver<OscillatorNonlinearOutput>>(
-        OscillatorNonlinearOutput{}, d, Eigen::Vector2d(-0.3, 0.0), o);
+        OscillatorNonlinearOutput{}, std::move(o));
   });
   state.SetLabel(inverse ? "explicit inverse" : "ceres projection, hand map");
 }
@@ -81,7 +83,7 @@ void BM_HighGainStepDuffing(benchmark::State& state) {
   static const Measurements data = record(Duffing{}, Eigen::Vector2d(1.2, 0.0), 1e-3, 12.0);
   const long which = state.range(0);
   run<Duffing>(state, data, [which] {
-    HighGainObserver<Duffing>::Design d;
+    HighGainDesign d;
     if (which == 1) {
       d.map = std::make_shared<LieObservabilityMap>(Duffing{}, 6);
     } else if (which == 2) {
@@ -96,7 +98,9 @@ void BM_HighGainStepDuffing(benchmark::State& state) {
     Eigen::VectorXd P(6);
     P << 0.8, 0.145, 0.103, 0.0158, 4.07e-3, 5.26e-4;
     o.saturation = SmoothSaturation{P.asDiagonal(), 1.0, 2.0};
-    return std::make_unique<HighGainObserver<Duffing>>(Duffing{}, d, Eigen::Vector2d::Zero(), o);
+    o.design = std::move(d);
+    o.initial_estimate = Eigen::Vector2d::Zero();
+    return std::make_unique<HighGainObserver<Duffing>>(Duffing{}, std::move(o));
   });
   state.SetLabel(which == 1   ? "ceres projection, ADOL-C map"
                  : which == 2 ? "ceres projection, Taylor map"
@@ -114,7 +118,7 @@ void BM_HighGainStepLorenzLieAlpha(benchmark::State& state) {
   static const Measurements data = record(Lorenz{}, Eigen::Vector3d(1.0, 1.0, 20.0), 1e-3, 5.0);
   const bool taylor = state.range(0) == 2;
   run<Lorenz>(state, data, [taylor] {
-    HighGainObserver<Lorenz>::Design d;
+    HighGainDesign d;
     if (taylor) {
       d.map = std::make_shared<TaylorObservabilityMap<Lorenz, 4>>();
     } else {
@@ -123,7 +127,9 @@ void BM_HighGainStepLorenzLieAlpha(benchmark::State& state) {
     HighGainOptions o;
     o.sample_time = 1e-3;
     o.theta = 0.02;
-    return std::make_unique<HighGainObserver<Lorenz>>(Lorenz{}, d, Eigen::Vector3d(2, 3, 25), o);
+    o.design = std::move(d);
+    o.initial_estimate = Eigen::Vector3d(2, 3, 25);
+    return std::make_unique<HighGainObserver<Lorenz>>(Lorenz{}, std::move(o));
   });
   state.SetLabel(taylor ? "alpha = L_f^4 h by Taylor mode, ceres projection"
                         : "alpha = L_f^4 h by ADOL-C, ceres projection");
@@ -140,7 +146,7 @@ void BM_HighGainIntegrator(benchmark::State& state) {
   const bool cvode = state.range(0) == 1;
   const double theta = static_cast<double>(state.range(1)) / 1000.0;
   run<OscillatorNonlinearOutput>(state, data, [cvode, theta] {
-    HighGainObserver<OscillatorNonlinearOutput>::Design d;
+    HighGainDesign d;
     d.map = std::make_shared<ExplicitObservabilityMap<OscillatorEmbedding>>();
     d.alpha = explicit_alpha<OscillatorEmbedding>();
     d.inverse = explicit_inverse<OscillatorEmbedding>();
@@ -149,8 +155,10 @@ void BM_HighGainIntegrator(benchmark::State& state) {
     o.theta = theta;
     o.saturation = oscillator_saturation();
     o.integrator = cvode ? HighGainIntegrator::kCvode : HighGainIntegrator::kRk4;
+    o.design = std::move(d);
+    o.initial_estimate = Eigen::Vector2d(-0.3, 0.0);
     return std::make_unique<HighGainObserver<OscillatorNonlinearOutput>>(
-        OscillatorNonlinearOutput{}, d, Eigen::Vector2d(-0.3, 0.0), o);
+        OscillatorNonlinearOutput{}, std::move(o));
   });
   state.SetLabel(std::string(cvode ? "cvode" : "rk4") +
                  ", h*|p|/theta = " + std::to_string(0.01 / theta));

@@ -28,14 +28,14 @@ const Measurements& lti_data() {
 void BM_ModulatingStep(benchmark::State& state) {
   const Measurements& data = lti_data();
   ModulatingOptions o;
+  o.initial_estimate = Eigen::Vector2d::Zero();
   o.sample_time = 0.01;
   o.horizon = 0.01 * static_cast<double>(state.range(0));
   o.sample_period = state.range(1) ? 0.1 : 0.0;
   double error = 0.0;
   for (auto _ : state) {
     state.PauseTiming();
-    ModulatingFunctionObserver<LtiInjectionForm> observer(LtiInjectionForm{},
-                                                          Eigen::Vector2d::Zero(), o);
+    ModulatingFunctionObserver<LtiInjectionForm> observer(LtiInjectionForm{}, o);
     state.ResumeTiming();
     for (Eigen::Index k = 0; k < data.steps(); ++k) {
       observer.step(k, data.y.col(k), data.u.col(k));

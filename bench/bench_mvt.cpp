@@ -60,7 +60,9 @@ void step(benchmark::State& state, const Example<Model>& example, MvtBetaMethod 
   o.sample_time = kStep;
   o.beta.method = method;
   o.beta.polish_rows = polish;
-  nlobs::MvtObserver<Model> observer(Model{}, example.xhat0, example.ehat0, o);
+  o.initial_estimate = example.xhat0;
+  o.initial_error_estimate = example.ehat0;
+  nlobs::MvtObserver<Model> observer(Model{}, o);
   // Columns as vectors once, outside the timed loop.
   std::vector<Eigen::VectorXd> ys, us;
   for (long k = 0; k < kSamples; ++k) {

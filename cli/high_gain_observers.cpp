@@ -90,7 +90,7 @@ std::unique_ptr<Observer> build(Model model, const HighGainSpec& spec, const Eig
       }
     }
   };
-  typename HighGainObserver<Model>::Design design;
+  HighGainDesign design;
   if (start.size() != Model::kStates) {
     refuse("'initial' must have " + std::to_string(Model::kStates) + " entries");
   }
@@ -150,7 +150,6 @@ std::unique_ptr<Observer> build(Model model, const HighGainSpec& spec, const Eig
     }
     o.saturation = s;
   }
-  o.projection = spec.projection;
   o.start = spec.start == "predicted" ? ProjectionStart::kPredicted : ProjectionStart::kPrevious;
   o.integrator = spec.integrator == "rk4"     ? HighGainIntegrator::kRk4
                  : spec.integrator == "cvode" ? HighGainIntegrator::kCvode
@@ -161,17 +160,27 @@ std::unique_ptr<Observer> build(Model model, const HighGainSpec& spec, const Eig
   o.residual_scale = spec.residual_scale;
   o.restart_residual = spec.restart_residual;
   o.restart_every = spec.restart_every;
-  std::optional<Eigen::VectorXd> z0 = spec.initial_z;
+  o.name = spec.name;
+  o.initial_estimate = start;
+  o.initial_embedded_estimate = spec.initial_z;
   if (spec.initial_z_from) {
     if (spec.initial_z_from->size() != Model::kStates) {
       refuse("'initial_z_from' must have " + std::to_string(Model::kStates) + " entries");
     }
     Eigen::VectorXd z(N);
     if (!design.map->value(*spec.initial_z_from, z)) refuse("q_N('initial_z_from') is not finite");
-    z0 = z;
+    o.initial_embedded_estimate = z;
   }
-  return std::make_unique<HighGainObserver<Model>>(std::move(model), std::move(design), start, o,
-                                                   z0, spec.name);
+  // The engine spec belongs to the scenario: built here through the registry, with the
+  // projection's tolerances. An explicit inverse needs none.
+  std::unique_ptr<Engine<Model::kStates>> projection;
+  if (!design.inverse) {
+    projection = EngineRegistry<Model::kStates>::global().create(spec.projection,
+                                                                 high_gain_projection_options());
+  }
+  o.design = std::move(design);
+  return std::make_unique<HighGainObserver<Model>>(std::move(model), std::move(o),
+                                                   std::move(projection));
 }
 
 }  // namespace

@@ -13,6 +13,7 @@ std::unique_ptr<Observer> build(Form form, const ModulatingSpec& spec, const Eig
                                 double sample_time) {
   ModulatingOptions o;
   o.name = spec.name;
+  o.initial_estimate = start;
   o.sample_time = sample_time;
   o.horizon = spec.horizon;
   o.quadrature = spec.quadrature == "trapezoid" ? Quadrature::kTrapezoid : Quadrature::kSimpson;
@@ -37,7 +38,7 @@ std::unique_ptr<Observer> build(Form form, const ModulatingSpec& spec, const Eig
       throw InvalidInput("'disturbance_bound': this model has no unknown disturbance");
     }
   }
-  return std::make_unique<ModulatingFunctionObserver<Form>>(std::move(form), start, o);
+  return std::make_unique<ModulatingFunctionObserver<Form>>(std::move(form), std::move(o));
 }
 
 }  // namespace

@@ -46,6 +46,9 @@ std::unique_ptr<Observer> make_mvt_observer(const MvtSpec& spec, const nlohmann:
                                             const Eigen::VectorXd& start, double sample_time,
                                             const std::string& where) {
   MvtOptions options;
+  options.name = spec.name;
+  options.initial_estimate = start;
+  options.initial_error_estimate = spec.error_guess;
   options.sample_time = sample_time;
   options.eta = spec.eta;
   options.variant =
@@ -57,8 +60,7 @@ std::unique_ptr<Observer> make_mvt_observer(const MvtSpec& spec, const nlohmann:
   JsonReader reader(model, where + ".model");
   return visit_model(reader, [&](auto m, double, Scheme) -> std::unique_ptr<Observer> {
     using Model = decltype(m);
-    return std::make_unique<MvtObserver<Model>>(std::move(m), start, spec.error_guess, options,
-                                                spec.name);
+    return std::make_unique<MvtObserver<Model>>(std::move(m), options);
   });
 }
 

@@ -126,8 +126,11 @@ std::unique_ptr<PiBankObserver> make_pi_bank(const PiBankSpec& spec, const AnyMo
                  x3, -1.0, [=](const Values& v) { return -sigma * v[u]; }, spec.gains[1], start));
     estimate = {y, x2.eta, x3, f.eta};
   }
-  return std::make_unique<PiBankObserver>("pi:" + spec.bank, std::move(bank), std::move(estimate),
-                                          PiBankOptions{model.sample_time(), spec.substeps});
+  return std::make_unique<PiBankObserver>(std::move(bank),
+                                          PiBankOptions{.name = "pi:" + spec.bank,
+                                                        .estimate = std::move(estimate),
+                                                        .sample_time = model.sample_time(),
+                                                        .substeps = spec.substeps});
 }
 
 }  // namespace nlobs::cli

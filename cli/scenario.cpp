@@ -639,8 +639,8 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& s, const A
               "finite_difference needs a model with one output (its "
               "state the output's phase variables y, y', ...)");
         }
-        out.push_back(std::make_unique<FiniteDifferenceObserver>(model.states(),
-                                                                 model.sample_time(), o.label));
+        out.push_back(std::make_unique<FiniteDifferenceObserver>(FiniteDifferenceOptions{
+            .name = o.label, .states = model.states(), .sample_time = model.sample_time()}));
       } else if (o.type == "window") {
         SolverOptions options;
         if (o.tol) {

@@ -16,19 +16,20 @@ int main() {
   const Measurements data = simulate(Discretized<Duffing>({}, h, Scheme::kRk4),
                                      Eigen::Vector2d(1.2, 0.0), {.steps = 12001, .sample_time = h});
 
-  HighGainObserver<Duffing>::Design design;
+  HighGainOptions options;
+  options.initial_estimate = Eigen::Vector2d::Zero();
   // z = q6(x) expanded by hand; std::make_shared<TaylorObservabilityMap<Duffing, 6>>() computes
   // the same map from the model by Taylor-mode AD (any model, ~10× slower per step; ADOL-C's
   // LieObservabilityMap ~100×).
-  design.map = std::make_shared<ExplicitObservabilityMap<DuffingEmbedding>>();
-  design.alpha = explicit_alpha<DuffingEmbedding>();  // z6' = α(z)
-  HighGainOptions options;
+  options.design.map = std::make_shared<ExplicitObservabilityMap<DuffingEmbedding>>();
+  options.design.alpha = explicit_alpha<DuffingEmbedding>();  // z6' = α(z)
   options.sample_time = h;
   options.theta = 0.1;  // poles of the error dynamics at −1/θ
   Eigen::VectorXd p(6);
   p << 0.8, 0.145, 0.103, 0.0158, 4.07e-3, 5.26e-4;  // the paper's P, R = 1, ρ = 2
   options.saturation = SmoothSaturation{p.asDiagonal(), 1.0, 2.0};
-  HighGainObserver<Duffing> observer({}, design, Eigen::Vector2d::Zero(), options);
+  // x̂ = argmin ‖ẑ − q6(x)‖ by Ceres (the default; any least-squares engine can be passed).
+  HighGainObserver<Duffing> observer({}, options);
 
   double z_error = 0.0, x_error = 0.0;
   for (Eigen::Index k = 0; k < data.steps(); ++k) {

@@ -18,10 +18,11 @@ int main() {
                                      {.steps = 1001, .noise_std = 0.01, .sample_time = h});
 
   ModulatingOptions o;
+  o.initial_estimate = Eigen::Vector2d::Zero();
   o.sample_time = h;
   o.horizon = 1.0;  // T = 100 samples: the first estimate at t = 1 s
-  ModulatingFunctionObserver<LtiInjectionForm> mf(LtiInjectionForm{}, Eigen::Vector2d::Zero(), o);
-  FiniteDifferenceObserver differences(2, h);
+  ModulatingFunctionObserver<LtiInjectionForm> mf(LtiInjectionForm{}, o);
+  FiniteDifferenceObserver differences({.states = 2, .sample_time = h});
 
   double mf_sum = 0.0, fd_sum = 0.0;
   double counted = 0.0;

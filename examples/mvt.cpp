@@ -29,13 +29,14 @@ int main() {
   const Eigen::Vector3d guess(0.0, 0.0, 2.0);  // x3 is the state to find
   nlobs::MvtOptions mvt;
   mvt.sample_time = kSampleTime;
+  mvt.initial_estimate = guess;
+  mvt.initial_error_estimate = Eigen::Vector3d(0.1, 0.1, 0.1);
   std::vector<std::unique_ptr<nlobs::Observer>> observers;
   for (nlobs::MvtVariant variant :
        {nlobs::MvtVariant::kPublished, nlobs::MvtVariant::kOutputInjection}) {
     mvt.variant = variant;
-    const char* name = variant == nlobs::MvtVariant::kPublished ? "mvt published" : "mvt injection";
-    observers.push_back(std::make_unique<nlobs::MvtObserver<Rossler>>(
-        Rossler{}, guess, Eigen::Vector3d(0.1, 0.1, 0.1), mvt, name));
+    mvt.name = variant == nlobs::MvtVariant::kPublished ? "mvt published" : "mvt injection";
+    observers.push_back(std::make_unique<nlobs::MvtObserver<Rossler>>(Rossler{}, mvt));
   }
   nlobs::EkfOptions ekf;
   ekf.initial_estimate = guess;

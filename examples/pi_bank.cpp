@@ -31,7 +31,8 @@ int main() {
                                    .b = [=](const PiBank::Values& v) { return -sigma * v[u]; },
                                    .gains = {49, 700},
                                    .initial_estimates = Eigen::Vector2d::Zero()});
-  PiBankObserver observer("pi:lander", bank, {y, x2.eta, x3, f.eta}, {.sample_time = h});
+  PiBankObserver observer(
+      bank, {.name = "pi:lander", .estimate = {y, x2.eta, x3, f.eta}, .sample_time = h});
 
   double worst = 0.0;
   for (long k = 0; k < data.steps(); ++k) {

@@ -120,7 +120,8 @@ TEST(Allocations, PiBankStepAllocatesNothing) {
                                    .a = -1.0,
                                    .b = [=](const PiBank::Values& v) { return -50 * v[u]; },
                                    .gains = {49, 700}});
-  PiBankObserver observer("pi", bank, {y, x2.eta, x3, f.eta}, {.sample_time = 1e-3, .substeps = 2});
+  PiBankObserver observer(
+      bank, {.name = "pi", .estimate = {y, x2.eta, x3, f.eta}, .sample_time = 1e-3, .substeps = 2});
   Eigen::VectorXd yk(1), uk = Eigen::VectorXd::Ones(1);
   yk[0] = -700.0;
   observer.step(0, yk, uk);
@@ -175,8 +176,9 @@ TEST(Allocations, WindowEstimatorStepAllocatesNothing) {
 TEST(Allocations, MvtStepWithPerRowBetaAllocatesNothing) {
   MvtOptions o;
   o.sample_time = 1e-3;
-  MvtObserver<FlexibleJointRobot> observer(FlexibleJointRobot{}, Eigen::Vector4d(-1, -2, -0.5, -1),
-                                           Eigen::Vector4d(4, 5, 3.5, 3), o);
+  o.initial_estimate = Eigen::Vector4d(-1, -2, -0.5, -1);
+  o.initial_error_estimate = Eigen::Vector4d(4, 5, 3.5, 3);
+  MvtObserver<FlexibleJointRobot> observer(FlexibleJointRobot{}, o);
   Eigen::VectorXd yk = Eigen::Vector3d(3, 3, 3), uk = Eigen::VectorXd::Zero(1);
   observer.step(0, yk, uk);
   const long before = g_allocations.load();
@@ -192,16 +194,15 @@ TEST(Allocations, MvtStepWithPerRowBetaAllocatesNothing) {
 // A high-gain step with an explicit map, α and inverse (the oscillator of [HG-EMB23]) on RK4:
 // the embedded state is dynamic-size but allocated once, so the step allocates nothing.
 TEST(Allocations, HighGainStepWithExplicitFormsAllocatesNothing) {
-  HighGainObserver<OscillatorNonlinearOutput>::Design d;
-  d.map = std::make_shared<ExplicitObservabilityMap<OscillatorEmbedding>>();
-  d.alpha = explicit_alpha<OscillatorEmbedding>();
-  d.inverse = explicit_inverse<OscillatorEmbedding>();
   HighGainOptions o;
+  o.initial_estimate = Eigen::Vector2d(-0.3, 0.0);
+  o.design.map = std::make_shared<ExplicitObservabilityMap<OscillatorEmbedding>>();
+  o.design.alpha = explicit_alpha<OscillatorEmbedding>();
+  o.design.inverse = explicit_inverse<OscillatorEmbedding>();
   o.sample_time = 1e-2;
   o.theta = 0.3;
   o.saturation = SmoothSaturation{Eigen::MatrixXd::Identity(4, 4) * 0.2, 1.0, 2.0};
-  HighGainObserver<OscillatorNonlinearOutput> observer(OscillatorNonlinearOutput{}, d,
-                                                       Eigen::Vector2d(-0.3, 0.0), o);
+  HighGainObserver<OscillatorNonlinearOutput> observer(OscillatorNonlinearOutput{}, o);
   const Eigen::VectorXd none(0);
   Eigen::VectorXd yk = Eigen::VectorXd::Constant(1, -0.25);
   observer.step(0, yk, none);
@@ -238,12 +239,12 @@ TEST(Allocations, TaylorObservabilityMapAllocatesNothing) {
 // With that map a whole high-gain step without explicit forms — α = L_f^4 h along the
 // prediction and x̂ by the Ceres projection (Lorenz, RK4) — allocates nothing either.
 TEST(Allocations, HighGainStepWithTaylorMapAndProjectionAllocatesNothing) {
-  HighGainObserver<Lorenz>::Design d;
-  d.map = std::make_shared<TaylorObservabilityMap<Lorenz, 4>>();
   HighGainOptions o;
+  o.initial_estimate = Eigen::Vector3d(2.0, 3.0, 25.0);
+  o.design.map = std::make_shared<TaylorObservabilityMap<Lorenz, 4>>();
   o.sample_time = 1e-3;
   o.theta = 0.02;
-  HighGainObserver<Lorenz> observer(Lorenz{}, d, Eigen::Vector3d(2.0, 3.0, 25.0), o);
+  HighGainObserver<Lorenz> observer(Lorenz{}, o);
   const Eigen::VectorXd none(0);
   Eigen::VectorXd yk = Eigen::VectorXd::Constant(1, 1.0);
   for (long k = 0; k < 5; ++k) observer.step(k, yk, none);
@@ -267,7 +268,8 @@ TEST(Allocations, ModulatingFunctionStepAllocatesNothing) {
     o.sample_time = 0.01;
     o.horizon = 0.5;
     o.sample_period = period;
-    ModulatingFunctionObserver<PendulumForm> observer(PendulumForm{}, Eigen::Vector2d::Zero(), o);
+    o.initial_estimate = Eigen::Vector2d::Zero();
+    ModulatingFunctionObserver<PendulumForm> observer(PendulumForm{}, o);
     const Eigen::VectorXd none(0);
     Eigen::VectorXd yk(1);
     const long before = g_allocations.load();

@@ -22,11 +22,11 @@ using ChuaWindow = reference::ChuaWindowCase;
 TEST(ModifiedChua, RejectsInvalidParameters) {
   ModifiedChuaParameters p;
   p.a = 0.0;
-  EXPECT_THROW(ModifiedChua{p}, std::invalid_argument);
+  EXPECT_THROW(ModifiedChua{p}, InvalidInput);
   try {
     paper_modified_chua({}, -0.05);
     FAIL();
-  } catch (const std::invalid_argument& e) {
+  } catch (const InvalidInput& e) {
     EXPECT_NE(std::string(e.what()).find("step = -0.05"), std::string::npos) << e.what();
   }
 }

@@ -19,6 +19,15 @@
 namespace nlobs {
 namespace {
 
+// The options with the design, x̂(0) and (when given) ẑ(0) set.
+HighGainOptions designed(HighGainOptions o, HighGainDesign d, const Eigen::VectorXd& xhat0,
+                         std::optional<Eigen::VectorXd> zhat0 = {}) {
+  o.design = std::move(d);
+  o.initial_estimate = xhat0;
+  o.initial_embedded_estimate = std::move(zhat0);
+  return o;
+}
+
 template <typename Model>
 Measurements simulate_continuous(const Model& model, const Eigen::VectorXd& x0, double step,
                                  double t_end) {
@@ -219,7 +228,8 @@ TEST(ObservabilityMap, TimeVaryingModelsAreRefused) {
   HighGainOptions o;
   o.sample_time = 0.01;
   try {
-    HighGainObserver<PendulumTimeVaryingFriction> observer({}, d, Eigen::Vector2d::Zero(), o);
+    HighGainObserver<PendulumTimeVaryingFriction> observer({},
+                                                           designed(o, d, Eigen::Vector2d::Zero()));
     FAIL() << "accepted";
   } catch (const InvalidInput& e) {
     EXPECT_NE(std::string(e.what()).find("depends on t"), std::string::npos) << e.what();
@@ -374,8 +384,9 @@ HighGainOptions oscillator_options(double h) {
 TEST(HighGainObserver, GainsAreScaledHurwitzCoefficients) {
   HighGainOptions o = oscillator_options(0.01);
   o.theta = 0.5;
-  const OscillatorObserver observer(OscillatorNonlinearOutput{}, oscillator_design(true),
-                                    Eigen::Vector2d(-0.3, 0.0), o);
+  const OscillatorObserver observer(
+      OscillatorNonlinearOutput{},
+      designed(o, oscillator_design(true), Eigen::Vector2d(-0.3, 0.0)));
   // (s + 1)^4: l = [1, 4, 6, 4]; k_i = l_{N−i} / θ^i
   EXPECT_TRUE(observer.gains().isApprox(Eigen::Vector4d(4 / 0.5, 6 / 0.25, 4 / 0.125, 1 / 0.0625)));
 }
@@ -385,8 +396,9 @@ TEST(HighGainObserver, OscillatorConvergesWithTheExplicitInverse) {
   const double h = 0.005;
   const Measurements data =
       simulate_continuous(OscillatorNonlinearOutput{}, Eigen::Vector2d(-0.5, 0.0), h, 30.0);
-  OscillatorObserver observer(OscillatorNonlinearOutput{}, oscillator_design(true),
-                              Eigen::Vector2d(-0.3, 0.0), oscillator_options(h));
+  OscillatorObserver observer(
+      OscillatorNonlinearOutput{},
+      designed(oscillator_options(h), oscillator_design(true), Eigen::Vector2d(-0.3, 0.0)));
   EXPECT_EQ(observer.integrator(), HighGainIntegrator::kRk4);  // h·1/θ = 0.017
   const Trace t = run(observer, data);
   EXPECT_TRUE(t.failures.empty());
@@ -400,8 +412,9 @@ TEST(HighGainObserver, ProjectionByCeresMatchesTheInverse) {
   const double h = 0.005;
   const Measurements data =
       simulate_continuous(OscillatorNonlinearOutput{}, Eigen::Vector2d(-0.5, 0.0), h, 25.0);
-  OscillatorObserver observer(OscillatorNonlinearOutput{}, oscillator_design(false),
-                              Eigen::Vector2d(-0.3, 0.0), oscillator_options(h));
+  OscillatorObserver observer(
+      OscillatorNonlinearOutput{},
+      designed(oscillator_options(h), oscillator_design(false), Eigen::Vector2d(-0.3, 0.0)));
   const Trace t = run(observer, data);
   EXPECT_TRUE(t.failures.empty());
   EXPECT_LT(max_after(t.x_error, data, 20.0), 1e-6);
@@ -414,11 +427,12 @@ TEST(HighGainObserver, CvodeAgreesWithRk4) {
       simulate_continuous(OscillatorNonlinearOutput{}, Eigen::Vector2d(-0.5, 0.0), h, 22.0);
   HighGainOptions o = oscillator_options(h);
   o.integrator = HighGainIntegrator::kRk4;
-  OscillatorObserver explicit_steps(OscillatorNonlinearOutput{}, oscillator_design(true),
-                                    Eigen::Vector2d(-0.3, 0.0), o);
+  OscillatorObserver explicit_steps(
+      OscillatorNonlinearOutput{},
+      designed(o, oscillator_design(true), Eigen::Vector2d(-0.3, 0.0)));
   o.integrator = HighGainIntegrator::kCvode;
-  OscillatorObserver implicit(OscillatorNonlinearOutput{}, oscillator_design(true),
-                              Eigen::Vector2d(-0.3, 0.0), o);
+  OscillatorObserver implicit(OscillatorNonlinearOutput{},
+                              designed(o, oscillator_design(true), Eigen::Vector2d(-0.3, 0.0)));
   double largest_gap = 0.0;
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
     ASSERT_TRUE(explicit_steps.step(k, data.y.col(k), data.u.col(k)).failure.empty());
@@ -440,10 +454,10 @@ TEST(HighGainObserver, CvodeWithLieAlphaMatchesRk4) {
   o.theta = 0.05;
   o.integrator = HighGainIntegrator::kRk4;
   o.substeps = 20;  // the reference: RK4 converged in the step
-  HighGainObserver<Lorenz> rk4(Lorenz{}, d, Eigen::Vector3d(2.0, 3.0, 25.0), o);
+  HighGainObserver<Lorenz> rk4(Lorenz{}, designed(o, d, Eigen::Vector3d(2.0, 3.0, 25.0)));
   o.integrator = HighGainIntegrator::kCvode;
   o.substeps = 1;
-  HighGainObserver<Lorenz> cvode(Lorenz{}, d, Eigen::Vector3d(2.0, 3.0, 25.0), o);
+  HighGainObserver<Lorenz> cvode(Lorenz{}, designed(o, d, Eigen::Vector3d(2.0, 3.0, 25.0)));
   double worst = 0.0;
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
     ASSERT_TRUE(rk4.step(k, data.y.col(k), data.u.col(k)).failure.empty());
@@ -461,8 +475,8 @@ TEST(HighGainObserver, CvodeFailureKeepsTheStateAndRecovers) {
       simulate_continuous(OscillatorNonlinearOutput{}, Eigen::Vector2d(-0.5, 0.0), h, 1.0);
   HighGainOptions o = oscillator_options(h);
   o.integrator = HighGainIntegrator::kCvode;
-  OscillatorObserver observer(OscillatorNonlinearOutput{}, oscillator_design(true),
-                              Eigen::Vector2d(-0.3, 0.0), o);
+  OscillatorObserver observer(OscillatorNonlinearOutput{},
+                              designed(o, oscillator_design(true), Eigen::Vector2d(-0.3, 0.0)));
   for (Eigen::Index k = 0; k < 50; ++k) observer.step(k, data.y.col(k), data.u.col(k));
   const Eigen::VectorXd before = observer.zhat();
   const ObserverStep& bad = observer.step(50, Eigen::VectorXd::Constant(1, 1e300), data.u.col(50));
@@ -487,7 +501,7 @@ TEST(HighGainObserver, DuffingConvergesFromTheHardStart) {
   Eigen::VectorXd P(6);
   P << 0.8, 0.145, 0.103, 0.0158, 4.07e-3, 5.26e-4;
   o.saturation = SmoothSaturation{P.asDiagonal(), 1.0, 2.0};
-  HighGainObserver<Duffing> observer(Duffing{}, d, Eigen::Vector2d::Zero(), o);
+  HighGainObserver<Duffing> observer(Duffing{}, designed(o, d, Eigen::Vector2d::Zero()));
   EXPECT_TRUE(observer.zhat().isZero());  // q6(0, 0) = 0
   const Trace t = run(observer, data);
   EXPECT_TRUE(t.failures.empty());
@@ -509,7 +523,7 @@ TEST(HighGainObserver, LorenzWithLieAlphaTracksAwayFromTheAxis) {
   o.saturation = SmoothSaturation{saturation_weight_from_box(embedded_box_bound(
                                       LorenzEmbedding{}, Eigen::Vector3d(25, 30, 55))),
                                   1.0, 2.0};
-  HighGainObserver<Lorenz> observer(Lorenz{}, d, Eigen::Vector3d(2.0, 3.0, 25.0), o);
+  HighGainObserver<Lorenz> observer(Lorenz{}, designed(o, d, Eigen::Vector3d(2.0, 3.0, 25.0)));
   const Trace t = run(observer, data);
   EXPECT_TRUE(t.failures.empty());
   double sum = 0.0;
@@ -535,8 +549,8 @@ TEST(HighGainObserver, TaylorAndAdolcMapsGiveTheSameRun) {
   HighGainObserver<Lorenz>::Design taylor, adolc;
   taylor.map = std::make_shared<TaylorObservabilityMap<Lorenz, 4>>();
   adolc.map = std::make_shared<LieObservabilityMap>(Lorenz{}, 4);
-  HighGainObserver<Lorenz> a(Lorenz{}, taylor, Eigen::Vector3d(2.0, 3.0, 25.0), o);
-  HighGainObserver<Lorenz> b(Lorenz{}, adolc, Eigen::Vector3d(2.0, 3.0, 25.0), o);
+  HighGainObserver<Lorenz> a(Lorenz{}, designed(o, taylor, Eigen::Vector3d(2.0, 3.0, 25.0)));
+  HighGainObserver<Lorenz> b(Lorenz{}, designed(o, adolc, Eigen::Vector3d(2.0, 3.0, 25.0)));
   double worst = 0.0, worst_z = 0.0, moved = 0.0;
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
     const Eigen::VectorXd xa = a.step(k, data.y.col(k), data.u.col(k)).estimate;
@@ -558,10 +572,10 @@ TEST(HighGainObserver, LieAlphaIsSwitchedOffOnTheNonObservableSet) {
   HighGainOptions o;
   o.sample_time = 1e-3;
   o.theta = 0.05;
-  HighGainObserver<Lorenz> on_axis(Lorenz{}, d, Eigen::Vector3d(0.0, 0.0, 10.0), o);
+  HighGainObserver<Lorenz> on_axis(Lorenz{}, designed(o, d, Eigen::Vector3d(0.0, 0.0, 10.0)));
   const ObserverStep& s = on_axis.step(0, Eigen::VectorXd::Zero(1), Eigen::VectorXd());
   EXPECT_LT(s.extras[6], 1e-12);  // alpha_weight: ∂q_4/∂x3 = 0 on the x3 axis
-  HighGainObserver<Lorenz> off_axis(Lorenz{}, d, Eigen::Vector3d(5.0, 5.0, 10.0), o);
+  HighGainObserver<Lorenz> off_axis(Lorenz{}, designed(o, d, Eigen::Vector3d(5.0, 5.0, 10.0)));
   const ObserverStep& s2 = off_axis.step(0, Eigen::VectorXd::Constant(1, 5.0), Eigen::VectorXd());
   EXPECT_GT(s2.extras[6], 0.99);
 }
@@ -577,7 +591,7 @@ TEST(HighGainObserver, VanDerPolWithLieAlphaConverges) {
   o.saturation = SmoothSaturation{
       saturation_weight_from_box(embedded_box_bound(VanDerPolEmbedding{}, Eigen::Vector2d(2.5, 3))),
       1.0, 2.0};
-  HighGainObserver<VanDerPol> observer(VanDerPol{}, d, Eigen::Vector2d(1.0, 1.0), o);
+  HighGainObserver<VanDerPol> observer(VanDerPol{}, designed(o, d, Eigen::Vector2d(1.0, 1.0)));
   const Trace t = run(observer, data);
   EXPECT_TRUE(t.failures.empty());
   EXPECT_LT(max_after(t.x_error, data, 2.0), 1e-3);  // measured 7.1e-5
@@ -589,8 +603,9 @@ TEST(HighGainObserver, MissingSamplesAreBridged) {
   Measurements data =
       simulate_continuous(OscillatorNonlinearOutput{}, Eigen::Vector2d(-0.5, 0.0), h, 25.0);
   for (Eigen::Index k = 4400; k < 4410; ++k) data.y(0, k) = std::nan("");  // t = 22–22.05 s
-  OscillatorObserver observer(OscillatorNonlinearOutput{}, oscillator_design(true),
-                              Eigen::Vector2d(-0.3, 0.0), oscillator_options(h));
+  OscillatorObserver observer(
+      OscillatorNonlinearOutput{},
+      designed(oscillator_options(h), oscillator_design(true), Eigen::Vector2d(-0.3, 0.0)));
   long missing = 0;
   double after_gap = 0.0;
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
@@ -621,8 +636,8 @@ TEST(HighGainObserver, ABlownUpPredictionDoesNotStopAnExplicitAlpha) {
   P << 0.8, 0.145, 0.103, 0.0158, 4.07e-3, 5.26e-4;
   o.saturation = SmoothSaturation{P.asDiagonal(), 1.0, 2.0};
   o.restart_every = 5;
-  HighGainObserver<Duffing> observer(Duffing{}, d, Eigen::Vector2d(1e100, 0.0), o,
-                                     Eigen::VectorXd::Zero(6));
+  HighGainObserver<Duffing> observer(
+      Duffing{}, designed(o, d, Eigen::Vector2d(1e100, 0.0), Eigen::VectorXd::Zero(6)));
   const Trace t = run(observer, data);
   EXPECT_TRUE(std::find(t.failures.begin(), t.failures.end(), "non_finite") == t.failures.end());
   EXPECT_LT(max_after(t.z_error, data, 10.5), 1e-6);
@@ -630,8 +645,9 @@ TEST(HighGainObserver, ABlownUpPredictionDoesNotStopAnExplicitAlpha) {
 }
 
 TEST(HighGainObserver, SamplesMustArriveInOrder) {
-  OscillatorObserver observer(OscillatorNonlinearOutput{}, oscillator_design(true),
-                              Eigen::Vector2d(-0.3, 0.0), oscillator_options(0.01));
+  OscillatorObserver observer(
+      OscillatorNonlinearOutput{},
+      designed(oscillator_options(0.01), oscillator_design(true), Eigen::Vector2d(-0.3, 0.0)));
   const Eigen::VectorXd y = Eigen::VectorXd::Constant(1, -0.25), none(0);
   observer.step(0, y, none);
   observer.step(1, y, none);
@@ -666,8 +682,8 @@ TEST(HighGainObserver, FailedProjectionKeepsThePreviousEstimate) {
   OscillatorObserver::Design d;
   d.map = map;
   d.alpha = explicit_alpha<OscillatorEmbedding>();
-  OscillatorObserver observer(OscillatorNonlinearOutput{}, d, Eigen::Vector2d(-0.3, 0.0),
-                              oscillator_options(h));
+  OscillatorObserver observer(OscillatorNonlinearOutput{},
+                              designed(oscillator_options(h), d, Eigen::Vector2d(-0.3, 0.0)));
   for (Eigen::Index k = 0; k < 50; ++k) observer.step(k, data.y.col(k), data.u.col(k));
   const Eigen::Vector2d before = observer.xhat();
   map->broken = true;
@@ -689,8 +705,8 @@ struct ShortMap {
 TEST(HighGainObserver, BadOptionsAreErrorsNamingTheOption) {
   const auto message = [](HighGainOptions o, OscillatorObserver::Design d) {
     try {
-      OscillatorObserver observer(OscillatorNonlinearOutput{}, std::move(d),
-                                  Eigen::Vector2d(-0.3, 0.0), std::move(o));
+      OscillatorObserver observer(OscillatorNonlinearOutput{},
+                                  designed(std::move(o), std::move(d), Eigen::Vector2d(-0.3, 0.0)));
     } catch (const InvalidInput& e) {
       return std::string(e.what());
     }
@@ -717,14 +733,35 @@ TEST(HighGainObserver, BadOptionsAreErrorsNamingTheOption) {
   o.saturation->P(0, 0) = -1.0;
   EXPECT_NE(message(o, oscillator_design(true)).find("saturation"), std::string::npos);
   o = good;
-  o.projection = "no-such-engine";
-  EXPECT_NE(message(o, oscillator_design(false)).find("no-such-engine"), std::string::npos);
-  o = good;
   o.sample_time = 0.0;
-  EXPECT_NE(message(o, oscillator_design(true)).find("sample_time"), std::string::npos);
+  EXPECT_NE(message(o, oscillator_design(true))
+                .find("HighGainOptions::sample_time must be finite and > 0 (got 0)"),
+            std::string::npos);
   o = good;
   o.residual_scale = 0.0;
   EXPECT_NE(message(o, oscillator_design(true)).find("residual_scale"), std::string::npos);
+  o = good;
+  o.restart_every = 0;
+  EXPECT_NE(message(o, oscillator_design(true))
+                .find("HighGainOptions::restart_every must be >= 1 (got 0)"),
+            std::string::npos);
+  o = good;
+  o.name.clear();
+  EXPECT_NE(message(o, oscillator_design(true)).find("HighGainOptions::name"), std::string::npos);
+  o = good;
+  try {  // ẑ(0) of N = 3 for N = 4 (designed() sets it; message() would reset it)
+    OscillatorObserver observer(OscillatorNonlinearOutput{},
+                                designed(good, oscillator_design(true), Eigen::Vector2d(-0.3, 0.0),
+                                         Eigen::VectorXd(Eigen::Vector3d::Zero())));
+    ADD_FAILURE() << "accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "initial_embedded_estimate must be a finite 4x1 matrix (got 3x1)"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_NE(message(good, OscillatorObserver::Design{}).find("HighGainOptions::design.map"),
+            std::string::npos);
   o = good;
   o.theta = 1e-80;
   EXPECT_NE(message(o, oscillator_design(true)).find("overflow"), std::string::npos);
@@ -735,8 +772,40 @@ TEST(HighGainObserver, BadOptionsAreErrorsNamingTheOption) {
   // N smaller than the state dimension.
   OscillatorObserver::Design short_map = oscillator_design(true);
   short_map.map = std::make_shared<ExplicitObservabilityMap<ShortMap>>();
-  EXPECT_NE(message(good, short_map).find("N = 1 is smaller than the state dimension"),
+  EXPECT_NE(message(good, short_map).find("HighGainOptions::design.map must have N >= 2"),
             std::string::npos);
+}
+
+// The projection engine is an object: a square-only one cannot project N = 4 onto n = 2, an
+// engine beside an explicit inverse is ambiguous, and the report names the engine it was given.
+TEST(HighGainObserverBadInput, TheProjectionEngineIsChecked) {
+  const auto with = [](OscillatorObserver::Design d, const std::string& spec) {
+    try {
+      OscillatorObserver observer(
+          OscillatorNonlinearOutput{},
+          designed(oscillator_options(0.01), std::move(d), Eigen::Vector2d(-0.3, 0.0)),
+          EngineRegistry<2>::global().create(spec, high_gain_projection_options()));
+      return "accepted: " + observer.engine();
+    } catch (const InvalidInput& e) {
+      return std::string(e.what());
+    }
+  };
+  EXPECT_NE(with(oscillator_design(false), "newton").find("'newton' solves square systems only"),
+            std::string::npos);
+  EXPECT_NE(with(oscillator_design(true), "ceres").find("both an explicit inverse"),
+            std::string::npos);
+  EXPECT_EQ(with(oscillator_design(false), "ceres:max_iter=50"), "accepted: ceres:max_iter=50");
+  // Without an engine: Ceres, or the explicit inverse when there is one.
+  EXPECT_EQ(OscillatorObserver(OscillatorNonlinearOutput{},
+                               designed(oscillator_options(0.01), oscillator_design(false),
+                                        Eigen::Vector2d(-0.3, 0.0)))
+                .engine(),
+            "ceres");
+  EXPECT_EQ(OscillatorObserver(OscillatorNonlinearOutput{},
+                               designed(oscillator_options(0.01), oscillator_design(true),
+                                        Eigen::Vector2d(-0.3, 0.0)))
+                .engine(),
+            "explicit inverse");
 }
 
 }  // namespace

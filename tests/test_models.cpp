@@ -30,7 +30,7 @@ TEST(Models, DiscretisationsConverge) {
     EXPECT_LT((xr - exact).norm(), 1e-4) << h;
     EXPECT_GT((xe - exact).norm(), 100 * (xr - exact).norm()) << h;
   }
-  EXPECT_THROW(Discretized<Duffing>(Duffing{}, 0.0), std::invalid_argument);
+  EXPECT_THROW(Discretized<Duffing>(Duffing{}, 0.0), InvalidInput);  // the one exception type
 }
 
 TEST(Models, OdeintAdaptiveIntegrationIsAccurate) {
@@ -56,7 +56,16 @@ TEST(Models, OdeintAdaptiveIntegrationIsAccurate) {
     pr = pend_rk4.f(pr, {}, k);
   }
   EXPECT_LT((pa - pr).norm(), 1e-7);
-  EXPECT_THROW(OdeintDiscretized<Duffing>(Duffing{}, -1.0), std::invalid_argument);
+  EXPECT_THROW(OdeintDiscretized<Duffing>(Duffing{}, -1.0), InvalidInput);
+  try {
+    OdeintDiscretized<Duffing>(Duffing{}, 0.1, {.absolute_tolerance = std::nan("")});
+    FAIL() << "accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(
+        std::string(e.what()).find("OdeintOptions::absolute_tolerance must be finite and > 0"),
+        std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(Models, LanderLeavesItsDomainWithAClearMessage) {

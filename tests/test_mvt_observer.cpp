@@ -73,6 +73,13 @@ MvtOptions options(MvtVariant variant, MvtBetaMethod method = MvtBetaMethod::kPe
   return o;
 }
 
+// The options with x̂(0) and ê(0) set.
+MvtOptions started(MvtOptions o, const Eigen::VectorXd& xhat0, const Eigen::VectorXd& ehat0) {
+  o.initial_estimate = xhat0;
+  o.initial_error_estimate = ehat0;
+  return o;
+}
+
 // ---- the β problem -------------------------------------------------------------------------
 
 template <typename Model>
@@ -186,8 +193,8 @@ TEST(MvtBeta, BadOptions) {
 TEST(MvtObserver, Case1ErrorEstimateTracksTheTrueError) {
   const Measurements data = simulate_continuous(ChaoticNoLinear{}, kChaoticX0, 15.0);
   for (MvtVariant v : {MvtVariant::kPublished, MvtVariant::kOutputInjection}) {
-    MvtObserver<ChaoticNoLinear> observer(ChaoticNoLinear{}, kChaoticXhat0,
-                                          kChaoticX0 - kChaoticXhat0, options(v));
+    MvtObserver<ChaoticNoLinear> observer(
+        ChaoticNoLinear{}, started(options(v), kChaoticXhat0, kChaoticX0 - kChaoticXhat0));
     const Trace trace = run(observer, data);
     EXPECT_EQ(trace.failures, 0);
     EXPECT_LE(*std::max_element(trace.tracking.begin(), trace.tracking.end()), 1e-6);
@@ -200,8 +207,8 @@ TEST(MvtObserver, Case1ErrorEstimateTracksTheTrueError) {
 // error stays at 0.06–0.18 (measured 0.0584 at t = 25) — x̂3 never learns it.
 TEST(MvtObserver, Case2PublishedLeavesTheUnmeasuredErrorUncorrected) {
   const Measurements data = simulate_continuous(ChaoticNoLinear{}, kChaoticX0, 25.0);
-  MvtObserver<ChaoticNoLinear> observer(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error,
-                                        options(MvtVariant::kPublished));
+  MvtObserver<ChaoticNoLinear> observer(
+      ChaoticNoLinear{}, started(options(MvtVariant::kPublished), kChaoticXhat0, kCase2Error));
   const Trace trace = run(observer, data);
   EXPECT_LE(trace.max_residual, 1e-8);
   EXPECT_LE(observer.ehat().norm(), 1e-9);     // ê has (nearly) vanished
@@ -214,8 +221,9 @@ TEST(MvtObserver, Case2PublishedLeavesTheUnmeasuredErrorUncorrected) {
 
 TEST(MvtObserver, Case2WithOutputInjectionConverges) {
   const Measurements data = simulate_continuous(ChaoticNoLinear{}, kChaoticX0, 30.0);
-  MvtObserver<ChaoticNoLinear> observer(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error,
-                                        options(MvtVariant::kOutputInjection));
+  MvtObserver<ChaoticNoLinear> observer(
+      ChaoticNoLinear{},
+      started(options(MvtVariant::kOutputInjection), kChaoticXhat0, kCase2Error));
   const Trace trace = run(observer, data);
   EXPECT_LE(trace.max_residual, 1e-8);
   EXPECT_LE(trace.max_error_from(17.5), 1e-6);  // measured 6e-8 over [17.5, 30]
@@ -223,12 +231,14 @@ TEST(MvtObserver, Case2WithOutputInjectionConverges) {
 
 TEST(MvtObserver, JointBetaSolversGiveTheSameRun) {
   const Measurements data = simulate_continuous(ChaoticNoLinear{}, kChaoticX0, 3.0);
-  MvtObserver<ChaoticNoLinear> rows(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error,
-                                    options(MvtVariant::kOutputInjection));
+  MvtObserver<ChaoticNoLinear> rows(
+      ChaoticNoLinear{},
+      started(options(MvtVariant::kOutputInjection), kChaoticXhat0, kCase2Error));
   const Trace reference = run(rows, data);
   for (MvtBetaMethod m : {MvtBetaMethod::kNlopt, MvtBetaMethod::kCeres}) {
-    MvtObserver<ChaoticNoLinear> joint(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error,
-                                       options(MvtVariant::kOutputInjection, m));
+    MvtObserver<ChaoticNoLinear> joint(
+        ChaoticNoLinear{},
+        started(options(MvtVariant::kOutputInjection, m), kChaoticXhat0, kCase2Error));
     const Trace trace = run(joint, data);
     EXPECT_LE(trace.max_residual, 1e-8) << to_string(m);
     EXPECT_LE((joint.xhat() - rows.xhat()).norm(), 1e-9) << to_string(m);
@@ -239,13 +249,13 @@ TEST(MvtObserver, JointBetaSolversGiveTheSameRun) {
 TEST(MvtObserver, AdaptiveIntegratorMatchesRk4) {
   const Measurements data = simulate_continuous(ChaoticNoLinear{}, kChaoticX0, 5.0);
   MvtOptions o = options(MvtVariant::kOutputInjection);
-  MvtObserver<ChaoticNoLinear> rk4(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error, o);
+  MvtObserver<ChaoticNoLinear> rk4(ChaoticNoLinear{}, started(o, kChaoticXhat0, kCase2Error));
   o.integrator = MvtIntegrator::kDopri5;
-  MvtObserver<ChaoticNoLinear> adaptive(ChaoticNoLinear{}, kChaoticXhat0,
-                                        kChaoticX0 - kChaoticXhat0, o);
+  MvtObserver<ChaoticNoLinear> adaptive(ChaoticNoLinear{},
+                                        started(o, kChaoticXhat0, kChaoticX0 - kChaoticXhat0));
   const Trace trace = run(adaptive, data);
   EXPECT_LE(*std::max_element(trace.tracking.begin(), trace.tracking.end()), 1e-6);
-  MvtObserver<ChaoticNoLinear> adaptive2(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error, o);
+  MvtObserver<ChaoticNoLinear> adaptive2(ChaoticNoLinear{}, started(o, kChaoticXhat0, kCase2Error));
   run(rk4, data);
   run(adaptive2, data);
   EXPECT_LE((adaptive2.xhat() - rk4.xhat()).norm(), 1e-7);  // same data, two integrators
@@ -254,8 +264,9 @@ TEST(MvtObserver, AdaptiveIntegratorMatchesRk4) {
 
 TEST(MvtObserver, ExactStartStaysExactWithBetaKept) {
   const Measurements data = simulate_continuous(ChaoticNoLinear{}, kChaoticX0, 2.0);
-  MvtObserver<ChaoticNoLinear> observer(ChaoticNoLinear{}, kChaoticX0, Eigen::Vector3d::Zero(),
-                                        options(MvtVariant::kOutputInjection));
+  MvtObserver<ChaoticNoLinear> observer(
+      ChaoticNoLinear{},
+      started(options(MvtVariant::kOutputInjection), kChaoticX0, Eigen::Vector3d::Zero()));
   const Trace trace = run(observer, data);
   EXPECT_EQ(trace.failures, 0);
   // The first samples interpolate y by lower-degree polynomials: measured 4.7e-9.
@@ -265,12 +276,14 @@ TEST(MvtObserver, ExactStartStaysExactWithBetaKept) {
 
 TEST(MvtObserver, MissingSamplesAreBridged) {
   Measurements data = simulate_continuous(ChaoticNoLinear{}, kChaoticX0, 4.0);
-  MvtObserver<ChaoticNoLinear> reference(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error,
-                                         options(MvtVariant::kOutputInjection));
+  MvtObserver<ChaoticNoLinear> reference(
+      ChaoticNoLinear{},
+      started(options(MvtVariant::kOutputInjection), kChaoticXhat0, kCase2Error));
   run(reference, data);
   for (long k = 1000; k < 1005; ++k) data.y.col(k).setConstant(std::nan(""));
-  MvtObserver<ChaoticNoLinear> gapped(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error,
-                                      options(MvtVariant::kOutputInjection));
+  MvtObserver<ChaoticNoLinear> gapped(
+      ChaoticNoLinear{},
+      started(options(MvtVariant::kOutputInjection), kChaoticXhat0, kCase2Error));
   const Trace trace = run(gapped, data);
   EXPECT_EQ(trace.failures, 0);
   EXPECT_TRUE(gapped.step(4001, data.y.col(0).setConstant(std::nan("")), data.u.col(0))
@@ -283,10 +296,10 @@ TEST(MvtObserver, MissingSamplesAreBridged) {
 TEST(MvtObserver, RobotConvergesAndTheInjectionCorrectsTheUnmeasuredState) {
   const Measurements data = simulate_continuous(FlexibleJointRobot{}, kRobotX0, 10.0, robot_input);
   const Eigen::Vector4d other(4, 5, 3.5, 3);  // ê(0) ≠ x(0) − x̂(0) by 1 in x4
-  MvtObserver<FlexibleJointRobot> published(FlexibleJointRobot{}, kRobotXhat0, other,
-                                            options(MvtVariant::kPublished));
-  MvtObserver<FlexibleJointRobot> injected(FlexibleJointRobot{}, kRobotXhat0, other,
-                                           options(MvtVariant::kOutputInjection));
+  MvtObserver<FlexibleJointRobot> published(
+      FlexibleJointRobot{}, started(options(MvtVariant::kPublished), kRobotXhat0, other));
+  MvtObserver<FlexibleJointRobot> injected(
+      FlexibleJointRobot{}, started(options(MvtVariant::kOutputInjection), kRobotXhat0, other));
   const Trace p = run(published, data), i = run(injected, data);
   EXPECT_LE(p.max_residual, 1e-8);
   EXPECT_LE(i.max_residual, 1e-8);
@@ -323,30 +336,52 @@ struct DoubleOnly : ModelSizes<2, 0, 1> {
 
 TEST(MvtObserverBadInput, OptionsAndOutputMap) {
   const auto make = [](MvtOptions o) {
-    return test::message_of(
-        [&] { MvtObserver<ChaoticNoLinear> m(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error, o); });
+    return test::message_of([&] {
+      MvtObserver<ChaoticNoLinear> m(ChaoticNoLinear{}, started(o, kChaoticXhat0, kCase2Error));
+    });
   };
   MvtOptions o = options(MvtVariant::kPublished);
   o.eta = 0.5;
-  EXPECT_NE(make(o).find("eta must be finite and >= 1"), std::string::npos);
+  EXPECT_NE(make(o).find("MvtOptions::eta must be finite and >= 1 (got 0.5)"), std::string::npos);
   o = options(MvtVariant::kPublished);
   o.sample_time = 0.0;
-  EXPECT_NE(make(o).find("sample_time"), std::string::npos);
+  EXPECT_NE(make(o).find("MvtOptions::sample_time must be finite and > 0 (got 0)"),
+            std::string::npos);
   o = options(MvtVariant::kPublished);
   o.injection_gain = -1.0;
-  EXPECT_NE(make(o).find("injection_gain"), std::string::npos);
+  EXPECT_NE(make(o).find("MvtOptions::injection_gain"), std::string::npos);
   o = options(MvtVariant::kPublished);
   o.substeps = 0;
-  EXPECT_NE(make(o).find("substeps"), std::string::npos);
+  EXPECT_NE(make(o).find("MvtOptions::substeps must be >= 1 (got 0)"), std::string::npos);
+  o = options(MvtVariant::kPublished);
+  o.name.clear();
+  EXPECT_NE(make(o).find("MvtOptions::name"), std::string::npos);
+  // validate() alone tells what needs no model; the constructor then checks the sizes.
+  o = started(options(MvtVariant::kPublished), kChaoticXhat0, Eigen::Vector2d(0.1, 0.1));
+  EXPECT_NO_THROW(o.validate());
+  EXPECT_NE(test::message_of([&] {
+              MvtObserver<ChaoticNoLinear> m(ChaoticNoLinear{}, o);
+            }).find("initial_error_estimate must be a finite 3x1 matrix (got 2x1)"),
+            std::string::npos);
+  o.initial_error_estimate.resize(0);  // empty: ê(0) = 0
+  MvtObserver<ChaoticNoLinear> zero_error(ChaoticNoLinear{}, o);
+  EXPECT_EQ(zero_error.ehat(), Eigen::Vector3d::Zero());
+  o.name = "my mvt";
+  EXPECT_EQ(MvtObserver<ChaoticNoLinear>(ChaoticNoLinear{}, o).name(), "my mvt");
   EXPECT_NE(test::message_of([] {
-              MvtObserver<ChaoticNoLinear> m(ChaoticNoLinear{}, Eigen::Vector3d(0, std::nan(""), 0),
-                                             kCase2Error, options(MvtVariant::kPublished));
-            }).find("x̂(0)"),
+              MvtObserver<ChaoticNoLinear>(ChaoticNoLinear{}, MvtOptions{});
+            }).find("MvtOptions::initial_estimate must be given"),
+            std::string::npos);
+  EXPECT_NE(test::message_of([] {
+              MvtObserver<ChaoticNoLinear> m(
+                  ChaoticNoLinear{}, started(options(MvtVariant::kPublished),
+                                             Eigen::Vector3d(0, std::nan(""), 0), kCase2Error));
+            }).find("MvtOptions::initial_estimate must be given, every entry finite"),
             std::string::npos);
   // Duffing measures x2: C = [0 1] is not [I_m 0].
   const std::string c = test::message_of([] {
-    MvtObserver<Duffing> m(Duffing{}, Eigen::Vector2d(1, 0), Eigen::Vector2d(0.1, 0.1),
-                           options(MvtVariant::kPublished));
+    MvtObserver<Duffing> m(Duffing{}, started(options(MvtVariant::kPublished),
+                                              Eigen::Vector2d(1, 0), Eigen::Vector2d(0.1, 0.1)));
   });
   EXPECT_NE(c.find("C = [I_m 0]"), std::string::npos) << c;
 }
@@ -358,8 +393,9 @@ TEST(MvtObserverBadInput, NonFiniteFKeepsTheLastGoodState) {
   data.t = Eigen::VectorXd::LinSpaced(steps, 0.0, kStep * (steps - 1));
   data.y = (0.5 + data.t.array()).matrix().transpose();
   data.u.resize(0, steps);
-  MvtObserver<BrokenAbove> observer(BrokenAbove{}, Eigen::Vector2d(0.5, 1.0),
-                                    Eigen::Vector2d(0.0, 0.0), options(MvtVariant::kPublished));
+  MvtObserver<BrokenAbove> observer(
+      BrokenAbove{}, started(options(MvtVariant::kPublished), Eigen::Vector2d(0.5, 1.0),
+                             Eigen::Vector2d(0.0, 0.0)));
   long first_failure = -1;
   Eigen::VectorXd last_good;
   for (long k = 0; k < steps; ++k) {
@@ -378,8 +414,9 @@ TEST(MvtObserverBadInput, NonFiniteFKeepsTheLastGoodState) {
 }
 
 TEST(MvtObserverBadInput, ModelWithoutJetSupportFallsBackToFiniteDifferences) {
-  MvtObserver<DoubleOnly> observer(DoubleOnly{}, Eigen::Vector2d(0.5, 0.0),
-                                   Eigen::Vector2d(0.2, -0.1), options(MvtVariant::kPublished));
+  MvtObserver<DoubleOnly> observer(
+      DoubleOnly{}, started(options(MvtVariant::kPublished), Eigen::Vector2d(0.5, 0.0),
+                            Eigen::Vector2d(0.2, -0.1)));
   ASSERT_EQ(observer.warnings().size(), 1u);
   EXPECT_NE(observer.warnings()[0].find("central differences"), std::string::npos);
   const DoubleOnly model;
@@ -396,8 +433,8 @@ TEST(MvtObserverBadInput, ModelWithoutJetSupportFallsBackToFiniteDifferences) {
 
 TEST(MvtObserverBadInput, NonFiniteInputKeepsTheState) {
   FlexibleJointRobot robot;
-  MvtObserver<FlexibleJointRobot> observer(robot, kRobotXhat0, kRobotX0 - kRobotXhat0,
-                                           options(MvtVariant::kOutputInjection));
+  MvtObserver<FlexibleJointRobot> observer(
+      robot, started(options(MvtVariant::kOutputInjection), kRobotXhat0, kRobotX0 - kRobotXhat0));
   const Eigen::VectorXd y = kRobotX0.head<3>(), u = Eigen::VectorXd::Zero(1);
   observer.step(0, y, u);
   observer.step(1, y, u);
@@ -411,8 +448,8 @@ TEST(MvtObserverBadInput, NonFiniteInputKeepsTheState) {
 }
 
 TEST(MvtObserverBadInput, WrongSampleSizeIsAnError) {
-  MvtObserver<ChaoticNoLinear> observer(ChaoticNoLinear{}, kChaoticXhat0, kCase2Error,
-                                        options(MvtVariant::kPublished));
+  MvtObserver<ChaoticNoLinear> observer(
+      ChaoticNoLinear{}, started(options(MvtVariant::kPublished), kChaoticXhat0, kCase2Error));
   EXPECT_NE(test::message_of([&] {
               observer.step(0, Eigen::VectorXd::Zero(3), Eigen::VectorXd());
             }).find("2 outputs"),

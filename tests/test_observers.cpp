@@ -331,7 +331,7 @@ TEST(ObserverOptions, ValidateNamesTheField) {
   sliding.gamma = -2.0;
   EXPECT_NE(refusal([&] {
               SlidingModeObserver<Linear2>(model, sliding);
-            }).find("SlidingModeOptions::gamma = -2"),
+            }).find("SlidingModeOptions::gamma must be finite and > 0 (got -2)"),
             std::string::npos);
   sliding.gamma = 0.5;
   sliding.q = Eigen::Vector3d::Zero();  // n × p = 2 × 1 wanted
@@ -341,8 +341,15 @@ TEST(ObserverOptions, ValidateNamesTheField) {
   EkfOptions ekf;
   ekf.initial_estimate = Eigen::Vector2d::Zero();
   ekf.measurement_covariance = Eigen::MatrixXd::Constant(1, 2, 1.0);  // not square
-  EXPECT_NE(refusal([&] { ekf.validate(); }).find("measurement_covariance R (1x2)"),
+  EXPECT_NE(refusal([&] {
+              ekf.validate();
+            }).find("EkfOptions::measurement_covariance must be square (got 1x2)"),
             std::string::npos);
+  ekf.measurement_covariance = Eigen::Matrix2d{{1.0, 2.0}, {2.0, 1.0}};  // eigenvalues 3, −1
+  EXPECT_NE(refusal([&] { ekf.validate(); }).find("must be positive semi-definite"),
+            std::string::npos);
+  ekf.measurement_covariance = Eigen::Matrix2d{{1.0, 0.5}, {0.0, 1.0}};
+  EXPECT_NE(refusal([&] { ekf.validate(); }).find("must be symmetric"), std::string::npos);
   ekf.measurement_covariance = Eigen::MatrixXd::Constant(1, 1, 1e-4);
   ekf.initial_covariance = Eigen::Matrix3d::Identity();  // valid alone, wrong size for n = 2
   EXPECT_EQ(refusal([&] { ekf.validate(); }), "(accepted)");

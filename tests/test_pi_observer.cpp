@@ -4,6 +4,9 @@
 
 #include <cmath>
 #include <functional>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "nlobs/observers/pi_bank.hpp"
 #include "nlobs/observers/pi_bound.hpp"
@@ -74,7 +77,8 @@ TEST(PiObserver, BankOnSamplesMatchesTheDirectFormToInterpolationAccuracy) {
   channel.initial_estimates = Eigen::Vector2d(0.7, -0.4);
   const auto eta = bank.add_pi("eta", channel);
   const double h = 1e-3;
-  PiBankObserver observer("pi", bank, {eta.eta, eta.rate}, {h, 2});
+  PiBankObserver observer(
+      bank, {.name = "pi", .estimate = {eta.eta, eta.rate}, .sample_time = h, .substeps = 2});
   Eigen::Vector2d e(0.7, -0.4);
   double worst = 0.0;
   for (long k = 0; k <= 5000; ++k) {
@@ -173,7 +177,8 @@ TEST(PiBank, TwoStageCascadeEstimatesVelocityThenAcceleration) {
   const auto v = bank.add_pi("v", {.measured = bank.output(0), .gains = {20, 200}});
   const auto acc = bank.add_pi("acc", {.measured = v.eta, .gains = {20, 200}});
   const double h = 1e-3;
-  PiBankObserver observer("cascade", bank, {v.eta, acc.eta}, {h, 1});
+  PiBankObserver observer(bank,
+                          {.name = "cascade", .estimate = {v.eta, acc.eta}, .sample_time = h});
   const PiBound first = pi_ultimate_bound({20, 200}, 1.0);  // |d cos t / dt| ≤ 1
   double worst_v = 0, worst_acc = 0;
   for (long k = 0; k <= 20000; ++k) {
@@ -196,7 +201,7 @@ TEST(PiBank, VectorEtaOnSeveralOutputs) {
   const auto a = bank.add_pi("a", {.measured = bank.output(0), .gains = {30, 300}});
   const auto b = bank.add_pi("b", {.measured = bank.output(1), .gains = {30, 300}});
   const double h = 1e-3;
-  PiBankObserver observer("two", bank, {a.eta, b.eta}, {h, 1});
+  PiBankObserver observer(bank, {.name = "two", .estimate = {a.eta, b.eta}, .sample_time = h});
   double worst_a = 0, worst_b = 0;
   for (long k = 0; k <= 10000; ++k) {
     const double t = h * static_cast<double>(k);
@@ -216,9 +221,8 @@ TEST(PiBank, StagesMayOnlyReadEarlierSignals) {
   const auto early =
       bank.add_signal("early", [&later](const PiBank::Values& v) { return v[later]; });
   later = bank.add_signal("later", [](const PiBank::Values& v) { return v.time(); });
-  const std::string message = test::message_of([&] {
-    PiBankObserver("bad", bank, {early}, {0.01, 1});
-  });
+  const std::string message = test::message_of(
+      [&] { PiBankObserver(bank, {.name = "bad", .estimate = {early}, .sample_time = 0.01}); });
   EXPECT_NE(message.find("stage 'early' reads 'later'"), std::string::npos) << message;
   EXPECT_THROW(bank.add_signal("later", [](const PiBank::Values&) { return 0.0; }), InvalidInput);
   EXPECT_THROW(bank.add_pi("pi", {.measured = PiBank::Signal{99}, .gains = {1, 1}}), InvalidInput);
@@ -226,8 +230,59 @@ TEST(PiBank, StagesMayOnlyReadEarlierSignals) {
   EXPECT_THROW(bank.add_pi("a0", {.measured = bank.output(0), .a = 0.0, .gains = {1, 1}}),
                InvalidInput);
   EXPECT_THROW(bank.output(1), InvalidInput);
-  EXPECT_THROW(PiBankObserver("t", bank, {early}, {0.0, 1}), InvalidInput);
-  EXPECT_THROW(PiBankObserver("t", bank, {early}, {0.01, 0}), InvalidInput);
+  EXPECT_THROW(PiBankObserver(bank, {.name = "t", .estimate = {early}, .sample_time = 0.0}),
+               InvalidInput);
+  EXPECT_THROW(
+      PiBankObserver(bank, {.name = "t", .estimate = {early}, .sample_time = 0.01, .substeps = 0}),
+      InvalidInput);
+}
+
+TEST(PiBankOptions, ValidateNamesTheFieldAndValue) {
+  PiBank bank(1, 0);  // signals y1, t, eta, eta.rate
+  const auto eta = bank.add_pi("eta", {.measured = bank.output(0), .gains = {8, 15}});
+  const PiBankOptions good{.estimate = {eta.eta, eta.rate}, .sample_time = 0.01};
+  EXPECT_NO_THROW(good.validate());
+  EXPECT_NO_THROW(PiBankObserver(bank, good));
+  EXPECT_EQ(PiBankObserver(bank, good).name(), "pi_bank");
+  const auto refusal = [](const PiBankOptions& o) {
+    return test::message_of([&] { o.validate(); });
+  };
+  // One bad field each, the others as in `good`.
+  const auto with = [&](const std::function<void(PiBankOptions&)>& change) {
+    PiBankOptions o = good;
+    change(o);
+    return o;
+  };
+  const std::vector<std::pair<PiBankOptions, std::string>> cases = {
+      {with([](PiBankOptions& o) { o.sample_time = 0.0; }),
+       "PiBankOptions::sample_time must be finite and > 0 (got 0)"},
+      {with([](PiBankOptions& o) { o.sample_time = std::nan(""); }),
+       "PiBankOptions::sample_time must be finite and > 0 (got nan)"},
+      {with([](PiBankOptions& o) { o.substeps = 0; }),
+       "PiBankOptions::substeps must be >= 1 (got 0)"},
+      {with([](PiBankOptions& o) { o.estimate.clear(); }),
+       "PiBankOptions::estimate must list at least one signal (got {})"},
+      {with([](PiBankOptions& o) { o.estimate[1] = PiBank::Signal{}; }),
+       "PiBankOptions::estimate[1] must be a signal id >= 0 (got -1)"},
+      {with([](PiBankOptions& o) { o.name.clear(); }),
+       "PiBankOptions::name must not be empty (got \"\")"},
+  };
+  for (const auto& [options, expected] : cases) {
+    const std::string message = refusal(options);
+    EXPECT_NE(message.find(expected), std::string::npos) << message;
+  }
+  // The constructor refuses them alike: it calls validate() before its own checks.
+  for (const auto& bad : cases) {
+    EXPECT_EQ(test::message_of([&] { PiBankObserver(bank, bad.first); }), refusal(bad.first));
+  }
+  // A signal of another (larger) bank passes validate(): only the constructor knows the bank.
+  const PiBankOptions foreign = with([](PiBankOptions& o) { o.estimate = {PiBank::Signal{17}}; });
+  EXPECT_NO_THROW(foreign.validate());
+  const std::string message = test::message_of([&] { PiBankObserver(bank, foreign); });
+  EXPECT_NE(
+      message.find("PiBankOptions::estimate[0] = signal 17 is not a signal of the bank (it has 4)"),
+      std::string::npos)
+      << message;
 }
 
 TEST(PiBank, MissingMeasurementsHoldTheStateAndTheGapIsIntegratedInSteps) {
@@ -236,8 +291,8 @@ TEST(PiBank, MissingMeasurementsHoldTheStateAndTheGapIsIntegratedInSteps) {
   PiBank bank(1, 0);
   const auto eta = bank.add_pi("eta", {.measured = bank.output(0), .gains = {49, 700}});
   const double h = 1e-3;
-  PiBankObserver full("full", bank, {eta.eta, eta.rate}, {h, 1});
-  PiBankObserver gappy("gappy", bank, {eta.eta, eta.rate}, {h, 1});
+  PiBankObserver full(bank, {.name = "full", .estimate = {eta.eta, eta.rate}, .sample_time = h});
+  PiBankObserver gappy(bank, {.name = "gappy", .estimate = {eta.eta, eta.rate}, .sample_time = h});
   const auto y = [&](long k) {
     return Eigen::VectorXd::Constant(1, 2.0 * h * static_cast<double>(k));
   };
@@ -264,7 +319,7 @@ TEST(PiBank, AFirstSampleWithNonFiniteSignalsDoesNotStart) {
   const auto inv = bank.add_signal("inverse", [y](const PiBank::Values& v) { return 1.0 / v[y]; });
   const auto eta = bank.add_pi(
       "eta", {.measured = inv, .gains = {8, 15}, .initial_estimates = Eigen::Vector2d::Zero()});
-  PiBankObserver observer("pi", bank, {eta.eta}, {0.1, 1});
+  PiBankObserver observer(bank, {.name = "pi", .estimate = {eta.eta}, .sample_time = 0.1});
   const auto& first = observer.step(0, Eigen::VectorXd::Zero(1), {});
   EXPECT_EQ(first.failure, "non_finite");
   EXPECT_FALSE(first.ready);
@@ -289,7 +344,7 @@ TEST(PiBank, NonFiniteSignalKeepsTheLastGoodStateAndSaysWhere) {
   const auto y = bank.output(0);
   const auto inv = bank.add_signal("inverse", [y](const PiBank::Values& v) { return 1.0 / v[y]; });
   const auto eta = bank.add_pi("eta", {.measured = inv, .gains = {8, 15}});
-  PiBankObserver observer("pi", bank, {eta.eta}, {0.5, 1});
+  PiBankObserver observer(bank, {.name = "pi", .estimate = {eta.eta}, .sample_time = 0.5});
   observer.step(0, Eigen::VectorXd::Constant(1, 1.0), {});
   const Eigen::VectorXd good = observer.step(1, Eigen::VectorXd::Constant(1, 0.5), {}).estimate;
   // [t1, t2] with y from 0.5 to −0.5: the RK4 midpoint hits y = 0.

@@ -2,7 +2,6 @@
 
 #include <numbers>
 #include <sstream>
-#include <stdexcept>
 
 namespace nlobs {
 namespace {
@@ -11,7 +10,7 @@ void require(bool ok, const char* name, double value, const char* requirement) {
   if (!ok) {
     std::ostringstream os;
     os << "ModifiedChuaParameters::" << name << " = " << value << " is invalid: " << requirement;
-    throw std::invalid_argument(os.str());
+    throw InvalidInput(os.str());
   }
 }
 

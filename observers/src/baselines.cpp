@@ -7,61 +7,48 @@
 namespace nlobs {
 namespace {
 
-void require_name(const char* who, const std::string& name) {
-  if (name.empty()) throw InvalidInput(std::string(who) + "::name must not be empty");
-}
-
-void require_finite(const char* who, const char* field, const Eigen::MatrixXd& m) {
-  if (m.size() > 0 && m.allFinite()) return;
-  std::ostringstream os;
-  os << who << "::" << field << " must be given, every entry finite (got " << m.rows() << "x"
-     << m.cols();
-  if (m.size() > 0) os << ": [" << m.reshaped().transpose() << "]";
-  os << ")";
-  throw InvalidInput(os.str());
-}
-
 // An optional covariance: empty (the default is used), or square, finite, symmetric and
 // positive semi-definite.
 void require_covariance(const char* field, const Eigen::MatrixXd& m) {
   if (m.size() == 0) return;
+  std::ostringstream got;
+  got << m.rows() << "x" << m.cols();
   // Square and finite first: the factorisation asserts (or reads out of bounds) otherwise.
-  if (m.rows() == m.cols() && m.allFinite() && m.isApprox(m.transpose())) {
-    const Eigen::LDLT<Eigen::MatrixXd> ldlt(m);
-    if (ldlt.info() == Eigen::Success && ldlt.isPositive()) return;
+  const auto fail = [&](const char* condition, const char* what) {
+    got << what;
+    detail::invalid_option("EkfOptions", field, condition, got.str());
+  };
+  if (m.rows() != m.cols()) fail("be square", "");
+  if (!m.allFinite()) fail("be finite", ", not all entries finite");
+  if (!m.isApprox(m.transpose())) fail("be symmetric", ", not symmetric");
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(m);
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) {
+    fail("be positive semi-definite", ", a negative eigenvalue");
   }
-  std::ostringstream os;
-  os << "EkfOptions::" << field << " (" << m.rows() << "x" << m.cols()
-     << ") must be square, finite, symmetric positive semi-definite";
-  throw InvalidInput(os.str());
 }
 
 }  // namespace
 
 void LuenbergerOptions::validate() const {
-  require_name("LuenbergerOptions", name);
-  require_finite("LuenbergerOptions", "initial_estimate", initial_estimate);
-  require_finite("LuenbergerOptions", "gain", gain);
+  detail::require_name("LuenbergerOptions", name);
+  detail::require_finite("LuenbergerOptions", "initial_estimate", initial_estimate);
+  detail::require_finite("LuenbergerOptions", "gain", gain);
 }
 
 void SlidingModeOptions::validate() const {
-  require_name("SlidingModeOptions", name);
-  require_finite("SlidingModeOptions", "initial_estimate", initial_estimate);
-  require_finite("SlidingModeOptions", "q", q);
-  require_finite("SlidingModeOptions", "r", r);
-  if (!(gamma > 0.0) || !std::isfinite(gamma)) {
-    std::ostringstream os;
-    os << "SlidingModeOptions::gamma = " << gamma << " must be finite and > 0";
-    throw InvalidInput(os.str());
-  }
+  detail::require_name("SlidingModeOptions", name);
+  detail::require_finite("SlidingModeOptions", "initial_estimate", initial_estimate);
+  detail::require_finite("SlidingModeOptions", "q", q);
+  detail::require_finite("SlidingModeOptions", "r", r);
+  detail::require_positive("SlidingModeOptions", "gamma", gamma);
 }
 
 void EkfOptions::validate() const {
-  require_name("EkfOptions", name);
-  require_finite("EkfOptions", "initial_estimate", initial_estimate);
-  require_covariance("process_covariance Q", process_covariance);
-  require_covariance("measurement_covariance R", measurement_covariance);
-  require_covariance("initial_covariance P0", initial_covariance);
+  detail::require_name("EkfOptions", name);
+  detail::require_finite("EkfOptions", "initial_estimate", initial_estimate);
+  require_covariance("process_covariance", process_covariance);
+  require_covariance("measurement_covariance", measurement_covariance);
+  require_covariance("initial_covariance", initial_covariance);
 }
 
 }  // namespace nlobs

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "nlobs/observers/option_checks.hpp"
 #include "nlobs/solvers/status.hpp"
 
 namespace nlobs {
@@ -224,27 +225,40 @@ PiBank::Signal PiBank::evaluate(double t, const Eigen::VectorXd& y, const Eigen:
 
 // ---------------------------------------------------------------------------------------------
 
-PiBankObserver::PiBankObserver(std::string name, PiBank bank, std::vector<PiBank::Signal> estimate,
-                               PiBankOptions options)
-    : name_(std::move(name)),
-      bank_(std::move(bank)),
-      estimate_ids_(std::move(estimate)),
-      options_(options) {
-  if (!(options_.sample_time > 0.0) || !std::isfinite(options_.sample_time)) {
-    throw InvalidInput(name_ + ": sample_time must be finite and > 0, got " +
-                       std::to_string(options_.sample_time));
+void PiBankOptions::validate() const {
+  detail::require_name("PiBankOptions", name);
+  if (estimate.empty()) {
+    detail::invalid_option("PiBankOptions", "estimate", "list at least one signal", "{}");
   }
-  if (options_.substeps < 1) {
-    throw InvalidInput(name_ + ": substeps must be >= 1, got " + std::to_string(options_.substeps));
+  for (size_t i = 0; i < estimate.size(); ++i) {
+    if (estimate[i].id < 0) {
+      std::string field = "estimate[";  // appended: GCC 12's false -Wrestrict, as in PiBank()
+      field.append(std::to_string(i)).append("]");
+      detail::invalid_option("PiBankOptions", field.c_str(), "be a signal id >= 0",
+                             std::to_string(estimate[i].id));
+    }
   }
-  if (estimate_ids_.empty()) throw InvalidInput(name_ + ": the estimate lists no signal");
-  for (const auto& s : estimate_ids_) bank_.signal_name(s);  // throws for unknown ids
+  detail::require_positive("PiBankOptions", "sample_time", sample_time);
+  detail::require_at_least("PiBankOptions", "substeps", static_cast<long>(substeps), 1L);
+}
+
+PiBankObserver::PiBankObserver(PiBank bank, PiBankOptions options)
+    : bank_(std::move(bank)), options_(detail::validated(std::move(options))) {
+  for (size_t i = 0; i < options_.estimate.size(); ++i) {
+    const int id = options_.estimate[i].id;  // >= 0: validated
+    if (id >= bank_.signal_count()) {
+      std::ostringstream os;
+      os << "PiBankOptions::estimate[" << i << "] = signal " << id
+         << " is not a signal of the bank (it has " << bank_.signal_count() << ")";
+      throw InvalidInput(os.str());
+    }
+  }
   extra_ids_ = bank_.stage_signals();
   const Eigen::Index n = bank_.state_size();
   for (Eigen::VectorXd* v : {&state_, &k1_, &k2_, &k3_, &k4_, &trial_, &scratch_}) v->resize(n);
   signals_.resize(bank_.signal_count());
   y_.resize(bank_.outputs());
-  step_.estimate.resize(static_cast<Eigen::Index>(estimate_ids_.size()));
+  step_.estimate.resize(static_cast<Eigen::Index>(options_.estimate.size()));
   step_.extras.resize(static_cast<Eigen::Index>(extra_ids_.size()));
   // A dry evaluation: a stage reading a later signal fails here, at construction.
   bank_.evaluate(0.0, Eigen::VectorXd::Zero(bank_.outputs()), Eigen::VectorXd::Zero(bank_.inputs()),
@@ -265,8 +279,8 @@ void PiBankObserver::reset() {
 }
 
 void PiBankObserver::publish() {
-  for (size_t i = 0; i < estimate_ids_.size(); ++i) {
-    step_.estimate[static_cast<Eigen::Index>(i)] = signals_[estimate_ids_[i].id];
+  for (size_t i = 0; i < options_.estimate.size(); ++i) {
+    step_.estimate[static_cast<Eigen::Index>(i)] = signals_[options_.estimate[i].id];
   }
   for (size_t i = 0; i < extra_ids_.size(); ++i) {
     step_.extras[static_cast<Eigen::Index>(i)] = signals_[extra_ids_[i].id];
@@ -316,7 +330,7 @@ const ObserverStep& PiBankObserver::step(long k, const Eigen::VectorXd& y,
                                          const Eigen::VectorXd& u) {
   if (y.size() != bank_.outputs() || u.size() != bank_.inputs()) {
     std::ostringstream os;
-    os << name_ << ": sample " << k << " has " << y.size() << " outputs and " << u.size()
+    os << options_.name << ": sample " << k << " has " << y.size() << " outputs and " << u.size()
        << " inputs; the bank expects " << bank_.outputs() << " and " << bank_.inputs();
     throw InvalidInput(os.str());
   }
@@ -331,7 +345,7 @@ const ObserverStep& PiBankObserver::step(long k, const Eigen::VectorXd& y,
     const PiBank::Signal bad = bank_.evaluate(t, y, u, state_, signals_, nullptr);
     if (bad.id >= 0 || !state_.allFinite()) {  // not started: try again at the next sample
       std::ostringstream os;
-      os << name_ << ": cannot start at t = " << t << ": signal '"
+      os << options_.name << ": cannot start at t = " << t << ": signal '"
          << (bad.id >= 0 ? bank_.signal_name(bad) : std::string("state")) << "' is not finite";
       step_.failure = "non_finite";
       step_.failure_message = os.str();
@@ -341,7 +355,7 @@ const ObserverStep& PiBankObserver::step(long k, const Eigen::VectorXd& y,
     step_.ready = true;
   } else if (!integrate(last_t_, t, y)) {
     std::ostringstream os;
-    os << name_ << ": ";
+    os << options_.name << ": ";
     if (bad_.id >= 0) {
       os << "signal '" << bank_.signal_name(bad_) << "' is not finite at t = " << bad_t_;
     } else {

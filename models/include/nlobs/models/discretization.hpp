@@ -3,9 +3,9 @@
 // (so window estimators can differentiate them): forward Euler (the fixed-point paper's) and
 // classic RK4. Adaptive and stiff integration go through Boost.Odeint (odeint_discretization.hpp).
 #include <sstream>
-#include <stdexcept>
 #include <string>
 
+#include "nlobs/common/invalid_input.hpp"
 #include "nlobs/models/model.hpp"
 
 namespace nlobs {
@@ -40,12 +40,12 @@ class SampledModel {
   }
 
  protected:
-  // Throws std::invalid_argument when the step is not finite and > 0.
+  // Throws InvalidInput when the step is not finite and > 0.
   SampledModel(Model model, double step) : model_(std::move(model)), step_(step) {
     if (!(step_ > 0.0) || !std::isfinite(step_)) {
       std::ostringstream os;
       os << "discretisation step = " << step_ << " is invalid: must be finite and > 0";
-      throw std::invalid_argument(os.str());
+      throw InvalidInput(os.str());
     }
   }
   Model model_;

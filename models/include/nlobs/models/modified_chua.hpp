@@ -22,7 +22,7 @@ struct ModifiedChuaParameters {
 
 class ModifiedChua : public ModelSizes<3, 0, 1> {
  public:
-  // Throws std::invalid_argument naming the parameter when a value is non-finite or a = 0.
+  // Throws InvalidInput naming the parameter when a value is non-finite or a = 0.
   explicit ModifiedChua(ModifiedChuaParameters parameters = {});
   const ModifiedChuaParameters& parameters() const { return p_; }
 

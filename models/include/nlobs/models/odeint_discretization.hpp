@@ -5,10 +5,11 @@
 // finite differences on it, or the fixed-step Discretized for AD. For stiff systems, the
 // Rosenbrock stepper arrives with the high-gain observer (issue 6), which needs it.
 #include <boost/numeric/odeint.hpp>
+#include <cmath>
 #include <sstream>
-#include <stdexcept>
 #include <vector>
 
+#include "nlobs/common/invalid_input.hpp"
 #include "nlobs/models/discretization.hpp"
 
 namespace nlobs {
@@ -27,9 +28,14 @@ class OdeintDiscretized : public SampledModel<Model> {
 
   OdeintDiscretized(Model model, double step, OdeintOptions options = {})
       : SampledModel<Model>(std::move(model), step), options_(options) {
-    if (!(options_.absolute_tolerance > 0.0) || !(options_.relative_tolerance > 0.0)) {
-      throw std::invalid_argument("OdeintOptions: tolerances must be > 0");
-    }
+    const auto check = [](const char* field, double value) {
+      if (value > 0.0 && std::isfinite(value)) return;
+      std::ostringstream os;
+      os << "OdeintOptions::" << field << " must be finite and > 0 (got " << value << ")";
+      throw InvalidInput(os.str());
+    };
+    check("absolute_tolerance", options_.absolute_tolerance);
+    check("relative_tolerance", options_.relative_tolerance);
   }
 
   template <typename T>

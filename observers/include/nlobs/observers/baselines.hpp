@@ -12,30 +12,11 @@
 
 #include "nlobs/models/model.hpp"
 #include "nlobs/observers/observer.hpp"
+#include "nlobs/observers/option_checks.hpp"
 #include "nlobs/solvers/autodiff.hpp"
 #include "nlobs/solvers/status.hpp"
 
 namespace nlobs {
-namespace detail {
-
-inline void require_shape(const char* who, const char* what, const Eigen::MatrixXd& m,
-                          Eigen::Index rows, Eigen::Index cols) {
-  if (m.rows() != rows || m.cols() != cols || !m.allFinite()) {
-    std::ostringstream os;
-    os << who << ": " << what << " must be a finite " << rows << "x" << cols << " matrix (got "
-       << m.rows() << "x" << m.cols() << ")";
-    throw InvalidInput(os.str());
-  }
-}
-
-// The options after their validate(): for a constructor's initialiser list.
-template <typename Options>
-Options validated(Options options) {
-  options.validate();
-  return options;
-}
-
-}  // namespace detail
 
 struct LuenbergerOptions {
   std::string name = "luenberger";   // in reports

@@ -7,26 +7,35 @@
 #include <string>
 
 #include "nlobs/observers/observer.hpp"
-#include "nlobs/solvers/status.hpp"
+#include "nlobs/observers/option_checks.hpp"
 
 namespace nlobs {
 
+// It needs no model (x is y's phase variables by assumption), so its options are all it takes.
+struct FiniteDifferenceOptions {
+  std::string name = "finite_difference";  // in reports
+  long states = 0;           // n ≥ 1: x̂ = (y, y', …, y⁽ⁿ⁻¹⁾) (required)
+  double sample_time = 0.0;  // δ > 0 between samples (required)
+  // Throws InvalidInput naming the field and value: an empty name, n < 1, δ not finite and > 0.
+  void validate() const {
+    detail::require_name("FiniteDifferenceOptions", name);
+    detail::require_at_least("FiniteDifferenceOptions", "states", states, 1L);
+    detail::require_positive("FiniteDifferenceOptions", "sample_time", sample_time);
+  }
+};
+
 class FiniteDifferenceObserver final : public Observer {
  public:
-  // Throws InvalidInput for states < 1 or a sample time that is not finite and positive.
-  FiniteDifferenceObserver(Eigen::Index states, double sample_time,
-                           std::string name = "finite_difference")
-      : n_(states), delta_(sample_time), name_(std::move(name)) {
-    if (n_ < 1) throw InvalidInput(name_ + ": states must be >= 1");
-    if (!(delta_ > 0.0) || !std::isfinite(delta_)) {
-      throw InvalidInput(name_ + ": the sample time must be finite and > 0");
-    }
+  explicit FiniteDifferenceObserver(FiniteDifferenceOptions options)
+      : options_(detail::validated(std::move(options))),
+        n_(options_.states),
+        delta_(options_.sample_time) {
     history_.resize(n_);
     differences_.resize(n_);
     reset();
   }
 
-  std::string name() const override { return name_; }
+  std::string name() const override { return options_.name; }
   Eigen::Index window() const override { return n_; }
   void reset() override {
     history_.setZero();
@@ -60,14 +69,14 @@ class FiniteDifferenceObserver final : public Observer {
       scale *= delta_;
       estimate_[i] = differences_[0] / scale;
     }
-    accept_finite(estimate_, step_.estimate, step_, name_, k, "the differences");  // huge y
+    accept_finite(estimate_, step_.estimate, step_, options_.name, k, "the differences");  // huge y
     return step_;
   }
 
  private:
+  FiniteDifferenceOptions options_;
   Eigen::Index n_;
   double delta_;
-  std::string name_;
   Eigen::VectorXd history_, differences_, estimate_;
   Eigen::Index filled_ = 0;
   ObserverStep step_;

@@ -7,7 +7,7 @@
 //   ẑ_i' = ẑ_{i+1} + (l_{N−i} / θ^i)(y − ẑ_1),   ẑ_N' = ᾱ(ẑ) + (l_0 / θ^N)(y − ẑ_1),
 // s^N + l_{N−1}s^{N−1} + … + l_0 Hurwitz (roots p_j; the linear error dynamics then has the roots
 // p_j / θ), ᾱ = s_{ρ²}(‖ẑ‖²_P / R²) α the smooth saturation (smooth_saturation.hpp). The state
-// estimate is the projection x̂ = argmin_x ‖ẑ − q_N(x)‖ (any least-squares engine by name,
+// estimate is the projection x̂ = argmin_x ‖ẑ − q_N(x)‖ (any least-squares engine object,
 // warm-started from the previous x̂ or from its prediction through the model), or an explicit
 // inverse when the user has one. The projection can jump where local minima merge or split: jumps
 // larger than a threshold are counted.
@@ -42,6 +42,7 @@
 #include "nlobs/observers/model_derivatives.hpp"
 #include "nlobs/observers/observability_map.hpp"
 #include "nlobs/observers/observer.hpp"
+#include "nlobs/observers/option_checks.hpp"
 #include "nlobs/observers/rk4_stepper.hpp"
 #include "nlobs/observers/sample_interpolator.hpp"
 #include "nlobs/observers/smooth_saturation.hpp"
@@ -97,7 +98,19 @@ EmbeddedInverse explicit_inverse(Form form = {}) {
   };
 }
 
+// What the observer is made of: q_N, α and (optionally) q_N's inverse. The design helpers
+// (high_gain_design.hpp, embedded_forms.hpp, lie_observability_map.hpp) build them.
+struct HighGainDesign {
+  std::shared_ptr<const ObservabilityMap> map{};  // q_N (required)
+  EmbeddedAlpha alpha{};      // empty: α = L_f^N h along the prediction (map->has_next())
+  EmbeddedInverse inverse{};  // empty: x̂ by the projection engine
+};
+
 struct HighGainOptions {
+  std::string name = "high_gain";    // in reports
+  Eigen::VectorXd initial_estimate;  // x̂(0): n finite numbers (required)
+  std::optional<Eigen::VectorXd> initial_embedded_estimate{};  // ẑ(0) (N numbers); unset: q_N(x̂(0))
+  HighGainDesign design{};
   double sample_time = 0.0;
   double theta = 0.1;  // θ > 0: gains l_{N−i} / θ^i
   // Roots p_j of s^N + l_{N−1}s^{N−1} + … + l_0, real and < 0; empty: all at −1 (the paper).
@@ -108,7 +121,6 @@ struct HighGainOptions {
   HighGainIntegrator integrator = HighGainIntegrator::kAuto;
   int substeps = 1;                                               // RK4 steps per sample interval
   double absolute_tolerance = 1e-10, relative_tolerance = 1e-10;  // CVODE
-  std::string projection = "ceres";  // least-squares engine spec (EngineRegistry)
   ProjectionStart start = ProjectionStart::kPrevious;
   double jump_threshold = 0.1;  // ‖x̂_k − x̄(t_k)‖∞ above this is a jump (x̄: prediction)
   double observability_floor = 1e-2;  // ε of the weight of α = L_f^N h (see above)
@@ -119,7 +131,16 @@ struct HighGainOptions {
   // at every sample while ẑ converges (with 100, x̂ wandered at residual ~1 in wrong minima);
   // under noise ẑ stays off the image and every sample restarts — raise it there (cost).
   int restart_every = 1;
+  // Throws InvalidInput naming the field and its value for what the options alone can tell:
+  // an empty name, x̂(0) or ẑ(0) not finite, no map, N < 2, no α from a map that cannot give
+  // L_f^N h, θ, T, tolerances, thresholds out of range, an invalid saturation.
+  void validate() const;
 };
+
+// The solver options of the default projection engine (Ceres): tight step and residual
+// tolerances, 100 iterations — the projection's accuracy bounds x̂'s. Give an engine built
+// from a spec the same (the CLI does): EngineRegistry<n>::global().create(spec, these).
+SolverOptions high_gain_projection_options();
 
 template <ContinuousModel Model>
 class HighGainObserver final : public Observer {
@@ -129,23 +150,20 @@ class HighGainObserver final : public Observer {
   static_assert(Model::kOutputs == 1, "the high-gain observer of [HG-EMB23] has one output");
   using State = ModelVector<double, n>;
 
-  struct Design {
-    std::shared_ptr<const ObservabilityMap> map;  // q_N
-    EmbeddedAlpha alpha{};      // empty: α = L_f^N h along the prediction (map->has_next())
-    EmbeddedInverse inverse{};  // empty: projection by the engine
-  };
+  using Design = HighGainDesign;
 
-  // x̂(0) = xhat0; ẑ(0) = zhat0, or q_N(x̂(0)) when not given. Throws InvalidInput naming the
-  // option for each invalid option, size or start.
-  HighGainObserver(Model model, Design design, const Eigen::VectorXd& xhat0,
-                   HighGainOptions options, std::optional<Eigen::VectorXd> zhat0 = {},
-                   std::string name = "high_gain");
+  // x̂ = argmin ‖ẑ − q_N(x)‖ by `projection` (any least-squares engine, or a square one when
+  // N = n); none given and no explicit inverse: Ceres with high_gain_projection_options().
+  // Throws InvalidInput naming the field for invalid options (HighGainOptions::validate()),
+  // sizes that do not fit the model, a time-varying model, an engine beside an inverse.
+  HighGainObserver(Model model, HighGainOptions options,
+                   std::unique_ptr<Engine<n>> projection = nullptr);
   HighGainObserver(const HighGainObserver&) = delete;
   HighGainObserver& operator=(const HighGainObserver&) = delete;
 
-  std::string name() const override { return name_; }
+  std::string name() const override { return options_.name; }
   std::string engine() const override {
-    return design_.inverse ? "explicit inverse" : options_.projection;
+    return design_.inverse ? "explicit inverse" : engine_->label();
   }
   std::vector<std::string> extra_names() const override { return extra_names_; }
   std::vector<std::string> warnings() const override { return warnings_; }
@@ -206,9 +224,8 @@ class HighGainObserver final : public Observer {
   const ObserverStep& publish();
 
   Model model_;
-  Design design_;
   HighGainOptions options_;
-  std::string name_;
+  const Design& design_ = options_.design;
   ModelDerivatives<Model> derivatives_;
   Eigen::Index N_ = 0;
   bool lie_alpha_ = false, predict_ = false;  // predict_: x̄' = f(x̄) integrated beside ẑ
@@ -236,84 +253,47 @@ class HighGainObserver final : public Observer {
 };
 
 template <ContinuousModel Model>
-HighGainObserver<Model>::HighGainObserver(Model model, Design design, const Eigen::VectorXd& xhat0,
-                                          HighGainOptions options,
-                                          std::optional<Eigen::VectorXd> zhat0, std::string name)
+HighGainObserver<Model>::HighGainObserver(Model model, HighGainOptions options,
+                                          std::unique_ptr<Engine<n>> projection)
     : model_(std::move(model)),
-      design_(std::move(design)),
-      options_(std::move(options)),
-      name_(std::move(name)),
-      derivatives_(model_) {
-  const auto fail = [this](const std::string& what) { throw InvalidInput(name_ + ": " + what); };
-  if (!design_.map) fail("no observability map q_N given");
+      options_(detail::validated(std::move(options))),
+      derivatives_(model_),
+      engine_(std::move(projection)) {
+  const auto fail = [this](const std::string& what) {
+    throw InvalidInput(options_.name + ": " + what);
+  };
   const ObservabilityMap& map = *design_.map;
   N_ = map.dimension();
   if (map.states() != n) {
     fail("the map's state dimension " + std::to_string(map.states()) + " is not the model's " +
          std::to_string(n));
   }
-  if (N_ < n || N_ < 2) {
+  if (N_ < n) {
     fail("N = " + std::to_string(N_) + " is smaller than the state dimension n = " +
-         std::to_string(n) + " (or 2): q_N cannot be injective");
-  }
-  if (!(options_.theta > 0.0) || !std::isfinite(options_.theta)) {
-    fail("HighGainOptions::theta must be finite and > 0 (got " + std::to_string(options_.theta) +
-         ")");
-  }
-  if (!(options_.sample_time > 0.0) || !std::isfinite(options_.sample_time)) {
-    fail("HighGainOptions::sample_time must be finite and > 0");
-  }
-  if (options_.substeps < 1) fail("HighGainOptions::substeps must be >= 1");
-  if (!(options_.absolute_tolerance > 0.0) || !(options_.relative_tolerance > 0.0)) {
-    fail("HighGainOptions::absolute_tolerance and relative_tolerance must be > 0");
-  }
-  if (!(options_.jump_threshold > 0.0)) fail("HighGainOptions::jump_threshold must be > 0");
-  if (options_.restart_every < 1) fail("HighGainOptions::restart_every must be >= 1");
-  if (!(options_.residual_scale > 0.0) || !std::isfinite(options_.residual_scale)) {
-    fail("HighGainOptions::residual_scale must be finite and > 0");
-  }
-  if (!(options_.restart_residual >= 0.0) || !std::isfinite(options_.restart_residual)) {
-    fail("HighGainOptions::restart_residual must be finite and >= 0 (0: never restart)");
+         std::to_string(n) + ": q_N cannot be injective");
   }
   if (vector_field_depends_on_time(model_)) {
     fail("the model's vector field depends on t: this observer is for autonomous x' = f(x)");
   }
-  if (!(options_.observability_floor >= 0.0)) {
-    fail("HighGainOptions::observability_floor must be >= 0");
-  }
   set_coefficients();
-  if (options_.saturation) {
-    try {
-      options_.saturation->validate(N_);
-    } catch (const InvalidInput& e) {
-      fail(std::string("HighGainOptions::saturation: ") + e.what());
-    }
-  }
-  if (!design_.alpha.value && !map.has_next()) {
-    fail("no α given and the map '" + map.description() +
-         "' cannot evaluate L_f^N h (build it from the model: LieObservabilityMap)");
-  }
   lie_alpha_ = !design_.alpha.value;
   predict_ = true;  // x̄ serves α (lie), the warm start (predicted) and the jump test
-  if (xhat0.size() != n || !xhat0.allFinite()) {
-    fail("the initial estimate x̂(0) must be " + std::to_string(n) + " finite numbers");
-  }
-  xhat0_ = xhat0;
+  detail::require_shape("HighGainOptions", "initial_estimate", options_.initial_estimate, n, 1);
+  xhat0_ = options_.initial_estimate;
   zhat0_.resize(N_);
-  if (zhat0) {
-    if (zhat0->size() != N_ || !zhat0->allFinite()) {
-      fail("ẑ(0) must be " + std::to_string(N_) + " finite numbers");
-    }
-    zhat0_ = *zhat0;
+  if (options_.initial_embedded_estimate) {
+    detail::require_shape("HighGainOptions", "initial_embedded_estimate",
+                          *options_.initial_embedded_estimate, N_, 1);
+    zhat0_ = *options_.initial_embedded_estimate;
   } else if (!map.value(xhat0_, zhat0_)) {
     fail("q_N(x̂(0)) is not finite");
   }
+  if (design_.inverse && engine_) {
+    fail("both an explicit inverse and a projection engine given: pass one");
+  }
   if (!design_.inverse) {
-    SolverOptions solver;
-    solver.stop.step_tolerance = 1e-12;
-    solver.stop.residual_tolerance = 1e-13;
-    solver.stop.max_iterations = 100;
-    engine_ = EngineRegistry<n>::global().create(options_.projection, solver);
+    if (!engine_)
+      engine_ = EngineRegistry<n>::global().create("ceres", high_gain_projection_options());
     problem_.emplace(RootProblem<n, Eigen::Dynamic>::with_jacobian(
         [this](const Vector<n>& x, Eigen::VectorXd& r) {
           x_ = x;
@@ -330,7 +310,7 @@ HighGainObserver<Model>::HighGainObserver(Model model, Design design, const Eige
         },
         n, N_));
     if (!engine_->least_squares() && N_ != n) {
-      fail("projection engine '" + options_.projection +
+      fail("projection engine '" + engine_->label() +
            "' solves square systems only (N = n); use ceres or nlopt");
     }
   }
@@ -343,7 +323,7 @@ HighGainObserver<Model>::HighGainObserver(Model model, Design design, const Eige
   }
   if (integrator_ == HighGainIntegrator::kCvode && !ModelDerivatives<Model>::kAutoDiff &&
       predict_) {
-    warnings_.push_back(name_ + ": ∂f for the implicit stepper by central differences");
+    warnings_.push_back(options_.name + ": ∂f for the implicit stepper by central differences");
   }
   for (Eigen::Index i = 0; i < N_; ++i) extra_names_.push_back("zhat" + std::to_string(i + 1));
   extra_names_.push_back("projection_residual");
@@ -372,7 +352,7 @@ template <ContinuousModel Model>
 const ObserverStep& HighGainObserver<Model>::step(long k, const Eigen::VectorXd& y,
                                                   const Eigen::VectorXd& u) {
   if (y.size() != 1 || u.size() != Model::kInputs) {
-    throw InvalidInput(name_ + ": a sample must have 1 output and " +
+    throw InvalidInput(options_.name + ": a sample must have 1 output and " +
                        std::to_string(Model::kInputs) + " inputs");
   }
   const double t = static_cast<double>(k) * options_.sample_time;
@@ -382,11 +362,11 @@ const ObserverStep& HighGainObserver<Model>::step(long k, const Eigen::VectorXd&
   step_.ready = true;
   if (!u.allFinite()) {
     step_.failure = "non_finite";
-    step_.failure_message = name_ + ": u_k is not finite at t = " + std::to_string(t);
+    step_.failure_message = options_.name + ": u_k is not finite at t = " + std::to_string(t);
     return publish();
   }
   if (started_ && !(t > last_t_)) {
-    throw InvalidInput(name_ + ": sample k = " + std::to_string(k) +
+    throw InvalidInput(options_.name + ": sample k = " + std::to_string(k) +
                        " does not come after the last one: samples must arrive in order");
   }
   input_ = u;
@@ -441,11 +421,11 @@ bool HighGainObserver<Model>::derivatives(double t, const double* s, double y, d
 template <ContinuousModel Model>
 void HighGainObserver<Model>::set_coefficients() {
   if (options_.coefficients.size() && !options_.poles.empty()) {
-    throw InvalidInput(name_ + ": give HighGainOptions::poles or coefficients, not both");
+    throw InvalidInput(options_.name + ": give HighGainOptions::poles or coefficients, not both");
   }
   if (options_.coefficients.size()) {
     if (options_.coefficients.size() != N_ || !options_.coefficients.allFinite()) {
-      throw InvalidInput(name_ + ": HighGainOptions::coefficients must be N = " +
+      throw InvalidInput(options_.name + ": HighGainOptions::coefficients must be N = " +
                          std::to_string(N_) + " finite numbers [l_0, …, l_{N−1}]");
     }
     coefficients_ = options_.coefficients;
@@ -453,8 +433,9 @@ void HighGainObserver<Model>::set_coefficients() {
     for (const auto& r : roots) {
       if (!(r.real() < 0.0)) {
         std::ostringstream os;
-        os << name_ << ": HighGainOptions::coefficients are not Hurwitz: s^N + … has the root "
-           << r.real() << (r.imag() >= 0 ? " + " : " - ") << std::abs(r.imag()) << "i";
+        os << options_.name
+           << ": HighGainOptions::coefficients are not Hurwitz: s^N + … has the root " << r.real()
+           << (r.imag() >= 0 ? " + " : " - ") << std::abs(r.imag()) << "i";
         throw InvalidInput(os.str());
       }
     }
@@ -463,13 +444,13 @@ void HighGainObserver<Model>::set_coefficients() {
     std::vector<double> poles = options_.poles;
     if (poles.empty()) poles.assign(static_cast<size_t>(N_), -1.0);
     if (static_cast<Eigen::Index>(poles.size()) != N_) {
-      throw InvalidInput(name_ + ": HighGainOptions::poles must list N = " + std::to_string(N_) +
-                         " roots");
+      throw InvalidInput(options_.name +
+                         ": HighGainOptions::poles must list N = " + std::to_string(N_) + " roots");
     }
     try {
       coefficients_ = hurwitz_coefficients(poles);
     } catch (const InvalidInput& e) {
-      throw InvalidInput(name_ + ": " + e.what());
+      throw InvalidInput(options_.name + ": " + e.what());
     }
     spectral_radius_ = 0.0;
     for (double p : poles) spectral_radius_ = std::max(spectral_radius_, std::abs(p));
@@ -479,8 +460,8 @@ void HighGainObserver<Model>::set_coefficients() {
     gains_[i - 1] = coefficients_[N_ - i] / std::pow(options_.theta, static_cast<double>(i));
   }
   if (!gains_.allFinite()) {
-    throw InvalidInput(name_ + ": HighGainOptions::theta = " + std::to_string(options_.theta) +
-                       " makes the gains l/θ^N overflow");
+    throw InvalidInput(options_.name + ": HighGainOptions::theta = " +
+                       std::to_string(options_.theta) + " makes the gains l/θ^N overflow");
   }
 }
 
@@ -530,7 +511,7 @@ bool HighGainObserver<Model>::integrate(double t0, double t1) {
       rk4_.step(rhs, state_, t0 + static_cast<double>(i) * h, h);
     }
   } else if (!stiff_->integrate(t0, t1, state_.data(), &failure_)) {
-    failure_ = name_ + ": " + failure_;
+    failure_ = options_.name + ": " + failure_;
     finite = false;
   }
   for (Eigen::Index i = 0; i < state_size(); ++i) {
@@ -544,8 +525,8 @@ bool HighGainObserver<Model>::integrate(double t0, double t1) {
   if (!finite) {
     if (failure_.empty()) {
       std::ostringstream os;
-      os << name_ << ": the observer's right-hand side is not finite between t = " << t0 << " and "
-         << t1 << " (ẑ = " << zhat_.transpose() << ")";
+      os << options_.name << ": the observer's right-hand side is not finite between t = " << t0
+         << " and " << t1 << " (ẑ = " << zhat_.transpose() << ")";
       failure_ = os.str();
     }
     return false;
@@ -632,7 +613,7 @@ void HighGainObserver<Model>::project(double t) {
   if (!ok) {
     step_.failure = "projection";
     std::ostringstream os;
-    os << name_ << ": the projection of ẑ = [" << zhat_.transpose() << "] at t = " << t
+    os << options_.name << ": the projection of ẑ = [" << zhat_.transpose() << "] at t = " << t
        << " failed (no finite x̂); x̂ kept";
     step_.failure_message = os.str();
     residual_ = std::numeric_limits<double>::quiet_NaN();  // no x̂ belongs to this ẑ

@@ -13,6 +13,10 @@
 // equation driven by the estimate), reset to y at each sample, fills the grid (Heun's method
 // with η̂ extrapolated over one δ). Before the first horizon the predictor runs on the initial
 // guess (the paper's constant initial function).
+//
+// Built as ModulatingFunctionObserver(form, ModulatingOptions) like every observer: the options
+// hold the name, x̂(0) and the design; ModulatingOptions::validate() (called by the constructor)
+// checks what the options alone can tell, the constructor the sizes against the form.
 #include <Eigen/Core>
 #include <cmath>
 #include <limits>
@@ -23,6 +27,7 @@
 #include "nlobs/observers/modulating_forms.hpp"
 #include "nlobs/observers/modulating_kernel.hpp"
 #include "nlobs/observers/observer.hpp"
+#include "nlobs/observers/option_checks.hpp"
 #include "nlobs/solvers/status.hpp"
 
 namespace nlobs {
@@ -30,6 +35,8 @@ namespace nlobs {
 enum class Quadrature { kTrapezoid, kSimpson };
 
 struct ModulatingOptions {
+  std::string name = "modulating";     // in reports
+  Eigen::VectorXd initial_estimate{};  // x̂(0): the guess for the state, finite (required)
   double sample_time = 0.0;  // δ: the spacing of the samples the observer is stepped with
   double horizon = 1.0;      // T: a multiple of δ, at least 4 intervals
   Quadrature quadrature = Quadrature::kSimpson;  // Simpson needs an even number of intervals
@@ -45,9 +52,15 @@ struct ModulatingOptions {
   double resample_max_gap = 0.0;
   // Theorem 1's bound on |η_j − η̂_j| when an unknown d with |d| ≤ disturbance_level enters
   // η' as disturbance_gains · d (FIR mode; empty: no bound).
-  Eigen::VectorXd disturbance_gains;
+  Eigen::VectorXd disturbance_gains{};
   double disturbance_level = 0.0;
-  std::string name = "modulating";
+  // Throws InvalidInput naming the field and its value: an empty name; an initial estimate
+  // that is empty or not finite; δ or T not finite and positive; T not a multiple of δ, shorter
+  // than 4 intervals, or an odd count of them with Simpson; h neither 0 nor a positive multiple
+  // of δ; a resample gap neither 0 nor finite and ≥ δ; a disturbance level not finite and ≥ 0;
+  // disturbance gains given but not finite. The kernel options need n: the kernel design
+  // checks them (modulating_kernel.hpp), the sizes the constructor.
+  void validate() const;
 };
 
 template <typename Form>
@@ -57,35 +70,29 @@ class ModulatingFunctionObserver final : public Observer {
   using Eta = Vector<n>;
   using State = Vector<nx>;
 
-  // Throws InvalidInput naming the option: δ or T not finite and positive, T not a multiple
-  // of δ or shorter than 4 samples, Simpson with an odd count, h not a multiple of δ, kernel
-  // options (modulating_kernel.hpp), disturbance gains of the wrong size, a bad x̂(0).
-  ModulatingFunctionObserver(Form form, const Eigen::VectorXd& initial, ModulatingOptions options)
-      : form_(std::move(form)), options_(std::move(options)), kernels_(make_kernels()) {
-    if (initial.size() != nx || !initial.allFinite()) {
-      fail("the initial guess must be " + std::to_string(nx) + " finite numbers");
+  // Throws InvalidInput naming the field: ModulatingOptions::validate()'s checks, the kernel
+  // options (modulating_kernel.hpp), an initial estimate of other than Form::state_size entries
+  // or disturbance gains of other than n.
+  ModulatingFunctionObserver(Form form, ModulatingOptions options)
+      : form_(std::move(form)),
+        options_(detail::validated(std::move(options))),
+        kernels_(make_kernels()) {
+    if (options_.initial_estimate.size() != nx) {
+      detail::invalid_option("ModulatingOptions", "initial_estimate",
+                             "have " + std::to_string(nx) + " entries",
+                             std::to_string(options_.initial_estimate.size()));
     }
-    initial_ = initial;
+    if (options_.disturbance_gains.size() != 0 && options_.disturbance_gains.size() != n) {
+      detail::invalid_option("ModulatingOptions", "disturbance_gains",
+                             "have n = " + std::to_string(n) + " entries, or none (no bound)",
+                             std::to_string(options_.disturbance_gains.size()));
+    }
+    initial_ = options_.initial_estimate;
     eta_guess_ = form_.canonical(0.0, initial_);
     const double delta = options_.sample_time;
-    if (options_.sample_period != 0.0) {
-      const double M = options_.sample_period / delta;
-      if (!(M >= 1.0 - 1e-9) || std::abs(M - std::round(M)) > 1e-6 * M) {
-        fail("sample_period must be a positive multiple of the sample time " + fmt(delta));
-      }
-      every_ = std::lround(M);
-    }
+    // validate() checked that h is 0 or a whole number of δ, and the gap 0 or at least δ.
+    if (options_.sample_period != 0.0) every_ = std::lround(options_.sample_period / delta);
     max_gap_ = options_.resample_max_gap == 0.0 ? 4.0 * delta : options_.resample_max_gap;
-    if (!(max_gap_ >= delta) || !std::isfinite(max_gap_)) {
-      fail("resample_max_gap must be at least the sample time " + fmt(delta));
-    }
-    if (options_.disturbance_gains.size() != 0) {
-      if (options_.disturbance_gains.size() != n || !options_.disturbance_gains.allFinite() ||
-          !(options_.disturbance_level >= 0.0) || !std::isfinite(options_.disturbance_level)) {
-        fail("disturbance_gains must be n = " + std::to_string(n) +
-             " finite numbers and disturbance_level finite and >= 0");
-      }
-    }
     // K_{j,i}[m] = (−1)^{i+j+1} w_m φ_j⁽ⁱ⁾(m δ), column j(n+1)+i, m oldest (t − T) to newest.
     weights_.resize(L_ + 1, n * (n + 1));
     for (Eigen::Index m = 0; m <= L_; ++m) {
@@ -264,23 +271,10 @@ class ModulatingFunctionObserver final : public Observer {
   }
 
  private:
+  // validate() checked that T is a whole number L ≥ 4 of δ (even for Simpson).
   ModulatingKernels make_kernels() {
-    const double delta = options_.sample_time, T = options_.horizon;
-    if (!(delta > 0.0) || !std::isfinite(delta)) fail("sample_time must be finite and > 0");
-    if (!(T > 0.0) || !std::isfinite(T)) fail("horizon must be finite and > 0");
-    const double intervals = T / delta;
-    L_ = std::lround(intervals);
-    if (std::abs(intervals - static_cast<double>(L_)) > 1e-6 * intervals) {
-      fail("horizon " + fmt(T) + " is not a multiple of the sample time " + fmt(delta));
-    }
-    if (L_ < 4) {
-      fail("horizon " + fmt(T) + " spans " + std::to_string(L_) +
-           " sample intervals; at least 4 are needed");
-    }
-    if (options_.quadrature == Quadrature::kSimpson && L_ % 2 != 0) {
-      fail("Simpson quadrature needs an even number of intervals per horizon (T/δ = " +
-           std::to_string(L_) + "); change the horizon or use the trapezoid rule");
-    }
+    const double delta = options_.sample_time;
+    L_ = std::lround(options_.horizon / delta);
     // Designed on the span the FIR covers (T within 1e-6 of it).
     return ModulatingKernels(n, static_cast<double>(L_) * delta, options_.kernel);
   }
@@ -416,9 +410,6 @@ class ModulatingFunctionObserver final : public Observer {
     return step_;
   }
 
-  [[noreturn]] void fail(const std::string& what) const {
-    throw InvalidInput(options_.name + ": " + what);
-  }
   static std::string fmt(double v) {
     std::ostringstream os;
     os.precision(12);
@@ -427,6 +418,7 @@ class ModulatingFunctionObserver final : public Observer {
   }
 
   Form form_;
+  // Before L_ and kernels_: make_kernels() reads the validated options and sets L_.
   ModulatingOptions options_;
   Eigen::Index L_ = 0;
   ModulatingKernels kernels_;

@@ -46,6 +46,7 @@
 #include "nlobs/models/catalogue.hpp"
 #include "nlobs/observers/mvt_beta.hpp"
 #include "nlobs/observers/observer.hpp"
+#include "nlobs/observers/option_checks.hpp"
 #include "nlobs/observers/sample_interpolator.hpp"
 
 namespace nlobs {
@@ -54,6 +55,12 @@ enum class MvtVariant { kPublished, kOutputInjection };
 enum class MvtIntegrator { kRk4, kDopri5 };
 
 struct MvtOptions {
+  std::string name = "mvt";          // in reports
+  Eigen::VectorXd initial_estimate;  // x̂(0): n finite numbers (required)
+  // ê(0), the guess of the error x(0) − x̂(0): n finite numbers; empty: 0. ê tracks e exactly
+  // only from ê(0) = x(0) − x̂(0) (the paper's case 1); the output-injection variant recovers
+  // from any other.
+  Eigen::VectorXd initial_error_estimate{};
   double sample_time = 0.0;  // seconds between samples k and k + 1 (> 0)
   double eta = 1.0;          // η ≥ 1 in Ḡ = η diag(α)
   MvtVariant variant = MvtVariant::kOutputInjection;
@@ -61,8 +68,13 @@ struct MvtOptions {
   double injection_gain = 10.0;
   MvtBetaOptions beta{};
   MvtIntegrator integrator = MvtIntegrator::kRk4;
-  int substeps = 1;                                               // RK4 steps per sample interval
-  double absolute_tolerance = 1e-10, relative_tolerance = 1e-10;  // kDopri5
+  int substeps = 1;                   // RK4 steps per sample interval
+  double absolute_tolerance = 1e-10;  // kDopri5
+  double relative_tolerance = 1e-10;  // kDopri5
+  // Throws InvalidInput naming the field and its value: an empty name, an initial estimate
+  // not given or not finite, an error estimate not finite, T, tolerances not finite and > 0,
+  // η < 1, γ < 0, substeps < 1.
+  void validate() const;
 };
 
 template <ContinuousModel Model>
@@ -77,14 +89,13 @@ class MvtObserver final : public Observer {
   using Input = ModelVector<double, M>;
   using Jacobian = Eigen::Matrix<double, N, N>;
 
-  // x̂(0) = xhat0, ê(0) = ehat0. Throws InvalidInput naming the option for invalid options,
-  // sizes or non-finite starts, and when the model's output is not y = [I_m 0] x.
-  MvtObserver(Model model, const Eigen::VectorXd& xhat0, const Eigen::VectorXd& ehat0,
-              MvtOptions options, std::string name = "mvt");
+  // Throws InvalidInput naming the field for invalid options (MvtOptions::validate()), starts
+  // of the wrong size, and when the model's output is not y = [I_m 0] x.
+  MvtObserver(Model model, MvtOptions options);
   MvtObserver(const MvtObserver&) = delete;
   MvtObserver& operator=(const MvtObserver&) = delete;
 
-  std::string name() const override { return name_; }
+  std::string name() const override { return options_.name; }
   std::string engine() const override { return std::string(to_string(options_.beta.method)); }
   std::vector<std::string> extra_names() const override { return extra_names_; }
   std::vector<std::string> warnings() const override { return warnings_; }
@@ -124,7 +135,6 @@ class MvtObserver final : public Observer {
 
   Model model_;  // before beta_solver_, which points to it
   MvtOptions options_;
-  std::string name_;
   State xhat0_ = State::Zero(), ehat0_ = State::Zero();
   std::unique_ptr<MvtBetaSolver<Model>> beta_solver_;
   std::vector<std::string> warnings_, extra_names_;
@@ -140,35 +150,19 @@ class MvtObserver final : public Observer {
 };
 
 template <ContinuousModel Model>
-MvtObserver<Model>::MvtObserver(Model model, const Eigen::VectorXd& xhat0,
-                                const Eigen::VectorXd& ehat0, MvtOptions options, std::string name)
-    : model_(std::move(model)), options_(std::move(options)), name_(std::move(name)) {
-  const auto fail = [](const std::string& what) { throw InvalidInput("MvtObserver: " + what); };
-  const auto start = [&](const Eigen::VectorXd& v, const char* what) {
-    if (v.size() != N || !v.allFinite()) {
-      fail(std::string(what) + " must be " + std::to_string(N) + " finite numbers");
-    }
-    return State(v);
-  };
-  xhat0_ = start(xhat0, "the initial estimate x̂(0)");
-  ehat0_ = start(ehat0, "the initial error estimate ê(0)");
-  if (!(options_.sample_time > 0.0) || !std::isfinite(options_.sample_time)) {
-    fail("MvtOptions::sample_time must be finite and > 0");
-  }
-  if (!(options_.eta >= 1.0) || !std::isfinite(options_.eta)) {
-    fail("MvtOptions::eta must be finite and >= 1 (got " + std::to_string(options_.eta) + ")");
-  }
-  if (!(options_.injection_gain >= 0.0) || !std::isfinite(options_.injection_gain)) {
-    fail("MvtOptions::injection_gain must be finite and >= 0");
-  }
-  if (options_.substeps < 1) fail("MvtOptions::substeps must be >= 1");
-  if (!(options_.absolute_tolerance > 0.0) || !(options_.relative_tolerance > 0.0)) {
-    fail("MvtOptions::absolute_tolerance and relative_tolerance must be > 0");
+MvtObserver<Model>::MvtObserver(Model model, MvtOptions options)
+    : model_(std::move(model)), options_(detail::validated(std::move(options))) {
+  detail::require_shape("MvtOptions", "initial_estimate", options_.initial_estimate, N, 1);
+  xhat0_ = options_.initial_estimate;
+  if (options_.initial_error_estimate.size() != 0) {
+    detail::require_shape("MvtOptions", "initial_error_estimate", options_.initial_error_estimate,
+                          N, 1);
+    ehat0_ = options_.initial_error_estimate;
   }
   check_output_map();
   beta_solver_ = std::make_unique<MvtBetaSolver<Model>>(model_, options_.beta);
   if constexpr (!ModelDerivatives<Model>::kAutoDiff) {
-    warnings_.push_back(name_ +
+    warnings_.push_back(options_.name +
                         ": the model's vector field does not accept ceres::Jet; ∂F by central "
                         "differences (β and D are then accurate to ~1e-7 only)");
   }
@@ -204,10 +198,10 @@ bool MvtObserver<Model>::derivatives(double t, const State& xhat, const State& e
     if (failure_.empty()) {
       std::ostringstream os;
       if (data_ok) {
-        os << name_ << ": F is not finite at t = " << t << " (x̂ = " << xhat.transpose()
+        os << options_.name << ": F is not finite at t = " << t << " (x̂ = " << xhat.transpose()
            << ", x̂ + ê = " << (xhat + ehat).transpose() << ")";
       } else {
-        os << name_ << ": y or u is not finite at t = " << t;
+        os << options_.name << ": y or u is not finite at t = " << t;
       }
       failure_ = os.str();
     }
@@ -222,7 +216,7 @@ bool MvtObserver<Model>::derivatives(double t, const State& xhat, const State& e
     dehat.setZero();
     if (failure_.empty()) {
       std::ostringstream os;
-      os << name_ << ": ∂F is not finite between x̂ and x̂ + ê at t = " << t
+      os << options_.name << ": ∂F is not finite between x̂ and x̂ + ê at t = " << t
          << " (x̂ = " << xhat.transpose() << ", ê = " << ehat.transpose() << ")";
       failure_ = os.str();
     }
@@ -251,8 +245,8 @@ template <ContinuousModel Model>
 const ObserverStep& MvtObserver<Model>::step(long k, const Eigen::VectorXd& y,
                                              const Eigen::VectorXd& u) {
   if (y.size() != P || u.size() != M) {
-    throw InvalidInput(name_ + ": a sample must have " + std::to_string(P) + " outputs and " +
-                       std::to_string(M) + " inputs");
+    throw InvalidInput(options_.name + ": a sample must have " + std::to_string(P) +
+                       " outputs and " + std::to_string(M) + " inputs");
   }
   const double t = static_cast<double>(k) * options_.sample_time;
   step_.failure.clear();
@@ -262,7 +256,7 @@ const ObserverStep& MvtObserver<Model>::step(long k, const Eigen::VectorXd& y,
   max_residual_ = 0.0;
   if (!u.allFinite()) {  // the plant's input is known by assumption: an error, state kept
     step_.failure = "non_finite";
-    step_.failure_message = name_ + ": u_k is not finite at t = " + std::to_string(t);
+    step_.failure_message = options_.name + ": u_k is not finite at t = " + std::to_string(t);
     return publish();
   }
   if (step_.measurement_missing) return publish();  // hold; the next sample bridges the gap
@@ -341,7 +335,7 @@ bool MvtObserver<Model>::integrate(double t0, double t1) {
   }
   const State x = Eigen::Map<const State>(s.data()), e = Eigen::Map<const State>(s.data() + N);
   if (!finite || !x.allFinite() || !e.allFinite()) {
-    if (failure_.empty()) failure_ = name_ + ": the state is not finite after the step";
+    if (failure_.empty()) failure_ = options_.name + ": the state is not finite after the step";
     beta_ = beta0, gains_ = gains0, d_ = d0;  // all that is published stays the last good step's
     return false;
   }

@@ -12,7 +12,8 @@
 //
 // Each stage reads the measured outputs y, the inputs u, the time and the signals of the
 // stages added before it (reading a later one is an error naming both). PiBankObserver runs
-// a bank on samples; docs/observers.md shows the three banks of the paper's examples.
+// a bank on samples, built as PiBankObserver(bank, PiBankOptions) with the bank in the model's
+// place; docs/observers.md shows the three banks of the paper's examples.
 #include <Eigen/Core>
 #include <functional>
 #include <limits>
@@ -118,9 +119,19 @@ class PiBank {
   friend class Values;
 };
 
+// A bank observer's options: the name, the signals that form x̂ and the time stepping. Unlike
+// the other observers' options there is no initial_estimate: a bank's state is its stages'
+// (γ, integrals), so its start stays with them, in each channel's gamma0 / initial_estimates
+// and each integrator's initial value, where the stage that uses it is defined.
 struct PiBankOptions {
-  double sample_time = 0.0;  // seconds between samples k and k + 1 (> 0)
-  int substeps = 1;          // RK4 steps per sample interval
+  std::string name = "pi_bank";            // in reports
+  std::vector<PiBank::Signal> estimate{};  // the signals that form x̂, in the model's state order
+  double sample_time = 0.0;                // seconds between samples k and k + 1 (> 0)
+  int substeps = 1;                        // RK4 steps per sample interval
+  // Throws InvalidInput naming the field and value: an empty name, an empty estimate or one
+  // holding an invalid signal (id < 0, e.g. a default Signal{}), a sample_time not finite and
+  // > 0, substeps < 1. Whether each signal is one of the bank's, only the constructor can tell.
+  void validate() const;
 };
 
 // Runs a bank on samples y_k, u_k at t_k = k·T. Between samples, y is interpolated linearly
@@ -129,12 +140,14 @@ struct PiBankOptions {
 // next good sample integrates across the gap (y interpolated, u held, the same step length); a
 // step whose signals turn non-finite (a stage left its domain) keeps the last good state and
 // reports the signal and time; a first sample whose signals are not finite does not start it.
+// Built as PiBankObserver(bank, PiBankOptions) like every observer, the bank playing the
+// model's part: PiBankOptions::validate() (called by the constructor) checks the options alone,
+// the constructor that each estimate signal is one of the bank's and, by one evaluation on
+// zeros, that no stage reads a later one.
 class PiBankObserver final : public Observer {
  public:
-  // `estimate`: the signals that form x̂, in the model's state order.
-  PiBankObserver(std::string name, PiBank bank, std::vector<PiBank::Signal> estimate,
-                 PiBankOptions options);
-  std::string name() const override { return name_; }
+  PiBankObserver(PiBank bank, PiBankOptions options);
+  std::string name() const override { return options_.name; }
   std::vector<std::string> extra_names() const override;
   void reset() override;
   const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override;
@@ -144,10 +157,9 @@ class PiBankObserver final : public Observer {
   bool integrate(double t0, double t1, const Eigen::VectorXd& y1);
   void publish();
 
-  std::string name_;
   PiBank bank_;
-  std::vector<PiBank::Signal> estimate_ids_, extra_ids_;
-  PiBankOptions options_;
+  PiBankOptions options_;  // validated; options_.estimate are the bank's signals
+  std::vector<PiBank::Signal> extra_ids_;
   bool started_ = false;
   double last_t_ = 0.0;
   Eigen::VectorXd state_, last_y_, last_u_, signals_, y_, k1_, k2_, k3_, k4_, trial_, scratch_;

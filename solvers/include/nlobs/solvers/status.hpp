@@ -5,6 +5,8 @@
 #include <string>
 #include <string_view>
 
+#include "nlobs/common/invalid_input.hpp"
+
 namespace nlobs {
 
 enum class Status {
@@ -23,12 +25,8 @@ enum class Status {
 // Lowercase snake_case name used in reports and JSON ("converged", "max_iterations", ...).
 std::string_view to_string(Status status);
 
-// Thrown for bad input (dimension mismatch, non-finite initial guess, invalid options).
-// The message names the offending option or component and its value.
-class InvalidInput : public std::invalid_argument {
- public:
-  explicit InvalidInput(const std::string& what) : std::invalid_argument(what) {}
-};
+// Bad input (dimension mismatch, non-finite initial guess, invalid options) throws
+// InvalidInput (nlobs/common/invalid_input.hpp), the message naming what and its value.
 
 // How user text (an engine spec, a CSV cell) appears in an error message: single-quoted, cut
 // to max_length characters ("..." after: a hostile megabyte stays one line), control characters

@@ -1,0 +1,70 @@
+#include "nlobs/observers/option_checks.hpp"
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <sstream>
+
+namespace nlobs::detail {
+namespace {
+
+// The shortest text that reads back as the same double: 0.1, not 0.10000000000000001.
+std::string number(double value) {
+  std::array<char, 32> text{};
+  const auto result = std::to_chars(text.data(), text.data() + text.size(), value);
+  return std::string(text.data(), result.ptr);
+}
+
+}  // namespace
+
+void invalid_option(const char* who, const char* field, const std::string& condition,
+                    const std::string& got) {
+  throw InvalidInput(std::string(who) + "::" + field + " must " + condition + " (got " + got + ")");
+}
+
+void require_name(const char* who, const std::string& name) {
+  if (name.empty()) invalid_option(who, "name", "not be empty", "\"\"");
+}
+
+void require_finite(const char* who, const char* field, const Eigen::MatrixXd& m) {
+  if (m.size() > 0 && m.allFinite()) return;
+  std::ostringstream os;
+  os << m.rows() << "x" << m.cols();
+  if (m.size() > 0 && m.size() <= 16) os << ": [" << m.reshaped().transpose() << "]";
+  invalid_option(who, field, "be given, every entry finite", os.str());
+}
+
+void require_positive(const char* who, const char* field, double value) {
+  if (!(value > 0.0) || !std::isfinite(value)) {
+    invalid_option(who, field, "be finite and > 0", number(value));
+  }
+}
+
+void require_non_negative(const char* who, const char* field, double value) {
+  if (!(value >= 0.0) || !std::isfinite(value)) {
+    invalid_option(who, field, "be finite and >= 0", number(value));
+  }
+}
+
+void require_at_least(const char* who, const char* field, double value, double lower) {
+  if (!(value >= lower) || !std::isfinite(value)) {
+    invalid_option(who, field, "be finite and >= " + number(lower), number(value));
+  }
+}
+
+void require_at_least(const char* who, const char* field, long value, long lower) {
+  if (value < lower) {
+    invalid_option(who, field, "be >= " + std::to_string(lower), std::to_string(value));
+  }
+}
+
+void require_shape(const char* who, const char* what, const Eigen::MatrixXd& m, Eigen::Index rows,
+                   Eigen::Index cols) {
+  if (m.rows() == rows && m.cols() == cols && m.allFinite()) return;
+  std::ostringstream os;
+  os << who << ": " << what << " must be a finite " << rows << "x" << cols << " matrix (got "
+     << m.rows() << "x" << m.cols() << (m.allFinite() ? "" : ", not all finite") << ")";
+  throw InvalidInput(os.str());
+}
+
+}  // namespace nlobs::detail
