@@ -172,13 +172,15 @@ std::unique_ptr<Observer> build(Model model, const HighGainSpec& spec, const Eig
     o.initial_embedded_estimate = z;
   }
   // The engine spec belongs to the scenario: built here through the registry, with the
-  // projection's tolerances. An explicit inverse needs none.
+  // projection's tolerances. An explicit inverse needs none. The options are checked first, so
+  // that a bad engine spec does not hide a bad option (the constructor checks them again).
+  o.design = std::move(design);
+  o.validate();
   std::unique_ptr<Engine<Model::kStates>> projection;
-  if (!design.inverse) {
+  if (!o.design.inverse) {
     projection = EngineRegistry<Model::kStates>::global().create(spec.projection,
                                                                  high_gain_projection_options());
   }
-  o.design = std::move(design);
   return std::make_unique<HighGainObserver<Model>>(std::move(model), std::move(o),
                                                    std::move(projection));
 }
@@ -187,7 +189,7 @@ std::unique_ptr<Observer> build(Model model, const HighGainSpec& spec, const Eig
 
 HighGainSpec parse_high_gain_spec(JsonReader& o) {
   HighGainSpec s;
-  s.name = o.text("name").value_or("high_gain");
+  s.name = o.name().value_or("high_gain");
   if (auto v = o.integer("N", 2, 12)) s.N = static_cast<int>(*v);
   s.theta = o.number("theta").value_or(0.1);
   if (!(s.theta > 0.0)) o.fail("'theta' must be > 0");

@@ -94,6 +94,12 @@ std::optional<std::string> JsonReader::text(const std::string& key) {
   return v.get<std::string>();
 }
 
+std::optional<std::string> JsonReader::name(const std::string& key) {
+  std::optional<std::string> s = text(key);
+  if (s && s->empty()) fail("'" + key + "' must not be empty");
+  return s;
+}
+
 std::optional<Eigen::VectorXd> JsonReader::vector(const std::string& key) {
   if (!has(key)) return std::nullopt;
   const auto& v = get(key);

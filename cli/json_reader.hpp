@@ -38,6 +38,8 @@ class JsonReader {
   std::optional<long> integer(const std::string& key, long min, long max);
   std::optional<bool> boolean(const std::string& key);
   std::optional<std::string> text(const std::string& key);
+  // An observer's name: a string, not empty (reports key their rows and files on it).
+  std::optional<std::string> name(const std::string& key = "name");
   std::optional<Eigen::VectorXd> vector(const std::string& key);
   // A matrix as an array of rows; a flat array is a column.
   std::optional<Eigen::MatrixXd> matrix(const std::string& key);

@@ -45,7 +45,7 @@ std::unique_ptr<Observer> build(Form form, const ModulatingSpec& spec, const Eig
 
 ModulatingSpec parse_modulating_spec(JsonReader& o) {
   ModulatingSpec s;
-  s.name = o.text("name").value_or("modulating");
+  s.name = o.name().value_or("modulating");
   s.horizon = o.number("horizon").value_or(1.0);
   if (!(s.horizon > 0.0)) o.fail("'horizon' must be > 0");
   if (auto v = o.integer("order", 1, 20)) s.order = static_cast<int>(*v);

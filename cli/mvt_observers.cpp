@@ -11,7 +11,7 @@ MvtSpec parse_mvt_spec(JsonReader& o) {
   if (s.variant != "injection" && s.variant != "published") {
     o.fail("'variant' must be injection (with the output-injection correction) or published");
   }
-  s.name = o.text("name").value_or("mvt:" + s.variant);
+  s.name = o.name().value_or("mvt:" + s.variant);
   s.error_guess = o.required_vector("error_guess");
   s.eta = o.number("eta").value_or(1.0);
   if (!(s.eta >= 1.0)) o.fail("'eta' must be >= 1");

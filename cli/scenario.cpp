@@ -472,7 +472,7 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
                 "quadrature", "sample_period", "resample", "resample_max_gap", "disturbance_bound",
                 "initial"});
     } else if (spec.type == "finite_difference") {
-      spec.label = o.text("name").value_or("finite_difference");
+      spec.label = o.name().value_or("finite_difference");
       o.finish({"type", "name"});
     } else if (spec.type == "luenberger") {
       spec.gain = o.matrix("gain").value_or(Eigen::MatrixXd());

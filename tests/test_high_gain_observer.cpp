@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "nlobs/models/discretization.hpp"
@@ -702,6 +703,15 @@ struct ShortMap {
   }
 };
 
+// Two coordinates of a three-state system: never injective.
+struct TwoOfThree {
+  static constexpr int kStates = 3, kDimension = 2;
+  template <typename T>
+  Eigen::Matrix<T, 2, 1> operator()(const Eigen::Matrix<T, 3, 1>& x) const {
+    return Eigen::Matrix<T, 2, 1>(x[0], x[1]);
+  }
+};
+
 TEST(HighGainObserver, BadOptionsAreErrorsNamingTheOption) {
   const auto message = [](HighGainOptions o, OscillatorObserver::Design d) {
     try {
@@ -756,7 +766,7 @@ TEST(HighGainObserver, BadOptionsAreErrorsNamingTheOption) {
     ADD_FAILURE() << "accepted";
   } catch (const InvalidInput& e) {
     EXPECT_NE(std::string(e.what()).find(
-                  "initial_embedded_estimate must be a finite 4x1 matrix (got 3x1)"),
+                  "HighGainOptions::initial_embedded_estimate must have 4 entries (got 3)"),
               std::string::npos)
         << e.what();
   }
@@ -769,10 +779,35 @@ TEST(HighGainObserver, BadOptionsAreErrorsNamingTheOption) {
   OscillatorObserver::Design no_alpha = oscillator_design(true);
   no_alpha.alpha = {};
   EXPECT_NE(message(good, no_alpha).find("no α"), std::string::npos);
-  // N smaller than the state dimension.
+  // N = 1: no map of one coordinate is injective (validate()).
   OscillatorObserver::Design short_map = oscillator_design(true);
   short_map.map = std::make_shared<ExplicitObservabilityMap<ShortMap>>();
   EXPECT_NE(message(good, short_map).find("HighGainOptions::design.map must have N >= 2"),
+            std::string::npos);
+  // N = 2 < n = 3 (Lorenz): valid options, refused against the model (the constructor).
+  HighGainOptions lorenz = good;
+  lorenz.saturation.reset();
+  lorenz.design.map = std::make_shared<ExplicitObservabilityMap<TwoOfThree>>();
+  lorenz.design.alpha =
+      EmbeddedAlpha{[](const Eigen::VectorXd&) { return 0.0; },
+                    [](const Eigen::VectorXd&, Eigen::VectorXd& g) { g.setZero(); }};
+  lorenz.initial_estimate = Eigen::Vector3d(1.0, 1.0, 20.0);
+  EXPECT_NO_THROW(lorenz.validate());
+  try {
+    HighGainObserver<Lorenz> refused(Lorenz{}, lorenz);
+    ADD_FAILURE() << "accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("N = 2 is smaller than the state dimension n = 3"),
+              std::string::npos)
+        << e.what();
+  }
+  o = good;
+  o.jump_threshold = std::numeric_limits<double>::infinity();  // count no jump: allowed
+  o.observability_floor = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(message(o, oscillator_design(true)), "accepted");
+  o.jump_threshold = 0.0;
+  EXPECT_NE(message(o, oscillator_design(true))
+                .find("HighGainOptions::jump_threshold must be > 0 (+inf: count no jump) (got 0)"),
             std::string::npos);
 }
 

@@ -524,6 +524,11 @@ TEST(ModulatingOptions, ValidateNamesTheFieldAndValue) {
        "sample_period", "(got inf)"},
       {[](ModulatingOptions& o) { o.resample_max_gap = 0.005; }, "resample_max_gap", "(got 0.005)"},
       {[](ModulatingOptions& o) { o.disturbance_level = -1.0; }, "disturbance_level", "(got -1)"},
+      {[](ModulatingOptions& o) {  // a level is checked without gains too (it was ignored)
+         o.disturbance_gains.resize(0);
+         o.disturbance_level = std::nan("");
+       },
+       "disturbance_level", "(got nan)"},
       {[](ModulatingOptions& o) { o.disturbance_gains = Eigen::Vector2d(1.0, std::nan("")); },
        "disturbance_gains", "nan"},
   };

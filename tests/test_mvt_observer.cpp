@@ -361,7 +361,7 @@ TEST(MvtObserverBadInput, OptionsAndOutputMap) {
   EXPECT_NO_THROW(o.validate());
   EXPECT_NE(test::message_of([&] {
               MvtObserver<ChaoticNoLinear> m(ChaoticNoLinear{}, o);
-            }).find("initial_error_estimate must be a finite 3x1 matrix (got 2x1)"),
+            }).find("MvtOptions::initial_error_estimate must have 3 entries (got 2)"),
             std::string::npos);
   o.initial_error_estimate.resize(0);  // empty: ê(0) = 0
   MvtObserver<ChaoticNoLinear> zero_error(ChaoticNoLinear{}, o);

@@ -279,9 +279,9 @@ TEST(PiBankOptions, ValidateNamesTheFieldAndValue) {
   const PiBankOptions foreign = with([](PiBankOptions& o) { o.estimate = {PiBank::Signal{17}}; });
   EXPECT_NO_THROW(foreign.validate());
   const std::string message = test::message_of([&] { PiBankObserver(bank, foreign); });
-  EXPECT_NE(
-      message.find("PiBankOptions::estimate[0] = signal 17 is not a signal of the bank (it has 4)"),
-      std::string::npos)
+  EXPECT_NE(message.find(
+                "PiBankOptions::estimate[0] must be one of the bank's 4 signals (got signal 17)"),
+            std::string::npos)
       << message;
 }
 

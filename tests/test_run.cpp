@@ -253,6 +253,35 @@ nlohmann::json hostile_high_gain_scenario(const std::string& payload) {
   return j;
 }
 
+// The projection engine is built from the scenario's spec only after the observer's options are
+// checked, so a bad option is not hidden behind a bad spec; both are named. An empty name is
+// refused where it is read.
+TEST(RunErrors, HighGainProjectionSpecAndOptionsAreNamed) {
+  const fs::path base = scratch("hg-projection-errors");
+  fs::create_directories(base);
+  const auto error_with = [&](const std::function<void(nlohmann::json&)>& change) {
+    nlohmann::json j = hostile_high_gain_scenario("hg");
+    j["observers"][0]["inverse"] = false;
+    change(j["observers"][0]);
+    const fs::path file = base / "s.json";
+    write(file, j.dump());
+    return error_of(file.string());
+  };
+  std::string e = error_with([](nlohmann::json& o) { o["projection"] = "no-such-engine"; });
+  EXPECT_NE(e.find("no-such-engine"), std::string::npos) << e;
+  e = error_with([](nlohmann::json& o) {
+    o["projection"] = "no-such-engine";
+    o["jump_threshold"] = 0.0;
+  });
+  EXPECT_NE(e.find("HighGainOptions::jump_threshold must be > 0"), std::string::npos) << e;
+  e = error_with([](nlohmann::json& o) { o["projection"] = "newton"; });  // N = 4 ≠ n = 2
+  EXPECT_NE(e.find("'newton' solves square systems only"), std::string::npos) << e;
+  e = error_with([](nlohmann::json& o) { o["name"] = ""; });
+  EXPECT_NE(e.find("'name' must not be empty"), std::string::npos) << e;
+  EXPECT_EQ(error_with([](nlohmann::json& o) { o["projection"] = "ceres:max_iter=50"; }),
+            "<no error>");
+}
+
 TEST(RunSafety, HostileNamesAndPathsRunNoCommand) {
   const fs::path base = scratch("hostile");
   fs::create_directories(base);

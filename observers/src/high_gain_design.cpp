@@ -16,7 +16,7 @@ Eigen::VectorXd hurwitz_coefficients(const std::vector<double>& poles) {
     const double p = poles[j];
     if (!(p < 0.0) || !std::isfinite(p)) {
       std::ostringstream os;
-      os << "HighGainOptions::poles: " << p << " is not a finite negative real root (Hurwitz)";
+      os << "HighGainOptions::poles must be finite negative real roots (Hurwitz) (got " << p << ")";
       throw InvalidInput(os.str());
     }
     for (Eigen::Index k = static_cast<Eigen::Index>(j) + 1; k > 0; --k) c[k] = c[k - 1] - p * c[k];

@@ -20,17 +20,25 @@ void HighGainOptions::validate() const {
                            "N = " + std::to_string(N));
   }
   if (!design.alpha.value && !design.map->has_next()) {
-    throw InvalidInput(std::string(who) + "::design: no α given and the map '" +
-                       design.map->description() +
-                       "' cannot evaluate L_f^N h (build it from the model: LieObservabilityMap)");
+    detail::invalid_option(who, "design.alpha",
+                           "be given when the map cannot evaluate L_f^N h (build the map from the "
+                           "model, e.g. LieObservabilityMap, for α = L_f^N h)",
+                           "no α, map '" + design.map->description() + "'");
   }
   detail::require_positive(who, "theta", theta);
   detail::require_positive(who, "sample_time", sample_time);
   detail::require_at_least(who, "substeps", static_cast<long>(substeps), 1L);
   detail::require_positive(who, "absolute_tolerance", absolute_tolerance);
   detail::require_positive(who, "relative_tolerance", relative_tolerance);
-  detail::require_positive(who, "jump_threshold", jump_threshold);
-  detail::require_non_negative(who, "observability_floor", observability_floor);
+  // +∞ is meaningful for these two: never count a jump; α = L_f^N h weighted 0 (the chain alone).
+  if (!(jump_threshold > 0.0)) {
+    detail::invalid_option(who, "jump_threshold", "be > 0 (+inf: count no jump)",
+                           detail::option_value(jump_threshold));
+  }
+  if (!(observability_floor >= 0.0)) {
+    detail::invalid_option(who, "observability_floor", "be >= 0 (+inf: the chain without α)",
+                           detail::option_value(observability_floor));
+  }
   detail::require_positive(who, "residual_scale", residual_scale);
   detail::require_non_negative(who, "restart_residual", restart_residual);
   detail::require_at_least(who, "restart_every", static_cast<long>(restart_every), 1L);

@@ -10,19 +10,10 @@ namespace {
 
 constexpr const char* kWho = "ModulatingOptions";
 
-// 12 digits: the value as the user wrote it (0.105, not 0.10499999999999999).
-std::string number(double value) {
-  std::ostringstream os;
-  os.precision(12);
-  os << value;
-  return os.str();
-}
-
 std::string entries(const Eigen::VectorXd& v) {
   std::ostringstream os;
-  os.precision(12);
   os << v.size() << " entries: [";
-  for (Eigen::Index i = 0; i < v.size(); ++i) os << (i ? " " : "") << v[i];
+  for (Eigen::Index i = 0; i < v.size(); ++i) os << (i ? " " : "") << detail::option_value(v[i]);
   os << "]";
   return os.str();
 }
@@ -34,15 +25,17 @@ void ModulatingOptions::validate() const {
   detail::require_finite(kWho, "initial_estimate", initial_estimate);
   detail::require_positive(kWho, "sample_time", sample_time);
   detail::require_positive(kWho, "horizon", horizon);
-  const std::string of_delta = "sample_time " + number(sample_time);
+  const std::string of_delta = "sample_time " + detail::option_value(sample_time);
   // T/δ carries the decimal rounding of both: a whole number to 1e-6 relative.
   const double ratio = horizon / sample_time;
   const long intervals = std::lround(ratio);
   if (std::abs(ratio - static_cast<double>(intervals)) > 1e-6 * ratio) {
-    detail::invalid_option(kWho, "horizon", "be a multiple of " + of_delta, number(horizon));
+    detail::invalid_option(kWho, "horizon", "be a multiple of " + of_delta,
+                           detail::option_value(horizon));
   }
-  const std::string got_intervals = number(horizon) + ": " + std::to_string(intervals) +
-                                    " interval" + (intervals == 1 ? "" : "s");
+  const std::string got_intervals = detail::option_value(horizon) + ": " +
+                                    std::to_string(intervals) + " interval" +
+                                    (intervals == 1 ? "" : "s");
   if (intervals < 4) {
     detail::invalid_option(kWho, "horizon", "span at least 4 intervals of " + of_delta,
                            got_intervals);
@@ -61,7 +54,7 @@ void ModulatingOptions::validate() const {
         std::abs(M - std::round(M)) > 1e-6 * M) {
       detail::invalid_option(kWho, "sample_period",
                              "be 0 (FIR mode) or a positive multiple of " + of_delta,
-                             number(sample_period));
+                             detail::option_value(sample_period));
     }
   }
   // 0 (4 δ) needs no check: T ≥ 4 δ is finite.
@@ -69,7 +62,7 @@ void ModulatingOptions::validate() const {
       (!(resample_max_gap >= sample_time) || !std::isfinite(resample_max_gap))) {
     detail::invalid_option(kWho, "resample_max_gap",
                            "be 0 (for 4 sample_time) or finite and >= " + of_delta,
-                           number(resample_max_gap));
+                           detail::option_value(resample_max_gap));
   }
   detail::require_non_negative(kWho, "disturbance_level", disturbance_level);
   if (disturbance_gains.size() != 0 && !disturbance_gains.allFinite()) {

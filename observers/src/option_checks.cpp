@@ -6,16 +6,12 @@
 #include <sstream>
 
 namespace nlobs::detail {
-namespace {
-
-// The shortest text that reads back as the same double: 0.1, not 0.10000000000000001.
-std::string number(double value) {
+// 0.1, not 0.10000000000000001.
+std::string option_value(double value) {
   std::array<char, 32> text{};
   const auto result = std::to_chars(text.data(), text.data() + text.size(), value);
   return std::string(text.data(), result.ptr);
 }
-
-}  // namespace
 
 void invalid_option(const char* who, const char* field, const std::string& condition,
                     const std::string& got) {
@@ -36,19 +32,19 @@ void require_finite(const char* who, const char* field, const Eigen::MatrixXd& m
 
 void require_positive(const char* who, const char* field, double value) {
   if (!(value > 0.0) || !std::isfinite(value)) {
-    invalid_option(who, field, "be finite and > 0", number(value));
+    invalid_option(who, field, "be finite and > 0", option_value(value));
   }
 }
 
 void require_non_negative(const char* who, const char* field, double value) {
   if (!(value >= 0.0) || !std::isfinite(value)) {
-    invalid_option(who, field, "be finite and >= 0", number(value));
+    invalid_option(who, field, "be finite and >= 0", option_value(value));
   }
 }
 
 void require_at_least(const char* who, const char* field, double value, double lower) {
   if (!(value >= lower) || !std::isfinite(value)) {
-    invalid_option(who, field, "be finite and >= " + number(lower), number(value));
+    invalid_option(who, field, "be finite and >= " + option_value(lower), option_value(value));
   }
 }
 
@@ -58,13 +54,20 @@ void require_at_least(const char* who, const char* field, long value, long lower
   }
 }
 
-void require_shape(const char* who, const char* what, const Eigen::MatrixXd& m, Eigen::Index rows,
+void require_size(const char* who, const char* field, const Eigen::VectorXd& v, Eigen::Index size) {
+  if (v.size() != size) {
+    invalid_option(who, field, "have " + std::to_string(size) + " entries",
+                   std::to_string(v.size()));
+  }
+}
+
+void require_shape(const char* who, const char* field, const Eigen::MatrixXd& m, Eigen::Index rows,
                    Eigen::Index cols) {
   if (m.rows() == rows && m.cols() == cols && m.allFinite()) return;
-  std::ostringstream os;
-  os << who << ": " << what << " must be a finite " << rows << "x" << cols << " matrix (got "
-     << m.rows() << "x" << m.cols() << (m.allFinite() ? "" : ", not all finite") << ")";
-  throw InvalidInput(os.str());
+  std::ostringstream want, got;
+  want << "be a finite " << rows << "x" << cols << " matrix";
+  got << m.rows() << "x" << m.cols() << (m.allFinite() ? "" : ", not all finite");
+  invalid_option(who, field, want.str(), got.str());
 }
 
 }  // namespace nlobs::detail

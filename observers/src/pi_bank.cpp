@@ -247,10 +247,12 @@ PiBankObserver::PiBankObserver(PiBank bank, PiBankOptions options)
   for (size_t i = 0; i < options_.estimate.size(); ++i) {
     const int id = options_.estimate[i].id;  // >= 0: validated
     if (id >= bank_.signal_count()) {
-      std::ostringstream os;
-      os << "PiBankOptions::estimate[" << i << "] = signal " << id
-         << " is not a signal of the bank (it has " << bank_.signal_count() << ")";
-      throw InvalidInput(os.str());
+      std::string field = "estimate[";  // appended: GCC 12's false -Wrestrict, as in PiBank()
+      field.append(std::to_string(i)).append("]");
+      detail::invalid_option(
+          "PiBankOptions", field.c_str(),
+          "be one of the bank's " + std::to_string(bank_.signal_count()) + " signals",
+          "signal " + std::to_string(id));
     }
   }
   extra_ids_ = bank_.stage_signals();

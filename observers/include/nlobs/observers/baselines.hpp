@@ -44,10 +44,10 @@ class LuenbergerObserver final : public Observer {
  public:
   LuenbergerObserver(Model model, LuenbergerOptions options)
       : model_(std::move(model)), options_(detail::validated(std::move(options))) {
-    detail::require_shape("LuenbergerOptions", "gain L", options_.gain, model_.states(),
+    detail::require_shape("LuenbergerOptions", "gain", options_.gain, model_.states(),
                           model_.outputs());
-    detail::require_shape("LuenbergerOptions", "initial_estimate", options_.initial_estimate,
-                          model_.states(), 1);
+    detail::require_size("LuenbergerOptions", "initial_estimate", options_.initial_estimate,
+                         model_.states());
     reset();
   }
   std::string name() const override { return options_.name; }
@@ -87,8 +87,7 @@ class SlidingModeObserver final : public Observer {
     const Eigen::Index n = model_.states(), p = model_.outputs();
     detail::require_shape("SlidingModeOptions", "q", options_.q, n, p);
     detail::require_shape("SlidingModeOptions", "r", options_.r, n, p);
-    detail::require_shape("SlidingModeOptions", "initial_estimate", options_.initial_estimate, n,
-                          1);
+    detail::require_size("SlidingModeOptions", "initial_estimate", options_.initial_estimate, n);
     reset();
   }
   std::string name() const override { return options_.name; }
@@ -147,10 +146,10 @@ class ExtendedKalmanFilter final : public Observer {
              : Eigen::MatrixXd(1e-4 * Eigen::MatrixXd::Identity(p, p));
     p0_ = options.initial_covariance.size() ? options.initial_covariance
                                             : Eigen::MatrixXd(Eigen::MatrixXd::Identity(n, n));
-    detail::require_shape("EkfOptions", "initial_estimate", initial_, n, 1);
-    detail::require_shape("EkfOptions", "process_covariance Q", q_, n, n);
-    detail::require_shape("EkfOptions", "measurement_covariance R", r_, p, p);
-    detail::require_shape("EkfOptions", "initial_covariance P0", p0_, n, n);
+    detail::require_size("EkfOptions", "initial_estimate", initial_, n);
+    detail::require_shape("EkfOptions", "process_covariance", q_, n, n);
+    detail::require_shape("EkfOptions", "measurement_covariance", r_, p, p);
+    detail::require_shape("EkfOptions", "initial_covariance", p0_, n, n);
     reset();
   }
   std::string name() const override { return name_; }

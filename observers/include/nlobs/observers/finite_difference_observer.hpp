@@ -14,12 +14,12 @@ namespace nlobs {
 // It needs no model (x is y's phase variables by assumption), so its options are all it takes.
 struct FiniteDifferenceOptions {
   std::string name = "finite_difference";  // in reports
-  long states = 0;           // n ≥ 1: x̂ = (y, y', …, y⁽ⁿ⁻¹⁾) (required)
+  Eigen::Index states = 0;   // n ≥ 1: x̂ = (y, y', …, y⁽ⁿ⁻¹⁾) (required)
   double sample_time = 0.0;  // δ > 0 between samples (required)
   // Throws InvalidInput naming the field and value: an empty name, n < 1, δ not finite and > 0.
   void validate() const {
     detail::require_name("FiniteDifferenceOptions", name);
-    detail::require_at_least("FiniteDifferenceOptions", "states", states, 1L);
+    detail::require_at_least("FiniteDifferenceOptions", "states", static_cast<long>(states), 1L);
     detail::require_positive("FiniteDifferenceOptions", "sample_time", sample_time);
   }
 };

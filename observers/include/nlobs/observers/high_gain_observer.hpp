@@ -278,12 +278,12 @@ HighGainObserver<Model>::HighGainObserver(Model model, HighGainOptions options,
   set_coefficients();
   lie_alpha_ = !design_.alpha.value;
   predict_ = true;  // x̄ serves α (lie), the warm start (predicted) and the jump test
-  detail::require_shape("HighGainOptions", "initial_estimate", options_.initial_estimate, n, 1);
+  detail::require_size("HighGainOptions", "initial_estimate", options_.initial_estimate, n);
   xhat0_ = options_.initial_estimate;
   zhat0_.resize(N_);
   if (options_.initial_embedded_estimate) {
-    detail::require_shape("HighGainOptions", "initial_embedded_estimate",
-                          *options_.initial_embedded_estimate, N_, 1);
+    detail::require_size("HighGainOptions", "initial_embedded_estimate",
+                         *options_.initial_embedded_estimate, N_);
     zhat0_ = *options_.initial_embedded_estimate;
   } else if (!map.value(xhat0_, zhat0_)) {
     fail("q_N(x̂(0)) is not finite");
@@ -425,18 +425,20 @@ void HighGainObserver<Model>::set_coefficients() {
   }
   if (options_.coefficients.size()) {
     if (options_.coefficients.size() != N_ || !options_.coefficients.allFinite()) {
-      throw InvalidInput(options_.name + ": HighGainOptions::coefficients must be N = " +
-                         std::to_string(N_) + " finite numbers [l_0, …, l_{N−1}]");
+      detail::invalid_option("HighGainOptions", "coefficients",
+                             "be N = " + std::to_string(N_) + " finite numbers [l_0, …, l_{N−1}]",
+                             std::to_string(options_.coefficients.size()) +
+                                 (options_.coefficients.allFinite() ? "" : ", not all finite"));
     }
     coefficients_ = options_.coefficients;
     const Eigen::VectorXcd roots = polynomial_roots(coefficients_);
     for (const auto& r : roots) {
       if (!(r.real() < 0.0)) {
         std::ostringstream os;
-        os << options_.name
-           << ": HighGainOptions::coefficients are not Hurwitz: s^N + … has the root " << r.real()
-           << (r.imag() >= 0 ? " + " : " - ") << std::abs(r.imag()) << "i";
-        throw InvalidInput(os.str());
+        os << "the root " << r.real() << (r.imag() >= 0 ? " + " : " - ") << std::abs(r.imag())
+           << "i: not Hurwitz";
+        detail::invalid_option("HighGainOptions", "coefficients",
+                               "make s^N + l_{N−1}s^{N−1} + … + l_0 Hurwitz", os.str());
       }
     }
     spectral_radius_ = roots.cwiseAbs().maxCoeff();
@@ -444,14 +446,11 @@ void HighGainObserver<Model>::set_coefficients() {
     std::vector<double> poles = options_.poles;
     if (poles.empty()) poles.assign(static_cast<size_t>(N_), -1.0);
     if (static_cast<Eigen::Index>(poles.size()) != N_) {
-      throw InvalidInput(options_.name +
-                         ": HighGainOptions::poles must list N = " + std::to_string(N_) + " roots");
+      detail::invalid_option("HighGainOptions", "poles",
+                             "list N = " + std::to_string(N_) + " roots (or none: all −1)",
+                             std::to_string(poles.size()));
     }
-    try {
-      coefficients_ = hurwitz_coefficients(poles);
-    } catch (const InvalidInput& e) {
-      throw InvalidInput(options_.name + ": " + e.what());
-    }
+    coefficients_ = hurwitz_coefficients(poles);  // refuses a root that is not real and < 0
     spectral_radius_ = 0.0;
     for (double p : poles) spectral_radius_ = std::max(spectral_radius_, std::abs(p));
   }
@@ -460,8 +459,10 @@ void HighGainObserver<Model>::set_coefficients() {
     gains_[i - 1] = coefficients_[N_ - i] / std::pow(options_.theta, static_cast<double>(i));
   }
   if (!gains_.allFinite()) {
-    throw InvalidInput(options_.name + ": HighGainOptions::theta = " +
-                       std::to_string(options_.theta) + " makes the gains l/θ^N overflow");
+    detail::invalid_option(
+        "HighGainOptions", "theta",
+        "keep the gains l_{N−i}/θ^i finite (they overflow for N = " + std::to_string(N_) + ")",
+        detail::option_value(options_.theta));
   }
 }
 

@@ -77,11 +77,7 @@ class ModulatingFunctionObserver final : public Observer {
       : form_(std::move(form)),
         options_(detail::validated(std::move(options))),
         kernels_(make_kernels()) {
-    if (options_.initial_estimate.size() != nx) {
-      detail::invalid_option("ModulatingOptions", "initial_estimate",
-                             "have " + std::to_string(nx) + " entries",
-                             std::to_string(options_.initial_estimate.size()));
-    }
+    detail::require_size("ModulatingOptions", "initial_estimate", options_.initial_estimate, nx);
     if (options_.disturbance_gains.size() != 0 && options_.disturbance_gains.size() != n) {
       detail::invalid_option("ModulatingOptions", "disturbance_gains",
                              "have n = " + std::to_string(n) + " entries, or none (no bound)",

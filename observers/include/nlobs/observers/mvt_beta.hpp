@@ -24,6 +24,7 @@
 #include <string_view>
 
 #include "nlobs/observers/model_derivatives.hpp"
+#include "nlobs/observers/option_checks.hpp"
 #include "nlobs/solvers/ceres_engine.hpp"
 #include "nlobs/solvers/nlopt_engine.hpp"
 #include "nlobs/solvers/status.hpp"
@@ -87,11 +88,9 @@ class MvtBetaSolver {
   // refers to this object).
   MvtBetaSolver(const Model& model, MvtBetaOptions options)
       : derivatives_(model), options_(std::move(options)) {
-    if (!(options_.tolerance > 0.0) || !std::isfinite(options_.tolerance)) {
-      throw InvalidInput("MvtBetaOptions::tolerance must be finite and > 0");
-    }
-    if (options_.max_iterations < 1)
-      throw InvalidInput("MvtBetaOptions::max_iterations must be >= 1");
+    detail::require_positive("MvtBetaOptions", "tolerance", options_.tolerance);
+    detail::require_at_least("MvtBetaOptions", "max_iterations",
+                             static_cast<long>(options_.max_iterations), 1L);
     if (options_.method != MvtBetaMethod::kPerRow) make_engine();
   }
   MvtBetaSolver(const MvtBetaSolver&) = delete;

@@ -152,11 +152,11 @@ class MvtObserver final : public Observer {
 template <ContinuousModel Model>
 MvtObserver<Model>::MvtObserver(Model model, MvtOptions options)
     : model_(std::move(model)), options_(detail::validated(std::move(options))) {
-  detail::require_shape("MvtOptions", "initial_estimate", options_.initial_estimate, N, 1);
+  detail::require_size("MvtOptions", "initial_estimate", options_.initial_estimate, N);
   xhat0_ = options_.initial_estimate;
   if (options_.initial_error_estimate.size() != 0) {
-    detail::require_shape("MvtOptions", "initial_error_estimate", options_.initial_error_estimate,
-                          N, 1);
+    detail::require_size("MvtOptions", "initial_error_estimate", options_.initial_error_estimate,
+                         N);
     ehat0_ = options_.initial_error_estimate;
   }
   check_output_map();

@@ -5,7 +5,7 @@
 #include <Eigen/Core>
 #include <string>
 
-#include "nlobs/solvers/status.hpp"
+#include "nlobs/common/invalid_input.hpp"
 
 namespace nlobs::detail {
 
@@ -21,6 +21,9 @@ Options validated(Options options) {
 [[noreturn]] void invalid_option(const char* who, const char* field, const std::string& condition,
                                  const std::string& got);
 
+// A value as these messages print it: the shortest text that reads back as the same double.
+std::string option_value(double value);
+
 void require_name(const char* who, const std::string& name);  // not empty
 // Given (not empty) and every entry finite.
 void require_finite(const char* who, const char* field, const Eigen::MatrixXd& m);
@@ -29,9 +32,11 @@ void require_non_negative(const char* who, const char* field, double value);  //
 void require_at_least(const char* who, const char* field, double value, double lower);  // finite
 void require_at_least(const char* who, const char* field, long value, long lower);
 
-// A matrix's size and finiteness against the model ("<who>: <what> must be a finite r×c matrix
-// (got …)"): for constructors, after validate().
-void require_shape(const char* who, const char* what, const Eigen::MatrixXd& m, Eigen::Index rows,
+// Sizes against the model, for constructors after validate(): a vector of `size` entries
+// ("<who>::<field> must have 3 entries (got 2)"), a matrix of rows × cols ("… must be 2x1 (got
+// 1x2)"). Finiteness is validate()'s.
+void require_size(const char* who, const char* field, const Eigen::VectorXd& v, Eigen::Index size);
+void require_shape(const char* who, const char* field, const Eigen::MatrixXd& m, Eigen::Index rows,
                    Eigen::Index cols);
 
 }  // namespace nlobs::detail
