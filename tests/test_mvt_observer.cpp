@@ -452,7 +452,7 @@ TEST(MvtObserverBadInput, WrongSampleSizeIsAnError) {
       ChaoticNoLinear{}, started(options(MvtVariant::kPublished), kChaoticXhat0, kCase2Error));
   EXPECT_NE(test::message_of([&] {
               observer.step(0, Eigen::VectorXd::Zero(3), Eigen::VectorXd());
-            }).find("2 outputs"),
+            }).find("the observer takes sizes 2 and 0"),
             std::string::npos);
 }
 

@@ -243,7 +243,9 @@ void PiBankOptions::validate() const {
 }
 
 PiBankObserver::PiBankObserver(PiBank bank, PiBankOptions options)
-    : bank_(std::move(bank)), options_(detail::validated(std::move(options))) {
+    : bank_(std::move(bank)),
+      options_(detail::validated(std::move(options))),
+      clock_(bank_.outputs(), bank_.inputs(), options_.sample_time, /*points=*/2) {
   for (size_t i = 0; i < options_.estimate.size(); ++i) {
     const int id = options_.estimate[i].id;  // >= 0: validated
     if (id >= bank_.signal_count()) {
@@ -257,14 +259,21 @@ PiBankObserver::PiBankObserver(PiBank bank, PiBankOptions options)
   }
   extra_ids_ = bank_.stage_signals();
   const Eigen::Index n = bank_.state_size();
-  for (Eigen::VectorXd* v : {&state_, &k1_, &k2_, &k3_, &k4_, &trial_, &scratch_}) v->resize(n);
+  for (Eigen::VectorXd* v : {&state_, &x_, &dx_}) v->resize(n);
+  trial_.resize(static_cast<size_t>(n));
   signals_.resize(bank_.signal_count());
   y_.resize(bank_.outputs());
+  IntervalIntegratorOptions o;  // classic RK4, `substeps` per interval
+  o.sample_time = options_.sample_time;
+  o.substeps = options_.substeps;
+  interval_.emplace(
+      static_cast<int>(n), [this](double t, const double* s, double* ds) { return rate(t, s, ds); },
+      o);
   step_.estimate.resize(static_cast<Eigen::Index>(options_.estimate.size()));
   step_.extras.resize(static_cast<Eigen::Index>(extra_ids_.size()));
   // A dry evaluation: a stage reading a later signal fails here, at construction.
   bank_.evaluate(0.0, Eigen::VectorXd::Zero(bank_.outputs()), Eigen::VectorXd::Zero(bank_.inputs()),
-                 Eigen::VectorXd::Zero(n), signals_, &k1_);
+                 Eigen::VectorXd::Zero(n), signals_, &dx_);
   reset();
 }
 
@@ -275,7 +284,7 @@ std::vector<std::string> PiBankObserver::extra_names() const {
 }
 
 void PiBankObserver::reset() {
-  started_ = false;
+  clock_.reset();
   step_.estimate.setConstant(std::nan(""));
   step_.extras.setConstant(std::nan(""));
 }
@@ -289,92 +298,70 @@ void PiBankObserver::publish() {
   }
 }
 
-// Classic RK4 over [t0, t1] in `substeps` steps; y moves linearly from last_y_ to y1, u is
-// held at last_u_. On a non-finite signal, returns false with state_ untouched.
-bool PiBankObserver::integrate(double t0, double t1, const Eigen::VectorXd& y1) {
-  trial_ = state_;
-  // After missing samples the interval spans several sample times: keep the step length.
-  const long intervals = std::max(1L, std::lround((t1 - t0) / options_.sample_time));
-  const long steps = intervals * options_.substeps;
-  const double h = (t1 - t0) / static_cast<double>(steps);
-  const auto rhs = [&](double t, const Eigen::VectorXd& x, Eigen::VectorXd& out) {
-    const double w = (t - t0) / (t1 - t0);
-    y_ = (1.0 - w) * last_y_ + w * y1;
-    const PiBank::Signal bad = bank_.evaluate(t, y_, last_u_, x, signals_, &out);
-    if (bad.id >= 0) {
-      bad_ = bad;
-      bad_t_ = t;
-      return false;
-    }
-    return true;
-  };
-  for (long i = 0; i < steps; ++i) {
-    const double t = t0 + h * static_cast<double>(i);
-    if (!rhs(t, trial_, k1_)) return false;
-    scratch_ = trial_ + 0.5 * h * k1_;
-    if (!rhs(t + 0.5 * h, scratch_, k2_)) return false;
-    scratch_ = trial_ + 0.5 * h * k2_;
-    if (!rhs(t + 0.5 * h, scratch_, k3_)) return false;
-    scratch_ = trial_ + h * k3_;
-    if (!rhs(t + h, scratch_, k4_)) return false;
-    trial_ += (h / 6.0) * (k1_ + 2.0 * k2_ + 2.0 * k3_ + k4_);
+bool PiBankObserver::rate(double t, const double* s, double* ds) {
+  const Eigen::Index n = bank_.state_size();
+  x_ = Eigen::Map<const Eigen::VectorXd>(s, n);
+  clock_.output_at(t, y_);
+  const PiBank::Signal bad = bank_.evaluate(t, y_, clock_.held_input(), x_, signals_, &dx_);
+  if (bad.id >= 0) {
+    bad_ = bad;
+    bad_t_ = t;
+    return false;
   }
-  if (!trial_.allFinite()) {
+  Eigen::Map<Eigen::VectorXd>(ds, n) = dx_;
+  return true;
+}
+
+bool PiBankObserver::integrate(double t0, double t1) {
+  Eigen::Map<Eigen::VectorXd>(trial_.data(), state_.size()) = state_;
+  if (!interval_->integrate(t0, t1, trial_)) return false;  // bad_, bad_t_ set by rate()
+  const Eigen::Map<const Eigen::VectorXd> next(trial_.data(), state_.size());
+  if (!next.allFinite()) {
     bad_ = PiBank::Signal{-1};
     bad_t_ = t1;
     return false;
   }
-  state_ = trial_;
+  state_ = next;
   return true;
 }
 
 const ObserverStep& PiBankObserver::step(long k, const Eigen::VectorXd& y,
                                          const Eigen::VectorXd& u) {
-  if (y.size() != bank_.outputs() || u.size() != bank_.inputs()) {
-    std::ostringstream os;
-    os << options_.name << ": sample " << k << " has " << y.size() << " outputs and " << u.size()
-       << " inputs; the bank expects " << bank_.outputs() << " and " << bank_.inputs();
-    throw InvalidInput(os.str());
-  }
-  const double t = static_cast<double>(k) * options_.sample_time;
-  step_.failure.clear();
-  step_.failure_message.clear();
-  step_.measurement_missing = !y.allFinite();
-  step_.ready = started_;
-  if (step_.measurement_missing) return step_;  // hold: the integral states keep their value
-  if (!started_) {
-    state_ = bank_.initial_state(t, y, u);
-    const PiBank::Signal bad = bank_.evaluate(t, y, u, state_, signals_, nullptr);
-    if (bad.id >= 0 || !state_.allFinite()) {  // not started: try again at the next sample
-      std::ostringstream os;
-      os << options_.name << ": cannot start at t = " << t << ": signal '"
-         << (bad.id >= 0 ? bank_.signal_name(bad) : std::string("state")) << "' is not finite";
-      step_.failure = "non_finite";
-      step_.failure_message = os.str();
-      return step_;
+  step_.ready = clock_.started();
+  switch (clock_.receive(options_.name, k, y, u, step_)) {
+    case SampledData<Eigen::Dynamic, Eigen::Dynamic>::kHold:
+      return step_;  // the integral states keep their value
+    case SampledData<Eigen::Dynamic, Eigen::Dynamic>::kStart: {
+      const double t = clock_.time();
+      state_ = bank_.initial_state(t, y, u);
+      const PiBank::Signal bad = bank_.evaluate(t, y, u, state_, signals_, nullptr);
+      if (bad.id >= 0 || !state_.allFinite()) {  // not started: try again at the next sample
+        std::ostringstream os;
+        os << options_.name << ": cannot start at t = " << t << ": signal '"
+           << (bad.id >= 0 ? bank_.signal_name(bad) : std::string("state")) << "' is not finite";
+        clock_.reject(step_, os.str());
+        return step_;
+      }
+      break;
     }
-    started_ = true;
-    step_.ready = true;
-  } else if (!integrate(last_t_, t, y)) {
-    std::ostringstream os;
-    os << options_.name << ": ";
-    if (bad_.id >= 0) {
-      os << "signal '" << bank_.signal_name(bad_) << "' is not finite at t = " << bad_t_;
-    } else {
-      os << "the state became non-finite by t = " << bad_t_;
-    }
-    os << "; kept the estimate of t = " << last_t_;
-    step_.failure = "non_finite";
-    step_.failure_message = os.str();
-    last_t_ = t;  // resume from the next interval, with the last good state
-    last_y_ = y;
-    last_u_ = u;
-    return step_;
+    case SampledData<Eigen::Dynamic, Eigen::Dynamic>::kIntegrate:
+      if (!integrate(clock_.last_time(), clock_.time())) {
+        std::ostringstream os;
+        os << options_.name << ": ";
+        if (bad_.id >= 0) {
+          os << "signal '" << bank_.signal_name(bad_) << "' is not finite at t = " << bad_t_;
+        } else {
+          os << "the state became non-finite by t = " << bad_t_;
+        }
+        os << "; kept the estimate of t = " << clock_.last_time();
+        clock_.reject(step_, os.str());  // the next sample goes on from the last good state
+        return step_;
+      }
+      break;
   }
-  last_t_ = t;
-  last_y_ = y;
-  last_u_ = u;
-  bank_.evaluate(t, y, u, state_, signals_, nullptr);
+  clock_.accept();
+  step_.ready = true;
+  bank_.evaluate(clock_.time(), y, u, state_, signals_, nullptr);
   publish();
   return step_;
 }

@@ -51,8 +51,8 @@ StiffIntegrator::StiffIntegrator(int size, Rhs rhs, Jacobian jacobian, double re
                                  double absolute_tolerance)
     : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
-  if (size < 1 || !rhs || !jacobian || !(relative_tolerance > 0.0) || !(absolute_tolerance > 0.0)) {
-    throw InvalidInput("StiffIntegrator: size >= 1, both functions and tolerances > 0 required");
+  if (size < 1 || !rhs || !(relative_tolerance > 0.0) || !(absolute_tolerance > 0.0)) {
+    throw InvalidInput("StiffIntegrator: size >= 1, F and tolerances > 0 required");
   }
   s.size = size;
   s.rhs = std::move(rhs);
@@ -76,7 +76,8 @@ StiffIntegrator::StiffIntegrator(int size, Rhs rhs, Jacobian jacobian, double re
         "CVodeSStolerances");
   check(CVodeSetUserData(s.cvode, &s) == CV_SUCCESS, "CVodeSetUserData");
   check(CVodeSetLinearSolver(s.cvode, s.solver, s.matrix) == CV_SUCCESS, "CVodeSetLinearSolver");
-  check(CVodeSetJacFn(s.cvode, Impl::jac) == CV_SUCCESS, "CVodeSetJacFn");
+  // Without the caller's Jacobian CVODE forms it by difference quotients.
+  if (s.jacobian) check(CVodeSetJacFn(s.cvode, Impl::jac) == CV_SUCCESS, "CVodeSetJacFn");
   check(CVodeSetMaxNumSteps(s.cvode, 20000) == CV_SUCCESS, "CVodeSetMaxNumSteps");
   // Its messages go to stderr by default; failures reach the caller as text instead.
   CVodeSetErrHandlerFn(

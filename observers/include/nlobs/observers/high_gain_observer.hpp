@@ -20,11 +20,12 @@
 // w = σ² / (σ² + ε²), σ = σ_min(∂q_N/∂x) at x̂ (ε = observability_floor): the observer falls back
 // to the pure integrator chain there.
 //
-// Between samples y is the cubic through the last four good samples (sample_interpolator.hpp).
-// Integration: RK4 (Boost.Odeint) with `substeps` per sample, or SUNDIALS CVODE (BDF, dense,
-// our Jacobian; stiff_integrator.hpp) for stiff gains; `auto` picks CVODE when h · max|p_j| / θ
-// exceeds 0.2 (bench BM_HighGainIntegrator: RK4 is as accurate and ~200× cheaper up to 0.1, its
-// error reaches 1e-2 at 0.33 and it diverges beyond 2.8; docs/observers.md).
+// Samples as in every sampled-data observer (sampled_data.hpp): y between samples is the cubic
+// through the last four good samples, u held. Integration (interval_integrator.hpp): RK4 with
+// `substeps` per sample, or SUNDIALS CVODE (BDF, dense, our Jacobian) for stiff gains; `auto` picks
+// CVODE when h · max|p_j| / θ exceeds 0.2 (bench BM_HighGainIntegrator: RK4 is as accurate and
+// ~200× cheaper up to 0.1, its error reaches 1e-2 at 0.33 and it diverges beyond 2.8;
+// docs/observers.md).
 #include <Eigen/Core>
 #include <cmath>
 #include <complex>
@@ -39,14 +40,13 @@
 #include "nlobs/models/catalogue.hpp"
 #include "nlobs/models/model.hpp"
 #include "nlobs/observers/high_gain_design.hpp"
+#include "nlobs/observers/interval_integrator.hpp"
 #include "nlobs/observers/model_derivatives.hpp"
 #include "nlobs/observers/observability_map.hpp"
 #include "nlobs/observers/observer.hpp"
 #include "nlobs/observers/option_checks.hpp"
-#include "nlobs/observers/rk4_stepper.hpp"
-#include "nlobs/observers/sample_interpolator.hpp"
+#include "nlobs/observers/sampled_data.hpp"
 #include "nlobs/observers/smooth_saturation.hpp"
-#include "nlobs/observers/stiff_integrator.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 
 namespace nlobs {
@@ -240,15 +240,14 @@ class HighGainObserver final : public Observer {
   Eigen::MatrixXd dq_;
   mutable Eigen::VectorXd x_;
   Eigen::VectorXd xd_ = Eigen::VectorXd::Zero(n);  // x̄ for the map's (dynamic-size) interface
-  typename Model::Input input_ = Model::Input::Zero();
-  SampleInterpolator<1> samples_;
-  bool started_ = false, started_once_ = false;
-  double last_t_ = 0.0, residual_ = 0.0, weight_ = 1.0;
+  typename Model::Input input_ = Model::Input::Zero();  // u_{k−1}, held over the interval
+  SampledData<1, Model::kInputs> clock_{1, Model::kInputs, options_.sample_time};  // y: cubic
+  bool started_once_ = false;
+  double residual_ = 0.0, weight_ = 1.0;
   long jumps_ = 0, samples_since_restart_ = 0;
   std::string failure_;
   std::vector<double> state_;
-  std::unique_ptr<StiffIntegrator> stiff_;
-  Rk4Stepper rk4_;
+  std::optional<IntervalIntegrator> interval_;
   ObserverStep step_;
 };
 
@@ -337,9 +336,7 @@ template <ContinuousModel Model>
 void HighGainObserver<Model>::reset() {
   zhat_ = zhat0_;
   xhat_ = xhat0_;
-  samples_.clear();
-  started_ = false;
-  last_t_ = 0.0;
+  clock_.reset();
   jumps_ = 0;
   residual_ = 0.0;
   weight_ = 1.0;
@@ -351,37 +348,22 @@ void HighGainObserver<Model>::reset() {
 template <ContinuousModel Model>
 const ObserverStep& HighGainObserver<Model>::step(long k, const Eigen::VectorXd& y,
                                                   const Eigen::VectorXd& u) {
-  if (y.size() != 1 || u.size() != Model::kInputs) {
-    throw InvalidInput(options_.name + ": a sample must have 1 output and " +
-                       std::to_string(Model::kInputs) + " inputs");
-  }
-  const double t = static_cast<double>(k) * options_.sample_time;
-  step_.failure.clear();
-  step_.failure_message.clear();
-  step_.measurement_missing = !y.allFinite();
   step_.ready = true;
-  if (!u.allFinite()) {
-    step_.failure = "non_finite";
-    step_.failure_message = options_.name + ": u_k is not finite at t = " + std::to_string(t);
-    return publish();
+  switch (clock_.receive(options_.name, k, y, u, step_)) {
+    case SampledData<1, Model::kInputs>::kHold:
+      return publish();
+    case SampledData<1, Model::kInputs>::kStart:
+      break;
+    case SampledData<1, Model::kInputs>::kIntegrate:
+      input_ = clock_.held_input();
+      if (!integrate(clock_.last_time(), clock_.time())) {
+        clock_.reject(step_, failure_);  // the last good state; the next sample goes on from it
+        return publish();
+      }
+      break;
   }
-  if (started_ && !(t > last_t_)) {
-    throw InvalidInput(options_.name + ": sample k = " + std::to_string(k) +
-                       " does not come after the last one: samples must arrive in order");
-  }
-  input_ = u;
-  if (step_.measurement_missing) return publish();  // hold; the next sample bridges the gap
-  const SampleInterpolator<1> before = samples_;
-  samples_.push(t, Eigen::Matrix<double, 1, 1>(y[0]));
-  if (started_ && !integrate(last_t_, t)) {
-    samples_ = before;  // the sample that broke the step does not shape the next ones
-    step_.failure = "non_finite";
-    step_.failure_message = failure_;
-    return publish();  // the last good state; the next sample integrates from last_t_
-  }
-  started_ = true;
-  last_t_ = t;
-  project(t);
+  clock_.accept();
+  project(clock_.time());
   return publish();
 }
 
@@ -477,19 +459,24 @@ void HighGainObserver<Model>::allocate() {
   state_.assign(static_cast<size_t>(state_size()), 0.0);
   step_.estimate.resize(n);
   step_.extras.resize(static_cast<Eigen::Index>(extra_names_.size()));
-  if (integrator_ == HighGainIntegrator::kCvode) {
-    const Eigen::Index size = state_size();
-    stiff_ = std::make_unique<StiffIntegrator>(
-        static_cast<int>(size),
-        [this](double t, const double* s, double* ds) {
-          return derivatives(t, s, samples_.at(t)[0], ds);
-        },
-        [this, size](double t, const double* s, double* j) {
-          Eigen::Map<Eigen::MatrixXd> jac(j, size, size);
-          jacobian(t, s, jac);
-        },
-        options_.relative_tolerance, options_.absolute_tolerance);
-  }
+  IntervalIntegratorOptions o;
+  o.scheme =
+      integrator_ == HighGainIntegrator::kCvode ? IntervalScheme::kCvode : IntervalScheme::kRk4;
+  o.sample_time = options_.sample_time;
+  o.substeps = options_.substeps;
+  o.absolute_tolerance = options_.absolute_tolerance;
+  o.relative_tolerance = options_.relative_tolerance;
+  const Eigen::Index size = state_size();
+  interval_.emplace(
+      static_cast<int>(size),
+      [this](double t, const double* s, double* ds) {
+        return derivatives(t, s, clock_.output_at(t)[0], ds);
+      },
+      o,
+      [this, size](double t, const double* s, double* j) {
+        Eigen::Map<Eigen::MatrixXd> jac(j, size, size);
+        jacobian(t, s, jac);
+      });
 }
 
 template <ContinuousModel Model>
@@ -499,22 +486,8 @@ bool HighGainObserver<Model>::integrate(double t0, double t1) {
   if (predict_) {
     for (int i = 0; i < n; ++i) state_[static_cast<size_t>(N_ + i)] = xhat_[i];
   }
-  bool finite = true;
-  const long intervals = std::max(1L, std::lround((t1 - t0) / options_.sample_time));
-  if (integrator_ == HighGainIntegrator::kRk4) {
-    const Rk4Stepper::Rhs rhs = [this, &finite](double t, const std::vector<double>& s,
-                                                std::vector<double>& ds) {
-      finite = derivatives(t, s.data(), samples_.at(t)[0], ds.data()) && finite;
-    };
-    const long steps = intervals * options_.substeps;
-    const double h = (t1 - t0) / static_cast<double>(steps);
-    for (long i = 0; i < steps && finite; ++i) {
-      rk4_.step(rhs, state_, t0 + static_cast<double>(i) * h, h);
-    }
-  } else if (!stiff_->integrate(t0, t1, state_.data(), &failure_)) {
-    failure_ = options_.name + ": " + failure_;
-    finite = false;
-  }
+  bool finite = interval_->integrate(t0, t1, state_, &failure_);
+  if (!finite && !failure_.empty()) failure_ = options_.name + ": " + failure_;  // CVODE's reason
   for (Eigen::Index i = 0; i < state_size(); ++i) {
     if (std::isfinite(state_[static_cast<size_t>(i)])) continue;
     if (i < N_ || lie_alpha_) {

@@ -30,13 +30,13 @@
 // are not bounded here. When ν ≡ 0 (case 1) the correction is identically zero. Measured in
 // docs/observers.md.
 //
-// On samples: the interval [t_{k−1}, t_k] is integrated when y_k arrives (Boost.Odeint, RK4
-// with `substeps` steps per sample, or adaptive Dormand–Prince); y between samples is the cubic
+// On samples (sampled_data.hpp, the skeleton the MVT, high-gain and PI-bank observers share):
+// the interval [t_{k−1}, t_k] is integrated when y_k arrives (interval_integrator.hpp: RK4 with
+// `substeps` steps per sample, or adaptive Dormand–Prince); y between samples is the cubic
 // through the last four good samples, u is held (the plant's sampled input). β is solved inside
 // the right-hand side at every evaluation, warm-started from the last β. The β and Ḡ published
 // with x̂_k are those of the step's last right-hand side (RK4's last stage, at t_k).
 #include <array>
-#include <boost/numeric/odeint.hpp>
 #include <cmath>
 #include <memory>
 #include <sstream>
@@ -44,10 +44,11 @@
 #include <vector>
 
 #include "nlobs/models/catalogue.hpp"
+#include "nlobs/observers/interval_integrator.hpp"
 #include "nlobs/observers/mvt_beta.hpp"
 #include "nlobs/observers/observer.hpp"
 #include "nlobs/observers/option_checks.hpp"
-#include "nlobs/observers/sample_interpolator.hpp"
+#include "nlobs/observers/sampled_data.hpp"
 
 namespace nlobs {
 
@@ -123,13 +124,12 @@ class MvtObserver final : public Observer {
   const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override;
 
  private:
-  using Augmented = std::array<double, 2 * N>;
-
   // y = C x with C = [I_m 0]: h(x) must equal the first m states at a few distinct points.
   void check_output_map() const;
 
-  // [t0, t1] with Boost.Odeint; false (state untouched) when F turned non-finite.
+  // [t0, t1] (interval_integrator.hpp); false (state untouched) when F turned non-finite.
   bool integrate(double t0, double t1);
+  IntervalIntegrator make_integrator();
 
   const ObserverStep& publish();
 
@@ -140,12 +140,11 @@ class MvtObserver final : public Observer {
   std::vector<std::string> warnings_, extra_names_;
   State xhat_ = State::Zero(), ehat_ = State::Zero(), beta_ = State::Zero(), gains_ = State::Zero();
   Jacobian d_ = Jacobian::Zero(), j_w_ = Jacobian::Zero();
-  bool started_ = false;
-  SampleInterpolator<P> samples_;  // y between samples: the cubic through the last four
-  double last_t_ = 0.0, max_residual_ = 0.0;
-  Input last_u_ = Input::Zero();
+  SampledData<P, M> clock_{P, M, options_.sample_time};  // y between samples: the cubic
+  double max_residual_ = 0.0;
   std::string failure_;
-  boost::numeric::odeint::runge_kutta4<Augmented> rk4_;
+  std::vector<double> state_ = std::vector<double>(2 * N);  // (x̂, ê) for the integrator
+  IntervalIntegrator integrator_ = make_integrator();
   ObserverStep step_;
 };
 
@@ -181,10 +180,7 @@ void MvtObserver<Model>::reset() {
   ehat_ = ehat0_;
   beta_.setConstant(0.5);
   gains_.setZero();
-  started_ = false;
-  samples_.clear();
-  last_t_ = 0.0;
-  last_u_.setZero();
+  clock_.reset();
   max_residual_ = 0.0;
 }
 
@@ -244,41 +240,29 @@ bool MvtObserver<Model>::derivatives(double t, const State& xhat, const State& e
 template <ContinuousModel Model>
 const ObserverStep& MvtObserver<Model>::step(long k, const Eigen::VectorXd& y,
                                              const Eigen::VectorXd& u) {
-  if (y.size() != P || u.size() != M) {
-    throw InvalidInput(options_.name + ": a sample must have " + std::to_string(P) +
-                       " outputs and " + std::to_string(M) + " inputs");
-  }
-  const double t = static_cast<double>(k) * options_.sample_time;
-  step_.failure.clear();
-  step_.failure_message.clear();
-  step_.measurement_missing = !y.allFinite();
   step_.ready = true;
   max_residual_ = 0.0;
-  if (!u.allFinite()) {  // the plant's input is known by assumption: an error, state kept
-    step_.failure = "non_finite";
-    step_.failure_message = options_.name + ": u_k is not finite at t = " + std::to_string(t);
-    return publish();
-  }
-  if (step_.measurement_missing) return publish();  // hold; the next sample bridges the gap
-  const SampleInterpolator<P> before = samples_;
-  samples_.push(t, Output(y));
-  if (!started_) {
-    // The first sample: the state is the initial condition; evaluate once to report β.
-    failure_.clear();
-    State dx, de;
-    if (!derivatives(t, xhat_, ehat_, Output(y), Input(u), dx, de)) {
-      step_.failure = "non_finite";
-      step_.failure_message = failure_;
+  switch (clock_.receive(options_.name, k, y, u, step_)) {
+    case SampledData<P, M>::kHold:
+      return publish();
+    case SampledData<P, M>::kStart: {
+      // The first sample: the state is the initial condition; evaluate once to report β.
+      failure_.clear();
+      State dx, de;
+      if (!derivatives(clock_.time(), xhat_, ehat_, Output(y), Input(u), dx, de)) {
+        step_.failure = "non_finite";
+        step_.failure_message = failure_;
+      }
+      break;
     }
-    started_ = true;
-  } else if (!integrate(last_t_, t)) {
-    samples_ = before;  // the sample that broke the step does not shape the next ones
-    step_.failure = "non_finite";
-    step_.failure_message = failure_;
-    return publish();  // the last good state; the next sample integrates from last_t_
+    case SampledData<P, M>::kIntegrate:
+      if (!integrate(clock_.last_time(), clock_.time())) {
+        clock_.reject(step_, failure_);  // the last good state; the next sample goes on from it
+        return publish();
+      }
+      break;
   }
-  last_t_ = t;
-  last_u_ = u;
+  clock_.accept();
   return publish();
 }
 
@@ -299,41 +283,38 @@ void MvtObserver<Model>::check_output_map() const {
 }
 
 template <ContinuousModel Model>
+IntervalIntegrator MvtObserver<Model>::make_integrator() {
+  IntervalIntegratorOptions o;
+  o.scheme = options_.integrator == MvtIntegrator::kDopri5 ? IntervalScheme::kDopri5
+                                                           : IntervalScheme::kRk4;
+  o.sample_time = options_.sample_time;
+  o.substeps = options_.substeps;
+  o.absolute_tolerance = options_.absolute_tolerance;
+  o.relative_tolerance = options_.relative_tolerance;
+  return IntervalIntegrator(
+      2 * N,
+      [this](double t, const double* z, double* dz) {
+        State dx, de;
+        const bool finite =
+            derivatives(t, Eigen::Map<const State>(z), Eigen::Map<const State>(z + N),
+                        clock_.output_at(t), clock_.held_input(), dx, de);
+        Eigen::Map<State>{dz} = dx;
+        Eigen::Map<State>(dz + N) = de;
+        return finite;
+      },
+      o);
+}
+
+template <ContinuousModel Model>
 bool MvtObserver<Model>::integrate(double t0, double t1) {
-  namespace odeint = boost::numeric::odeint;
   failure_.clear();
   const State beta0 = beta_, gains0 = gains_;
   const Jacobian d0 = d_;
-  Augmented s;
-  Eigen::Map<State>(s.data()) = xhat_;
-  Eigen::Map<State>(s.data() + N) = ehat_;
-  bool finite = true;
-  const auto rhs = [this, &finite](const Augmented& z, Augmented& dz, double t) {
-    State dx, de;
-    finite = derivatives(t, Eigen::Map<const State>(z.data()),
-                         Eigen::Map<const State>(z.data() + N), samples_.at(t), last_u_, dx, de) &&
-             finite;
-    Eigen::Map<State>(dz.data()) = dx;
-    Eigen::Map<State>(dz.data() + N) = de;
-  };
-  // After missing samples the interval spans several sample times: keep the step length.
-  const long intervals = std::max(1L, std::lround((t1 - t0) / options_.sample_time));
-  if (options_.integrator == MvtIntegrator::kRk4) {
-    const long steps = intervals * options_.substeps;
-    const double h = (t1 - t0) / static_cast<double>(steps);
-    for (long i = 0; i < steps && finite; ++i) {
-      rk4_.do_step(rhs, s, t0 + static_cast<double>(i) * h, h);
-    }
-  } else {
-    auto stepper = odeint::make_controlled<odeint::runge_kutta_dopri5<Augmented>>(
-        options_.absolute_tolerance, options_.relative_tolerance);
-    try {
-      odeint::integrate_adaptive(stepper, rhs, s, t0, t1, options_.sample_time / options_.substeps);
-    } catch (const odeint::step_adjustment_error&) {
-      finite = false;
-    }
-  }
-  const State x = Eigen::Map<const State>(s.data()), e = Eigen::Map<const State>(s.data() + N);
+  Eigen::Map<State>(state_.data()) = xhat_;
+  Eigen::Map<State>(state_.data() + N) = ehat_;
+  const bool finite = integrator_.integrate(t0, t1, state_);
+  const State x = Eigen::Map<const State>(state_.data()),
+              e = Eigen::Map<const State>(state_.data() + N);
   if (!finite || !x.allFinite() || !e.allFinite()) {
     if (failure_.empty()) failure_ = options_.name + ": the state is not finite after the step";
     beta_ = beta0, gains_ = gains0, d_ = d0;  // all that is published stays the last good step's

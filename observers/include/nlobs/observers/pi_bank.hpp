@@ -21,8 +21,10 @@
 #include <string>
 #include <vector>
 
+#include "nlobs/observers/interval_integrator.hpp"
 #include "nlobs/observers/observer.hpp"
 #include "nlobs/observers/pi_observer.hpp"
+#include "nlobs/observers/sampled_data.hpp"
 
 namespace nlobs {
 
@@ -134,12 +136,14 @@ struct PiBankOptions {
   void validate() const;
 };
 
-// Runs a bank on samples y_k, u_k at t_k = k·T. Between samples, y is interpolated linearly
-// (the interval [t_{k−1}, t_k] is integrated when y_k arrives, so x̂_k uses data up to t_k) and
-// u is held (the plant's sampled input). A non-finite y_k is skipped with the state held; the
-// next good sample integrates across the gap (y interpolated, u held, the same step length); a
-// step whose signals turn non-finite (a stage left its domain) keeps the last good state and
-// reports the signal and time; a first sample whose signals are not finite does not start it.
+// Runs a bank on samples y_k, u_k at t_k = k·T, as every sampled-data observer does
+// (sampled_data.hpp): between samples y is interpolated linearly (the interval [t_{k−1}, t_k] is
+// integrated by RK4 when y_k arrives, so x̂_k uses data up to t_k) and u is held (the plant's
+// sampled input). A non-finite y_k is skipped with the state held, a non-finite u_k reported
+// with the state held; the next good sample integrates across the gap (y interpolated, u held,
+// the same step length). A step whose signals turn non-finite (a stage left its domain) keeps
+// the last good state and reports the signal and time, and the sample is dropped as if missing;
+// a first sample whose signals are not finite does not start the bank.
 // Built as PiBankObserver(bank, PiBankOptions) like every observer, the bank playing the
 // model's part: PiBankOptions::validate() (called by the constructor) checks the options alone,
 // the constructor that each estimate signal is one of the bank's and, by one evaluation on
@@ -154,15 +158,20 @@ class PiBankObserver final : public Observer {
   const PiBank& bank() const { return bank_; }
 
  private:
-  bool integrate(double t0, double t1, const Eigen::VectorXd& y1);
+  // [t0, t1] (interval_integrator.hpp); false, state_ untouched, when a signal is not finite.
+  bool integrate(double t0, double t1);
+  // The bank's rate at (t, s) with y(t) interpolated and u held; false at a non-finite signal.
+  bool rate(double t, const double* s, double* ds);
   void publish();
 
   PiBank bank_;
   PiBankOptions options_;  // validated; options_.estimate are the bank's signals
   std::vector<PiBank::Signal> extra_ids_;
-  bool started_ = false;
-  double last_t_ = 0.0;
-  Eigen::VectorXd state_, last_y_, last_u_, signals_, y_, k1_, k2_, k3_, k4_, trial_, scratch_;
+  // y between samples: the line through the last two good ones.
+  SampledData<Eigen::Dynamic, Eigen::Dynamic> clock_;
+  std::optional<IntervalIntegrator> interval_;
+  Eigen::VectorXd state_, signals_, y_, x_, dx_;
+  std::vector<double> trial_;
   PiBank::Signal bad_{};
   double bad_t_ = 0.0;
   ObserverStep step_;

@@ -14,7 +14,7 @@ class StiffIntegrator {
  public:
   // ds = F(t, s); false when F is not finite at s.
   using Rhs = std::function<bool(double t, const double* s, double* ds)>;
-  // J = ∂F/∂s at (t, s), column-major size × size.
+  // J = ∂F/∂s at (t, s), column-major size × size; empty: CVODE's difference quotients.
   using Jacobian = std::function<void(double t, const double* s, double* jacobian)>;
 
   StiffIntegrator(int size, Rhs rhs, Jacobian jacobian, double relative_tolerance,
