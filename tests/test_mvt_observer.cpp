@@ -447,6 +447,21 @@ TEST(MvtObserverBadInput, NonFiniteInputKeepsTheState) {
   EXPECT_TRUE(observer.xhat().allFinite());
 }
 
+// A repeated sample is an error naming it; after reset() the observer starts again at k = 0.
+TEST(MvtObserverBadInput, SamplesComeInOrderAndResetStartsAgain) {
+  MvtObserver<ChaoticNoLinear> observer(
+      ChaoticNoLinear{}, started(options(MvtVariant::kPublished), kChaoticXhat0, kCase2Error));
+  const Eigen::VectorXd y = kChaoticX0.head<2>(), u(0);
+  observer.step(0, y, u);
+  const Eigen::Vector3d first = observer.step(1, y, u).estimate;
+  EXPECT_NE(
+      test::message_of([&] { observer.step(1, y, u); }).find("sample k = 1 does not come after"),
+      std::string::npos);
+  observer.reset();
+  EXPECT_TRUE(observer.step(0, y, u).failure.empty());
+  EXPECT_EQ(observer.step(1, y, u).estimate, first);  // the same run again
+}
+
 TEST(MvtObserverBadInput, WrongSampleSizeIsAnError) {
   MvtObserver<ChaoticNoLinear> observer(
       ChaoticNoLinear{}, started(options(MvtVariant::kPublished), kChaoticXhat0, kCase2Error));

@@ -1,6 +1,7 @@
 // The sampled-data skeleton (sampled_data.hpp) and the one interval integrator
 // (interval_integrator.hpp) that the MVT, high-gain and PI-bank observers share: each rule once
-// here, on an ODE with a known solution, and then through one observer of each family.
+// here, on an ODE with a known solution, and through the PI bank and the MVT observer (the
+// families' own tests cover the rest).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -126,11 +127,16 @@ TEST(SampledData, HoldStartIntegrateRejectInOnePlace) {
   EXPECT_EQ(step.failure, "non_finite");
   EXPECT_EQ(step.failure_message, "obs: went wrong");
   EXPECT_NEAR(clock.output_at(0.75)[0], 1.0, 1e-15);  // the one sample left
-  EXPECT_EQ(clock.receive("obs", 4, Eigen::VectorXd::Constant(1, 3.0), u, step), Clock::kIntegrate);
+  EXPECT_EQ(clock.receive("obs", 4, Eigen::VectorXd::Constant(1, 3.0),
+                          Eigen::VectorXd::Constant(1, 7.0), step),
+            Clock::kIntegrate);
   EXPECT_EQ(clock.last_time(), 0.0);
+  EXPECT_EQ(clock.held_input()[0], 2.0);  // u_0 over [t_0, t_4]: the rejected u_3 never held
   clock.accept();
   EXPECT_EQ(clock.last_time(), 2.0);
-  EXPECT_EQ(clock.held_input()[0], 2.0);
+  EXPECT_EQ(clock.held_input()[0], 7.0);  // u_4, for the next interval
+  clock.reset();  // k = 0 again after a reset is a new start, not an order error
+  EXPECT_EQ(clock.receive("obs", 0, y0, u, step), Clock::kStart);
 }
 
 TEST(SampledData, SizesAndOrderAreErrors) {
@@ -167,6 +173,25 @@ TEST(SampledData, APiBankResumesFromTheLastGoodStateAfterAFailedStep) {
   const Eigen::VectorXd after = failing.step(3, sample(0.6), {}).estimate;
   EXPECT_EQ(after, reference.step(3, sample(0.6), {}).estimate);
   EXPECT_TRUE(after.allFinite());
+}
+
+// A bank of signals only has nothing to integrate; a signal that leaves its domain is still
+// caught at the sample, not published.
+TEST(SampledData, ABankOfSignalsOnlyStillReportsANonFiniteSignal) {
+  PiBank bank(1, 0);
+  const auto y = bank.output(0);
+  const auto inv = bank.add_signal("inverse", [y](const PiBank::Values& v) { return 1.0 / v[y]; });
+  ASSERT_EQ(bank.state_size(), 0);
+  PiBankObserver observer(bank, {.name = "pi", .estimate = {inv}, .sample_time = 0.5});
+  const auto sample = [](double v) { return Eigen::VectorXd::Constant(1, v); };
+  EXPECT_EQ(observer.step(0, sample(2.0), {}).estimate[0], 0.5);
+  const ObserverStep& bad = observer.step(1, sample(0.0), {});
+  EXPECT_EQ(bad.failure, "non_finite");
+  EXPECT_NE(bad.failure_message.find("signal 'inverse' is not finite at t = 0.5"),
+            std::string::npos)
+      << bad.failure_message;
+  EXPECT_EQ(bad.estimate[0], 0.5);  // the last good one
+  EXPECT_EQ(observer.step(2, sample(4.0), {}).estimate[0], 0.25);
 }
 
 }  // namespace

@@ -58,13 +58,15 @@ IntervalIntegrator::IntervalIntegrator(int size, Rhs rhs, IntervalIntegratorOpti
   Impl& s = *impl_;
   s.rhs = std::move(rhs);
   s.options = options;
-  s.dopri5.emplace(odeint::make_controlled<odeint::runge_kutta_dopri5<State>>(
-      options.absolute_tolerance, options.relative_tolerance));
   s.size = size;
   // Odeint sizes its stages at the first step: do it here, so that no step allocates.
   const State shape(static_cast<size_t>(size), 0.0);
-  s.rk4.adjust_size(shape);
-  s.dopri5->adjust_size(shape);
+  if (options.scheme == IntervalScheme::kRk4) s.rk4.adjust_size(shape);
+  if (options.scheme == IntervalScheme::kDopri5) {
+    s.dopri5.emplace(odeint::make_controlled<odeint::runge_kutta_dopri5<State>>(
+        options.absolute_tolerance, options.relative_tolerance));
+    s.dopri5->adjust_size(shape);
+  }
   if (options.scheme == IntervalScheme::kCvode && size > 0) {
     s.cvode = std::make_unique<StiffIntegrator>(
         size, s.rhs, std::move(jacobian), options.relative_tolerance, options.absolute_tolerance);

@@ -312,16 +312,25 @@ bool PiBankObserver::rate(double t, const double* s, double* ds) {
   return true;
 }
 
-bool PiBankObserver::integrate(double t0, double t1) {
+bool PiBankObserver::integrate(double t0, double t1, const Eigen::VectorXd& y1,
+                               const Eigen::VectorXd& u1) {
   Eigen::Map<Eigen::VectorXd>(trial_.data(), state_.size()) = state_;
   if (!interval_->integrate(t0, t1, trial_)) return false;  // bad_, bad_t_ set by rate()
-  const Eigen::Map<const Eigen::VectorXd> next(trial_.data(), state_.size());
-  if (!next.allFinite()) {
+  x_ = Eigen::Map<const Eigen::VectorXd>(trial_.data(), state_.size());
+  if (!x_.allFinite()) {
     bad_ = PiBank::Signal{-1};
     bad_t_ = t1;
     return false;
   }
-  state_ = next;
+  // The signals at t1 from the new state, as they will be published: a bank of signals only
+  // (nothing to integrate) or one whose signals leave their domain exactly at t1 fails here.
+  const PiBank::Signal bad = bank_.evaluate(t1, y1, u1, x_, signals_, nullptr);
+  if (bad.id >= 0) {
+    bad_ = bad;
+    bad_t_ = t1;
+    return false;
+  }
+  state_ = x_;
   return true;
 }
 
@@ -345,7 +354,7 @@ const ObserverStep& PiBankObserver::step(long k, const Eigen::VectorXd& y,
       break;
     }
     case SampledData<Eigen::Dynamic, Eigen::Dynamic>::kIntegrate:
-      if (!integrate(clock_.last_time(), clock_.time())) {
+      if (!integrate(clock_.last_time(), clock_.time(), y, u)) {
         std::ostringstream os;
         os << options_.name << ": ";
         if (bad_.id >= 0) {
@@ -361,7 +370,6 @@ const ObserverStep& PiBankObserver::step(long k, const Eigen::VectorXd& y,
   }
   clock_.accept();
   step_.ready = true;
-  bank_.evaluate(clock_.time(), y, u, state_, signals_, nullptr);
   publish();
   return step_;
 }

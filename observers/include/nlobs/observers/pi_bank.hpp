@@ -158,8 +158,9 @@ class PiBankObserver final : public Observer {
   const PiBank& bank() const { return bank_; }
 
  private:
-  // [t0, t1] (interval_integrator.hpp); false, state_ untouched, when a signal is not finite.
-  bool integrate(double t0, double t1);
+  // [t0, t1] (interval_integrator.hpp), then the signals at t1 (y1, u1); false, state_
+  // untouched, when a signal is not finite on the way or at t1.
+  bool integrate(double t0, double t1, const Eigen::VectorXd& y1, const Eigen::VectorXd& u1);
   // The bank's rate at (t, s) with y(t) interpolated and u held; false at a non-finite signal.
   bool rate(double t, const double* s, double* ds);
   void publish();

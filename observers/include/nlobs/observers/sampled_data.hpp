@@ -26,6 +26,7 @@
 #include <cmath>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "nlobs/common/invalid_input.hpp"
 #include "nlobs/observers/observer.hpp"
