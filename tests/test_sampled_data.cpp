@@ -194,5 +194,26 @@ TEST(SampledData, ABankOfSignalsOnlyStillReportsANonFiniteSignal) {
   EXPECT_EQ(observer.step(2, sample(4.0), {}).estimate[0], 0.25);
 }
 
+// Hostile values: an integrator at 1e308 with rate 1e308 overflows within the first interval.
+// The step is refused with a failure naming the signal, the published estimate stays the last
+// finite one, and the bank keeps refusing (its state cannot get back) instead of publishing inf.
+TEST(SampledData, AnOverflowingBankStateIsRefusedNotPublished) {
+  PiBank bank(1, 0);
+  const auto blow = bank.add_integrator(
+      "blow", [](const PiBank::Values& v) { return 1e308 + 0.0 * v.time(); }, 1e308);
+  PiBankObserver observer(bank, {.name = "pi", .estimate = {blow}, .sample_time = 1.0});
+  const auto sample = [](double v) { return Eigen::VectorXd::Constant(1, v); };
+  EXPECT_EQ(observer.step(0, sample(1.0), {}).estimate[0], 1e308);
+  for (long k = 1; k < 4; ++k) {
+    const ObserverStep& s = observer.step(k, sample(1.0), {});
+    EXPECT_EQ(s.failure, "non_finite") << k;
+    // Each later sample integrates from the last good state (t = 0), whose first RK4 step
+    // already overflows at its end, t = 1.
+    EXPECT_EQ(s.failure_message,
+              "pi: signal 'blow' is not finite at t = 1; kept the estimate of t = 0");
+    EXPECT_EQ(s.estimate[0], 1e308) << k;
+  }
+}
+
 }  // namespace
 }  // namespace nlobs

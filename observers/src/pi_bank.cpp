@@ -225,6 +225,17 @@ PiBank::Signal PiBank::evaluate(double t, const Eigen::VectorXd& y, const Eigen:
 
 // ---------------------------------------------------------------------------------------------
 
+namespace {
+
+// "estimate[i]", appended piecewise: GCC 12's false -Wrestrict, as in PiBank().
+std::string estimate_field(size_t i) {
+  std::string field = "estimate[";
+  field.append(std::to_string(i)).append("]");
+  return field;
+}
+
+}  // namespace
+
 void PiBankOptions::validate() const {
   detail::require_name("PiBankOptions", name);
   if (estimate.empty()) {
@@ -232,9 +243,7 @@ void PiBankOptions::validate() const {
   }
   for (size_t i = 0; i < estimate.size(); ++i) {
     if (estimate[i].id < 0) {
-      std::string field = "estimate[";  // appended: GCC 12's false -Wrestrict, as in PiBank()
-      field.append(std::to_string(i)).append("]");
-      detail::invalid_option("PiBankOptions", field.c_str(), "be a signal id >= 0",
+      detail::invalid_option("PiBankOptions", estimate_field(i).c_str(), "be a signal id >= 0",
                              std::to_string(estimate[i].id));
     }
   }
@@ -249,10 +258,8 @@ PiBankObserver::PiBankObserver(PiBank bank, PiBankOptions options)
   for (size_t i = 0; i < options_.estimate.size(); ++i) {
     const int id = options_.estimate[i].id;  // >= 0: validated
     if (id >= bank_.signal_count()) {
-      std::string field = "estimate[";  // appended: GCC 12's false -Wrestrict, as in PiBank()
-      field.append(std::to_string(i)).append("]");
       detail::invalid_option(
-          "PiBankOptions", field.c_str(),
+          "PiBankOptions", estimate_field(i).c_str(),
           "be one of the bank's " + std::to_string(bank_.signal_count()) + " signals",
           "signal " + std::to_string(id));
     }
