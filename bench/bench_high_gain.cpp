@@ -40,11 +40,12 @@ void run(benchmark::State& state, const Measurements& data,
     auto observer = make();
     state.ResumeTiming();
     for (Eigen::Index k = 0; k < data.steps(); ++k) {
-      failures += observer->step(k, data.y.col(k), data.u.col(k)).failure.empty() ? 0 : 1;
+      failures +=
+          observer->step(k, data.t[k], data.y.col(k), data.u.col(k)).failure.empty() ? 0 : 1;
     }
     steps += data.steps();
     const Eigen::Index last = data.steps() - 1;
-    z_error = (observer->coordinates_of(data.x.col(last)) - observer->zhat()).norm();
+    z_error = (observer->coordinates_at(data.x.col(last), data.t[last]) - observer->zhat()).norm();
   }
   state.counters["z_error"] = z_error;
   state.counters["failures"] = static_cast<double>(failures);

@@ -38,7 +38,7 @@ void BM_ModulatingStep(benchmark::State& state) {
     ModulatingFunctionObserver<LtiInjectionForm> observer(LtiInjectionForm{}, o);
     state.ResumeTiming();
     for (Eigen::Index k = 0; k < data.steps(); ++k) {
-      observer.step(k, data.y.col(k), data.u.col(k));
+      observer.step(k, data.t[k], data.y.col(k), data.u.col(k));
     }
     const Eigen::Index K = data.steps() - 1;
     error = (observer.coordinates_at(data.x.col(K), data.t[K]) - Eigen::VectorXd(observer.eta()))

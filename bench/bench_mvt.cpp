@@ -77,8 +77,8 @@ void step(benchmark::State& state, const Example<Model>& example, MvtBetaMethod 
       k = 0;
     }
     const nlobs::ObserverStep& s =
-        observer.step(k, ys[static_cast<size_t>(k)], us[static_cast<size_t>(k)]);
-    worst = std::max(worst, s.extras[0]);
+        observer.step(k, example.data.t[k], ys[static_cast<size_t>(k)], us[static_cast<size_t>(k)]);
+    worst = std::max(worst, s.signals[0]);
     benchmark::DoNotOptimize(s.estimate.data());
     ++k;
   }

@@ -42,7 +42,7 @@ void BM_PiBankStepLander(benchmark::State& state) {
       k = 0;
     }
     benchmark::DoNotOptimize(
-        observer.step(k, ys[static_cast<size_t>(k)], us[static_cast<size_t>(k)]));
+        observer.step(k, data.t[k], ys[static_cast<size_t>(k)], us[static_cast<size_t>(k)]));
     ++k;
   }
 }

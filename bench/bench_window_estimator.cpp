@@ -40,16 +40,16 @@ void window_step(benchmark::State& state, const char* engine) {
                                          nlobs::EngineRegistry<3>::global().create(engine, solver));
   const Eigen::VectorXd no_input(0);
   // Past the first windows: the steady state of a run.
-  for (long k = 0; k < 50; ++k) estimator.step(k, data.y.col(k), no_input);
+  for (long k = 0; k < 50; ++k) estimator.step(k, data.t[k], data.y.col(k), no_input);
   long k = 50, iterations = 0, solves = 0;
   for (auto _ : state) {
-    const nlobs::ObserverStep& s = estimator.step(k, data.y.col(k), no_input);
+    const nlobs::ObserverStep& s = estimator.step(k, data.t[k], data.y.col(k), no_input);
     benchmark::DoNotOptimize(s.estimate.data());
     if (s.summary) iterations += s.summary->iterations, ++solves;
     if (++k == data.steps()) {
       state.PauseTiming();
       estimator.reset();
-      for (k = 0; k < 50; ++k) estimator.step(k, data.y.col(k), no_input);
+      for (k = 0; k < 50; ++k) estimator.step(k, data.t[k], data.y.col(k), no_input);
       state.ResumeTiming();
     }
   }

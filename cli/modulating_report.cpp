@@ -16,13 +16,6 @@
 namespace nlobs::cli {
 namespace {
 
-std::optional<Eigen::Index> row_of(const RunResult& r, size_t i, const char* name) {
-  const auto& names = r.extra_names[i];
-  const auto at = std::find(names.begin(), names.end(), name);
-  if (at == names.end()) return std::nullopt;
-  return at - names.begin();
-}
-
 // Largest of a row over [from, K); NaN as soon as one entry is not finite.
 double max_over(const Eigen::MatrixXd& e, Eigen::Index row, Eigen::Index from) {
   double worst = 0.0;
@@ -38,10 +31,10 @@ double max_over(const Eigen::MatrixXd& e, Eigen::Index row, Eigen::Index from) {
 
 std::optional<ModulatingMetrics> modulating_metrics(const RunResult& r, size_t i,
                                                     long horizon_index) {
-  const auto error = row_of(r, i, "eta_error");
-  const auto norm = row_of(r, i, "eta_norm");
+  const auto error = signal_row(r.signal_info[i], SignalKind::kCanonicalError);
+  const auto norm = signal_row(r.signal_info[i], SignalKind::kCanonicalNorm);
   if (!error || !norm) return std::nullopt;
-  const Eigen::MatrixXd& e = r.extras[i];
+  const Eigen::MatrixXd& e = r.signals[i];
   const Eigen::Index K = e.cols();
   ModulatingMetrics m;
   if (K == 0) return m;
@@ -54,7 +47,9 @@ std::optional<ModulatingMetrics> modulating_metrics(const RunResult& r, size_t i
     m.eta_rms_after =
         std::sqrt(e.row(*error).tail(K - from).squaredNorm() / static_cast<double>(K - from));
   }
-  if (const auto bound = row_of(r, i, "eta_bound")) m.max_bound = max_over(e, *bound, 0);
+  if (const auto bound = signal_row(r.signal_info[i], SignalKind::kCanonicalBound)) {
+    m.max_bound = max_over(e, *bound, 0);
+  }
   return m;
 }
 
@@ -185,7 +180,7 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
     }
     for (size_t i = 0; i < observers.size(); ++i) {
       const ObserverMetrics& m = r.metrics[i];
-      const auto mm = modulating_metrics(r, i, static_cast<long>(observers[i]->window()) - 1);
+      const auto mm = modulating_metrics(r, i, static_cast<long>(observers[i]->info().window) - 1);
       const double x_rms =
           m.mse_after_window.size() ? std::sqrt(m.mse_after_window.sum()) : std::nan("");
       const double x2_rms =

@@ -15,13 +15,14 @@
 
 namespace nlobs::cli {
 
-// Per observer with an "eta_error" extra (add_coordinate_errors).
+// Per observer with a canonical error signal (kCanonicalError and kCanonicalNorm, added by
+// add_coordinate_errors).
 struct ModulatingMetrics {
   double rel_after_horizon = NAN;  // max ‖η − η̂‖ / max ‖η‖ over samples from one horizon on
   double abs_after_horizon = NAN;  // the same, absolute (summary: max_eta_error_after_horizon)
   double final_rel = NAN;          // the same over the last 10 % of the run
   double eta_rms_after = NAN;      // RMS of ‖η − η̂‖ from the settle index on
-  double max_bound = NAN;          // largest Theorem 1 bound ‖β‖ (extra "eta_bound"), if any
+  double max_bound = NAN;          // largest Theorem 1 bound (the kCanonicalBound signal), if any
 };
 std::optional<ModulatingMetrics> modulating_metrics(const RunResult& r, size_t i,
                                                     long horizon_index);

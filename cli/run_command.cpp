@@ -52,18 +52,14 @@ std::string fmt(double v, const char* f) {
 
 namespace {
 
-// MVT observers publish ‖X(β)‖ per step as the extra signal "residual" (beside β): its largest
-// value over the run, or nothing for other observers.
+// Observers that publish a per-sample solve residual (kSolveResidual: the MVT's ‖X(β)‖): its
+// largest finite value over the run, or nothing for other observers.
 std::optional<double> max_beta_residual(const RunResult& r, size_t i) {
-  const auto& names = r.extra_names[i];
-  const auto at = std::find(names.begin(), names.end(), "residual");
-  if (at == names.end() || std::find(names.begin(), names.end(), "beta1") == names.end()) {
-    return std::nullopt;
-  }
-  const Eigen::Index row = at - names.begin();
+  const auto row = signal_row(r.signal_info[i], SignalKind::kSolveResidual);
+  if (!row) return std::nullopt;
   double worst = 0.0;
-  for (Eigen::Index k = 0; k < r.extras[i].cols(); ++k) {
-    const double v = r.extras[i](row, k);
+  for (Eigen::Index k = 0; k < r.signals[i].cols(); ++k) {
+    const double v = r.signals[i](*row, k);
     if (std::isfinite(v)) worst = std::max(worst, v);
   }
   return worst;
@@ -75,55 +71,50 @@ void add_coordinate_errors(const Measurements& data,
                            const std::vector<std::unique_ptr<Observer>>& observers, RunResult& r) {
   if (!data.has_truth()) return;
   for (size_t i = 0; i < observers.size(); ++i) {
-    const Eigen::VectorXd z0 = observers[i]->coordinates_at(data.x.col(0), data.t[0]);
-    if (z0.size() == 0) continue;
-    const auto& names = r.extra_names[i];
-    auto first = std::find(names.begin(), names.end(), "zhat1");
-    const bool eta = first == names.end();
-    if (eta) first = std::find(names.begin(), names.end(), "eta1");
-    if (first == names.end()) continue;
-    const Eigen::Index row = first - names.begin(), K = data.steps();
-    Eigen::MatrixXd& extras = r.extras[i];
-    const Eigen::Index added = eta ? 2 : 1;
-    extras.conservativeResize(extras.rows() + added, Eigen::NoChange);
+    const auto& info = r.signal_info[i];
+    std::vector<Eigen::Index> rows = signal_rows(info, SignalKind::kEmbeddedEstimate);
+    const bool canonical = rows.empty();
+    if (canonical) rows = signal_rows(info, SignalKind::kCanonicalEstimate);
+    if (rows.empty()) continue;
+    const Eigen::Index K = data.steps();
+    const auto size = static_cast<Eigen::Index>(rows.size());
+    Eigen::MatrixXd& signals = r.signals[i];
+    const Eigen::Index added = canonical ? 2 : 1, at = signals.rows();
+    signals.conservativeResize(at + added, Eigen::NoChange);
+    Eigen::VectorXd estimate(size);
     for (Eigen::Index k = 0; k < K; ++k) {
       const Eigen::VectorXd z = observers[i]->coordinates_at(data.x.col(k), data.t[k]);
-      const Eigen::Index at = extras.rows() - added;
-      extras(at, k) = (z - extras.col(k).segment(row, z.size())).norm();
-      if (eta) extras(at + 1, k) = z.norm();
+      for (Eigen::Index j = 0; j < size; ++j) {
+        estimate[j] = signals(rows[static_cast<size_t>(j)], k);
+      }
+      // An observer whose coordinates_at() does not match its published estimate: NaN.
+      signals(at, k) = z.size() == size ? (z - estimate).norm() : NAN;
+      if (canonical) signals(at + 1, k) = z.size() == size ? z.norm() : NAN;
     }
-    r.extra_names[i].push_back(eta ? "eta_error" : "z_error");
-    if (eta) r.extra_names[i].push_back("eta_norm");
+    if (canonical) {
+      r.signal_info[i].push_back({"eta_error", SignalKind::kCanonicalError});
+      r.signal_info[i].push_back({"eta_norm", SignalKind::kCanonicalNorm});
+    } else {
+      r.signal_info[i].push_back({"z_error", SignalKind::kEmbeddedError});
+    }
   }
 }
 
-namespace {
-
-// Per observer with a "z_error" extra: what [HG-EMB23]'s figures show.
-struct EmbeddedMetrics {
-  double max_zhat_norm = 0.0;  // the peaking
-  double final_z_error = NAN;
-  double z_rms_after = NAN, max_residual_after = NAN;
-  long time_index_below = -1;  // ‖z − ẑ‖ < 1e-6 from here to the end
-  double jumps = 0.0;
-};
-
 std::optional<EmbeddedMetrics> embedded_metrics(const RunResult& r, size_t i) {
-  const auto& names = r.extra_names[i];
-  const auto error_at = std::find(names.begin(), names.end(), "z_error");
-  const auto z1 = std::find(names.begin(), names.end(), "zhat1");
-  const auto residual_at = std::find(names.begin(), names.end(), "projection_residual");
-  const auto jumps_at = std::find(names.begin(), names.end(), "jumps");
-  if (error_at == names.end() || z1 == names.end() || residual_at == names.end()) {
-    return std::nullopt;
-  }
-  const Eigen::MatrixXd& e = r.extras[i];
-  const Eigen::Index K = e.cols(), row = error_at - names.begin(), zrow = z1 - names.begin();
-  const Eigen::Index N = residual_at - z1;
+  const auto& info = r.signal_info[i];
+  const auto error_row = signal_row(info, SignalKind::kEmbeddedError);
+  const std::vector<Eigen::Index> z_rows = signal_rows(info, SignalKind::kEmbeddedEstimate);
+  const auto residual_row = signal_row(info, SignalKind::kProjectionResidual);
+  const auto jumps_row = signal_row(info, SignalKind::kJumpCount);
+  if (!error_row || z_rows.empty()) return std::nullopt;
+  const Eigen::MatrixXd& e = r.signals[i];
+  const Eigen::Index K = e.cols(), row = *error_row;
   EmbeddedMetrics m;
   if (K == 0) return m;
+  Eigen::VectorXd zhat(static_cast<Eigen::Index>(z_rows.size()));
   for (Eigen::Index k = 0; k < K; ++k) {
-    const double norm = e.col(k).segment(zrow, N).norm();
+    for (Eigen::Index j = 0; j < zhat.size(); ++j) zhat[j] = e(z_rows[static_cast<size_t>(j)], k);
+    const double norm = zhat.norm();
     if (!(norm <= m.max_zhat_norm)) m.max_zhat_norm = norm;  // NaN propagates
   }
   m.final_z_error = e(row, K - 1);
@@ -133,14 +124,18 @@ std::optional<EmbeddedMetrics> embedded_metrics(const RunResult& r, size_t i) {
   double sum = 0.0, worst = 0.0;
   for (Eigen::Index k = from; k < K; ++k) {
     sum += e(row, k) * e(row, k);
-    const double res = e(residual_at - names.begin(), k);
-    if (!(res <= worst)) worst = res;
+    if (residual_row) {
+      const double res = e(*residual_row, k);
+      if (!(res <= worst)) worst = res;
+    }
   }
   m.z_rms_after = std::sqrt(sum / static_cast<double>(K - from));
-  m.max_residual_after = worst;
-  if (jumps_at != names.end()) m.jumps = e(jumps_at - names.begin(), K - 1);
+  if (residual_row) m.max_residual_after = worst;  // NaN for an observer without one
+  if (jumps_row) m.jumps = e(*jumps_row, K - 1);
   return m;
 }
+
+namespace {
 
 void print_table(const Scenario& s, const Measurements& data, const RunResult& r,
                  std::ostream& out) {
@@ -516,7 +511,7 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
   }
   Eigen::Index longest = 1;
   auto observers = make_observers(s, model, !options.out_dir.empty());
-  for (const auto& o : observers) longest = std::max(longest, o->window());
+  for (const auto& o : observers) longest = std::max(longest, o->info().window);
   if (longest > data.steps()) {
     std::ostringstream os;
     os << "a window of " << longest << " samples is longer than the data (" << data.steps()
@@ -533,7 +528,7 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
   std::vector<std::string> warnings;
   const nlohmann::json bounds = pi_bounds_json(s, &warnings);
   for (const auto& o : observers) {
-    for (const auto& w : o->warnings()) warnings.push_back(w);
+    for (const auto& w : o->info().warnings) warnings.push_back(w);
   }
   for (const auto& w : warnings) err << "nlobs: warning: " << w << '\n';
 
@@ -555,7 +550,7 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
   make_names_unique(r);
   // What the run itself found (a window map that does not contract, a singular guess).
   for (const auto& o : observers) {
-    for (const auto& w : o->warnings()) {
+    for (const auto& w : o->info().warnings) {
       if (std::find(warnings.begin(), warnings.end(), w) != warnings.end()) continue;
       warnings.push_back(w);
       err << "nlobs: warning: " << w << '\n';
@@ -564,7 +559,8 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
   add_coordinate_errors(data, observers, r);
 
   std::vector<long> horizon_indices;  // the first sample with a full window, per observer
-  for (const auto& o : observers) horizon_indices.push_back(static_cast<long>(o->window()) - 1);
+  for (const auto& o : observers)
+    horizon_indices.push_back(static_cast<long>(o->info().window) - 1);
   print_table(s, data, r, out);
   print_modulating_metrics(r, horizon_indices, out);
   print_bounds(bounds, out);

@@ -6,6 +6,7 @@
 #include <iomanip>
 #include <limits>
 #include <sstream>
+#include <tuple>
 
 #include "gnuplot.hpp"
 #include "run_support.hpp"
@@ -55,10 +56,10 @@ ColumnTable run_table(const Measurements& data, const RunResult& r, bool errors,
       add_name(r.metrics[o].name + ".x" + std::to_string(i + 1));
     }
   }
-  for (size_t o = 0; o < r.extra_names.size(); ++o) {
-    for (size_t e = 0; e < r.extra_names[o].size(); ++e) {
-      refs.push_back(row_of(r.extras[o], static_cast<Eigen::Index>(e)));
-      add_name(r.metrics[o].name + ".signal." + r.extra_names[o][e]);
+  for (size_t o = 0; o < r.signal_info.size(); ++o) {
+    for (size_t e = 0; e < r.signal_info[o].size(); ++e) {
+      refs.push_back(row_of(r.signals[o], static_cast<Eigen::Index>(e)));
+      add_name(r.metrics[o].name + ".signal." + r.signal_info[o][e].name);
     }
   }
   if (errors && data.has_truth()) {
@@ -191,7 +192,7 @@ std::string plot_script(OutputDirectory& dir, const Measurements& data, const Ru
   const long observers = static_cast<long>(r.metrics.size());
   const long offset = data.has_truth() ? n : 0;
   long extra_columns = 0;
-  for (const auto& names : r.extra_names) extra_columns += static_cast<long>(names.size());
+  for (const auto& info : r.signal_info) extra_columns += static_cast<long>(info.size());
   const long first_error = 2 + offset + observers * n + extra_columns;  // |x - xhat| columns
   std::ostringstream g;
   g << "set datafile separator ','\nset key outside right\nset grid\n"
@@ -247,36 +248,34 @@ std::string plot_script(OutputDirectory& dir, const Measurements& data, const Ru
   }
   // Further signals of observers that publish them (PI banks: η̂, η̂₁ per channel, ...).
   long column = 2 + offset + observers * n;
-  for (size_t o = 0; o < r.extra_names.size(); ++o) {
-    const auto& names = r.extra_names[o];
-    if (names.empty()) continue;
+  for (size_t o = 0; o < r.signal_info.size(); ++o) {
+    const auto& info = r.signal_info[o];
+    if (info.empty()) continue;
     const std::string file = "signals_" + std::to_string(o + 1) + ".png";
-    g << "set terminal pngcairo noenhanced size 1200," << 250 * names.size() << "\nset output "
-      << gnuplot_quoted(dir.external(file)) << "\nset multiplot layout " << names.size()
+    g << "set terminal pngcairo noenhanced size 1200," << 250 * info.size() << "\nset output "
+      << gnuplot_quoted(dir.external(file)) << "\nset multiplot layout " << info.size()
       << ",1 title " << gnuplot_quoted(r.metrics[o].name) << "\n";
-    for (const auto& name : names) {
-      g << "set ylabel " << gnuplot_quoted(name) << "\nplot 'plot_data.csv' using 1:" << column++
-        << " with lines notitle\n";
+    for (const auto& signal : info) {
+      g << "set ylabel " << gnuplot_quoted(signal.name)
+        << "\nplot 'plot_data.csv' using 1:" << column++ << " with lines notitle\n";
     }
     g << "unset multiplot\n";
   }
   // [HG-EMB23]'s Figs. 3 and 6 (‖z − ẑ‖) and [MF-LTV]'s canonical error ‖η − η̂‖ on a log scale.
-  for (const auto& [extra, label] :
-       {std::pair<std::string, std::string>{"z_error", "||z - zhat||_2"},
-        {"eta_error", "||eta - etahat||_2"}}) {
+  for (const auto& [kind, file, label] :
+       {std::tuple<SignalKind, const char*, const char*>{SignalKind::kEmbeddedError, "z_error.png",
+                                                         "||z - zhat||_2"},
+        {SignalKind::kCanonicalError, "eta_error.png", "||eta - etahat||_2"}}) {
     std::vector<std::pair<long, std::string>> columns;
     std::vector<long> style_of;  // the observer of each column
     for (size_t o = 0, c = static_cast<size_t>(2 + offset + observers * n);
-         o < r.extra_names.size(); c += r.extra_names[o].size(), ++o) {
-      const auto& names = r.extra_names[o];
-      const auto at = std::find(names.begin(), names.end(), extra);
-      if (at != names.end()) {
-        columns.emplace_back(static_cast<long>(c) + (at - names.begin()), r.metrics[o].name);
+         o < r.signal_info.size(); c += r.signal_info[o].size(), ++o) {
+      if (const auto row = signal_row(r.signal_info[o], kind)) {
+        columns.emplace_back(static_cast<long>(c) + *row, r.metrics[o].name);
         style_of.push_back(static_cast<long>(o));
       }
     }
     if (columns.empty()) continue;
-    const std::string file = extra + ".png";
     g << "set terminal pngcairo noenhanced size 1000,600\nset output "
       << gnuplot_quoted(dir.external(file)) << "\nset logscale y\nset xlabel 't'\nset ylabel "
       << gnuplot_quoted(label) << "\nplot ";

@@ -1,9 +1,11 @@
 #pragma once
 // What `nlobs run`'s parts share (run_command.cpp, modulating_report.cpp).
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <string_view>
@@ -32,10 +34,24 @@ std::vector<double> parse_sweep_values(const std::string& key, const std::string
 // The scenario's true system simulated (steps, noise, seed, input); a domain exit ends the data
 // early with Measurements::stop_message set.
 Measurements simulate_scenario(const Scenario& s, const AnyModel& model);
-// Observers in other coordinates publish their estimate there as extras zhat1… (high gain) or
-// eta1… (modulating functions): with the truth known, the error in those coordinates becomes
-// the extra "z_error" or "eta_error" (and, for eta, the true norm "eta_norm").
+// Observers in other coordinates publish their estimate there as signals of kind
+// kEmbeddedEstimate (ẑ, high gain) or kCanonicalEstimate (η̂, modulating functions): with the
+// truth known, the error in those coordinates (through Observer::coordinates_at) becomes the
+// signal "z_error" (kEmbeddedError) or "eta_error" (kCanonicalError, with the true norm
+// "eta_norm", kCanonicalNorm).
 void add_coordinate_errors(const Measurements& data,
                            const std::vector<std::unique_ptr<Observer>>& observers, RunResult& r);
+
+// Per observer with an embedded error signal (kEmbeddedError, add_coordinate_errors): what
+// [HG-EMB23]'s figures show.
+struct EmbeddedMetrics {
+  double max_zhat_norm = 0.0;  // the peaking: max_k ‖ẑ_k‖ over the kEmbeddedEstimate signals
+  double final_z_error = NAN;
+  double z_rms_after = NAN;
+  double max_residual_after = NAN;  // of the kProjectionResidual signal (NaN without one)
+  long time_index_below = -1;       // ‖z − ẑ‖ < 1e-6 from here to the end
+  double jumps = 0.0;               // the kJumpCount signal's last value (0 without one)
+};
+std::optional<EmbeddedMetrics> embedded_metrics(const RunResult& r, size_t i);
 
 }  // namespace nlobs::cli

@@ -33,8 +33,8 @@ int main() {
 
   double z_error = 0.0, x_error = 0.0;
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
-    const ObserverStep& s = observer.step(k, data.y.col(k), data.u.col(k));
-    z_error = (observer.coordinates_of(data.x.col(k)) - observer.zhat()).norm();
+    const ObserverStep& s = observer.step(k, data.t[k], data.y.col(k), data.u.col(k));
+    z_error = (observer.coordinates_at(data.x.col(k), data.t[k]) - observer.zhat()).norm();
     x_error = (data.x.col(k) - s.estimate).norm();
     if (k % 2000 == 0) {
       std::printf("t = %4.1f  |z - zhat| = %.2e  |x - xhat| = %.2e\n", data.t[k], z_error, x_error);

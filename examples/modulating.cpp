@@ -27,8 +27,8 @@ int main() {
   double mf_sum = 0.0, fd_sum = 0.0;
   double counted = 0.0;
   for (long k = 0; k < data.steps(); ++k) {
-    const ObserverStep& s = mf.step(k, data.y.col(k), data.u.col(k));
-    const ObserverStep& d = differences.step(k, data.y.col(k), data.u.col(k));
+    const ObserverStep& s = mf.step(k, data.t[k], data.y.col(k), data.u.col(k));
+    const ObserverStep& d = differences.step(k, data.t[k], data.y.col(k), data.u.col(k));
     if (!s.ready) continue;
     mf_sum += std::pow(s.estimate[1] - data.x(1, k), 2);
     fd_sum += std::pow(d.estimate[1] - data.x(1, k), 2);

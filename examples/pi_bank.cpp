@@ -36,7 +36,7 @@ int main() {
 
   double worst = 0.0;
   for (long k = 0; k < data.steps(); ++k) {
-    const ObserverStep& s = observer.step(k, data.y.col(k), data.u.col(k));
+    const ObserverStep& s = observer.step(k, data.t[k], data.y.col(k), data.u.col(k));
     if (static_cast<double>(k) * h >= 5.0)
       worst = std::max(worst, std::abs(s.estimate[3] - data.x(3, k)));
   }

@@ -124,11 +124,11 @@ TEST(Allocations, PiBankStepAllocatesNothing) {
       bank, {.name = "pi", .estimate = {y, x2.eta, x3, f.eta}, .sample_time = 1e-3, .substeps = 2});
   Eigen::VectorXd yk(1), uk = Eigen::VectorXd::Ones(1);
   yk[0] = -700.0;
-  observer.step(0, yk, uk);
+  observer.step(0, 0.0, yk, uk);
   const long before = g_allocations.load();
   for (long k = 1; k < 100; ++k) {
     yk[0] = -700.0 - 1e-3 * static_cast<double>(k);
-    observer.step(k, yk, uk);
+    observer.step(k, 1e-3 * static_cast<double>(k), yk, uk);
   }
   EXPECT_EQ(g_allocations.load() - before, 0);
 }
@@ -159,13 +159,13 @@ TEST(Allocations, WindowEstimatorStepAllocatesNothing) {
       Eigen::VectorXd y(1);
       for (long k = 0; k < 10; ++k) {  // the first windows: Ψ chosen, workspaces sized
         y = data.y.col(k);
-        estimator.step(k, y, no_input);
+        estimator.step(k, static_cast<double>(k), y, no_input);
       }
       long solves = 0;
       const long before = g_allocations.load();
       for (long k = 10; k < data.steps(); ++k) {
         y = data.y.col(k);
-        solves += estimator.step(k, y, no_input).summary.has_value();
+        solves += estimator.step(k, static_cast<double>(k), y, no_input).summary.has_value();
       }
       EXPECT_EQ(g_allocations.load() - before, 0) << engine << " psi " << to_string(gain);
       EXPECT_EQ(solves, data.steps() - 10);
@@ -180,12 +180,12 @@ TEST(Allocations, MvtStepWithPerRowBetaAllocatesNothing) {
   o.initial_error_estimate = Eigen::Vector4d(4, 5, 3.5, 3);
   MvtObserver<FlexibleJointRobot> observer(FlexibleJointRobot{}, o);
   Eigen::VectorXd yk = Eigen::Vector3d(3, 3, 3), uk = Eigen::VectorXd::Zero(1);
-  observer.step(0, yk, uk);
+  observer.step(0, 0.0, yk, uk);
   const long before = g_allocations.load();
   for (long k = 1; k < 100; ++k) {
     yk += Eigen::Vector3d::Constant(1e-3);
     uk[0] = std::sin(1e-3 * static_cast<double>(k));
-    observer.step(k, yk, uk);
+    observer.step(k, 1e-3 * static_cast<double>(k), yk, uk);
   }
   EXPECT_EQ(g_allocations.load() - before, 0);
   EXPECT_GT(observer.ehat().norm(), 1e-3);  // the β problems were real ones
@@ -205,12 +205,12 @@ TEST(Allocations, HighGainStepWithExplicitFormsAllocatesNothing) {
   HighGainObserver<OscillatorNonlinearOutput> observer(OscillatorNonlinearOutput{}, o);
   const Eigen::VectorXd none(0);
   Eigen::VectorXd yk = Eigen::VectorXd::Constant(1, -0.25);
-  observer.step(0, yk, none);
-  observer.step(1, yk, none);
+  observer.step(0, 0.0, yk, none);
+  observer.step(1, 1e-2, yk, none);
   const long before = g_allocations.load();
   for (long k = 2; k < 100; ++k) {
     yk[0] = -0.25 + 0.01 * std::sin(0.01 * static_cast<double>(k));
-    observer.step(k, yk, none);
+    observer.step(k, 1e-2 * static_cast<double>(k), yk, none);
   }
   EXPECT_EQ(g_allocations.load() - before, 0);
   EXPECT_GT(observer.zhat().norm(), 0.1);
@@ -247,13 +247,13 @@ TEST(Allocations, HighGainStepWithTaylorMapAndProjectionAllocatesNothing) {
   HighGainObserver<Lorenz> observer(Lorenz{}, o);
   const Eigen::VectorXd none(0);
   Eigen::VectorXd yk = Eigen::VectorXd::Constant(1, 1.0);
-  for (long k = 0; k < 5; ++k) observer.step(k, yk, none);
+  for (long k = 0; k < 5; ++k) observer.step(k, 1e-3 * static_cast<double>(k), yk, none);
   const Eigen::VectorXd z5 = observer.zhat();
   long failures = 0;
   const long before = g_allocations.load();
   for (long k = 5; k < 100; ++k) {
     yk[0] = 1.0 + 0.1 * std::sin(0.01 * static_cast<double>(k));
-    failures += observer.step(k, yk, none).failure.empty() ? 0 : 1;
+    failures += observer.step(k, 1e-3 * static_cast<double>(k), yk, none).failure.empty() ? 0 : 1;
   }
   EXPECT_EQ(g_allocations.load() - before, 0);
   EXPECT_EQ(failures, 0);
@@ -275,7 +275,7 @@ TEST(Allocations, ModulatingFunctionStepAllocatesNothing) {
     const long before = g_allocations.load();
     for (long k = 0; k < 200; ++k) {
       yk[0] = std::sin(0.01 * static_cast<double>(k));
-      observer.step(k, yk, none);
+      observer.step(k, 0.01 * static_cast<double>(k), yk, none);
     }
     EXPECT_EQ(g_allocations.load() - before, 0) << period;
     EXPECT_GT(Eigen::VectorXd(observer.eta()).norm(), 0.1);

@@ -18,6 +18,7 @@
 #include "nlobs/solvers/solvers.hpp"
 #include "reference/kinsol_adapter.hpp"
 #include "reference/root_reference.hpp"
+#include "test_support.hpp"
 
 namespace nlobs {
 namespace {
@@ -267,7 +268,7 @@ TEST(TracedCase, IdentityGainWarnsAndNeverPublishesNonFinite) {
   for (size_t i = 0; i < observers.size(); ++i) {
     const ObserverMetrics& m = r.metrics[i];
     EXPECT_TRUE(r.estimates[i].allFinite()) << m.name;
-    const auto warnings = observers[i]->warnings();
+    const auto warnings = observers[i]->info().warnings;
     ASSERT_EQ(warnings.size(), 1u) << m.name;
     EXPECT_NE(warnings[0].find("does not contract"), std::string::npos) << warnings[0];
     // Failures are counted and explained, never "none".
@@ -279,15 +280,15 @@ TEST(TracedCase, IdentityGainWarnsAndNeverPublishesNonFinite) {
 TEST(TracedCase, AutoGainChoosesNewtonWhereIdentityDoesNotContract) {
   auto estimator = rossler_estimator("picard", WindowGain::kAuto);
   const Measurements data = rossler_data(10);
-  for (long k = 0; k < 3; ++k) estimator->step(k, data.y.col(k), Eigen::VectorXd(0));
+  for (long k = 0; k < 3; ++k) estimator->step(k, data.t[k], data.y.col(k), Eigen::VectorXd(0));
   EXPECT_EQ(estimator->gain(), WindowGain::kNewton);
-  ASSERT_EQ(estimator->warnings().size(), 1u);
-  EXPECT_NE(estimator->warnings()[0].find("chose psi = newton"), std::string::npos);
+  ASSERT_EQ(estimator->info().warnings.size(), 1u);
+  EXPECT_NE(estimator->info().warnings[0].find("chose psi = newton"), std::string::npos);
   // Engines that need no contraction keep the paper's Ψ = I, without a check.
   auto newton = rossler_estimator("newton", WindowGain::kAuto);
-  for (long k = 0; k < 3; ++k) newton->step(k, data.y.col(k), Eigen::VectorXd(0));
+  for (long k = 0; k < 3; ++k) newton->step(k, data.t[k], data.y.col(k), Eigen::VectorXd(0));
   EXPECT_EQ(newton->gain(), WindowGain::kIdentity);
-  EXPECT_TRUE(newton->warnings().empty());
+  EXPECT_TRUE(newton->info().warnings.empty());
 }
 
 // A user's engine that records every guess it is given and fails on the calls it is told to
@@ -332,7 +333,7 @@ TEST(TracedCase, AFailedSolveIsNotTheNextWarmStart) {
     options.initial_estimate = Eigen::Vector3d(-3.5, 2.5, 0.1);
     WindowEstimator<Rossler> estimator(Rossler{}, options, std::move(engine));
     const Measurements data = rossler_data(5);
-    for (long k = 0; k < 5; ++k) estimator.step(k, data.y.col(k), Eigen::VectorXd(0));
+    for (long k = 0; k < 5; ++k) estimator.step(k, data.t[k], data.y.col(k), Eigen::VectorXd(0));
     ASSERT_EQ(scripted->guesses.size(), 3u);
     ASSERT_TRUE(scripted->usable[0]);  // the k = 2 solve gave a warm start
     // The k = 2 answer w* (= x̂[0]) gave x̂[2] = f²(w*), kept for sample 2: the first sample
@@ -354,7 +355,8 @@ TEST(TracedCase, AFailedSolveIsNotTheNextWarmStart) {
     WindowEstimator<Scaled1> estimator(Scaled1{}, options, std::move(engine));
     for (long k = 0; k < 3; ++k) {
       const double x = 2.0 * std::pow(0.9, static_cast<double>(k));
-      estimator.step(k, Eigen::VectorXd::Constant(1, 3.0 * x), Eigen::VectorXd(0));
+      estimator.step(k, static_cast<double>(k), Eigen::VectorXd::Constant(1, 3.0 * x),
+                     Eigen::VectorXd(0));
     }
     ASSERT_EQ(scripted->guesses.size(), 3u);
     ASSERT_TRUE(scripted->usable[0]);
@@ -378,7 +380,7 @@ TEST(SingularGuess, LorenzEquilibriumWarnsAndIsLeft) {
   options.initial_estimate = Eigen::Vector3d::Zero();
   observers.push_back(make_window_estimator(lorenz, "newton", options, window_solver_options()));
   const RunResult r = run_observers(data, observers);
-  const auto warnings = observers[0]->warnings();
+  const auto warnings = observers[0]->info().warnings;
   ASSERT_FALSE(warnings.empty());
   EXPECT_NE(warnings[0].find("singular point"), std::string::npos) << warnings[0];
   EXPECT_TRUE(r.estimates[0].allFinite());
@@ -404,7 +406,7 @@ TEST(ContractionWarning, OnANonContractingSquareWindow) {
     observers.push_back(
         make_window_estimator(Scaled1{}, "picard", options, window_solver_options()));
     const RunResult r = run_observers(data, observers);
-    return std::make_pair(observers[0]->warnings(), r);
+    return std::make_pair(observers[0]->info().warnings, r);
   };
   const auto [identity_warnings, identity] = run(WindowGain::kIdentity, 1.0);
   ASSERT_EQ(identity_warnings.size(), 1u);
@@ -499,9 +501,10 @@ TEST(Baselines, EkfAndSlidingModeUnderAbsurdNoiseStayFinite) {
 
 class NanObserver final : public Observer {
  public:
-  std::string name() const override { return "nan"; }
+  NanObserver() { info_.name = "nan"; }
   void reset() override {}
-  const ObserverStep& step(long k, const Eigen::VectorXd&, const Eigen::VectorXd&) override {
+  const ObserverStep& step(long k, double, const Eigen::VectorXd&,
+                           const Eigen::VectorXd&) override {
     step_.estimate = Eigen::Vector2d(k > 3 ? kNaN : 0.0, 0.0);
     return step_;
   }
@@ -509,6 +512,37 @@ class NanObserver final : public Observer {
  private:
   ObserverStep step_;
 };
+
+// One that names one signal and publishes three from k = 2 on: refused by name, never written
+// past the harness's table.
+class BrokenPromiseObserver final : public Observer {
+ public:
+  BrokenPromiseObserver() {
+    info_.name = "broken";
+    info_.signals = {{"only"}};
+  }
+  void reset() override {}
+  const ObserverStep& step(long k, double, const Eigen::VectorXd&,
+                           const Eigen::VectorXd&) override {
+    step_.estimate = Eigen::Vector2d::Zero();
+    step_.signals = Eigen::VectorXd::Zero(k >= 2 ? 3 : 1);
+    return step_;
+  }
+
+ private:
+  ObserverStep step_;
+};
+
+TEST(Harness, AnObserverPublishingOtherSizesThanItNamesIsRefused) {
+  SimulationOptions so;
+  so.steps = 10;
+  const Measurements data = simulate(Linear2{}, Eigen::Vector2d(1.0, -1.0), so);
+  std::vector<std::unique_ptr<Observer>> observers;
+  observers.push_back(std::make_unique<BrokenPromiseObserver>());
+  EXPECT_EQ(test::message_of([&] { run_observers(data, observers); }),
+            "run_observers: broken at sample k = 2 published an estimate of 2 entries and 3 "
+            "signals; expected 2 and 1 (ObserverInfo::signals)");
+}
 
 TEST(Harness, NonFiniteEstimatesAreFailures) {
   SimulationOptions so;
@@ -551,8 +585,8 @@ TEST(Harness, FirstFailureHoldsTheEnginesStatusAndMessage) {
   EXPECT_NE(first.find("Jacobian of F is singular"), std::string::npos) << first;  // the message
   EXPECT_EQ(r.metrics[0].failures.at("singular_jacobian"), 19);
   EXPECT_TRUE(r.estimates[0].allFinite());
-  ASSERT_FALSE(observers[0]->warnings().empty());
-  EXPECT_NE(observers[0]->warnings()[0].find("singular point"), std::string::npos);
+  ASSERT_FALSE(observers[0]->info().warnings.empty());
+  EXPECT_NE(observers[0]->info().warnings[0].find("singular point"), std::string::npos);
 }
 
 // The simulation stops where the true state overflows instead of feeding NaN measurements.

@@ -50,9 +50,9 @@ Trace run(HighGainObserver<Model>& observer, const Measurements& data) {
   t.z_error.resize(data.steps());
   t.x_error.resize(data.steps());
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
-    const ObserverStep& s = observer.step(k, data.y.col(k), data.u.col(k));
+    const ObserverStep& s = observer.step(k, data.t[k], data.y.col(k), data.u.col(k));
     if (!s.failure.empty()) t.failures.push_back(s.failure);
-    t.z_error[k] = (observer.coordinates_of(data.x.col(k)) - observer.zhat()).norm();
+    t.z_error[k] = (observer.coordinates_at(data.x.col(k), data.t[k]) - observer.zhat()).norm();
     t.x_error[k] = (data.x.col(k) - s.estimate).norm();
   }
   return t;
@@ -436,12 +436,13 @@ TEST(HighGainObserver, CvodeAgreesWithRk4) {
                               designed(o, oscillator_design(true), Eigen::Vector2d(-0.3, 0.0)));
   double largest_gap = 0.0;
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
-    ASSERT_TRUE(explicit_steps.step(k, data.y.col(k), data.u.col(k)).failure.empty());
-    ASSERT_TRUE(implicit.step(k, data.y.col(k), data.u.col(k)).failure.empty());
+    ASSERT_TRUE(explicit_steps.step(k, data.t[k], data.y.col(k), data.u.col(k)).failure.empty());
+    ASSERT_TRUE(implicit.step(k, data.t[k], data.y.col(k), data.u.col(k)).failure.empty());
     largest_gap = std::max(largest_gap, (implicit.zhat() - explicit_steps.zhat()).norm());
   }
   EXPECT_LT(largest_gap, 1e-6);  // both solve the same ODE (RK4 at h·|p|/θ = 0.017)
-  EXPECT_LT((implicit.coordinates_of(data.x.col(data.steps() - 1)) - implicit.zhat()).norm(), 1e-6);
+  EXPECT_LT((implicit.coordinates_at(data.x.col(data.steps() - 1), 0.0) - implicit.zhat()).norm(),
+            1e-6);
 }
 
 // CVODE with α = L_f^N h: the prediction x̄ and its Jacobian rows are in the implicit system.
@@ -461,8 +462,8 @@ TEST(HighGainObserver, CvodeWithLieAlphaMatchesRk4) {
   HighGainObserver<Lorenz> cvode(Lorenz{}, designed(o, d, Eigen::Vector3d(2.0, 3.0, 25.0)));
   double worst = 0.0;
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
-    ASSERT_TRUE(rk4.step(k, data.y.col(k), data.u.col(k)).failure.empty());
-    ASSERT_TRUE(cvode.step(k, data.y.col(k), data.u.col(k)).failure.empty());
+    ASSERT_TRUE(rk4.step(k, data.t[k], data.y.col(k), data.u.col(k)).failure.empty());
+    ASSERT_TRUE(cvode.step(k, data.t[k], data.y.col(k), data.u.col(k)).failure.empty());
     worst = std::max(worst, (cvode.zhat() - rk4.zhat()).norm() / (1.0 + rk4.zhat().norm()));
   }
   EXPECT_LT(worst, 1e-6);
@@ -478,14 +479,15 @@ TEST(HighGainObserver, CvodeFailureKeepsTheStateAndRecovers) {
   o.integrator = HighGainIntegrator::kCvode;
   OscillatorObserver observer(OscillatorNonlinearOutput{},
                               designed(o, oscillator_design(true), Eigen::Vector2d(-0.3, 0.0)));
-  for (Eigen::Index k = 0; k < 50; ++k) observer.step(k, data.y.col(k), data.u.col(k));
+  for (Eigen::Index k = 0; k < 50; ++k) observer.step(k, data.t[k], data.y.col(k), data.u.col(k));
   const Eigen::VectorXd before = observer.zhat();
-  const ObserverStep& bad = observer.step(50, Eigen::VectorXd::Constant(1, 1e300), data.u.col(50));
+  const ObserverStep& bad =
+      observer.step(50, data.t[50], Eigen::VectorXd::Constant(1, 1e300), data.u.col(50));
   EXPECT_EQ(bad.failure, "non_finite");
   EXPECT_FALSE(bad.failure_message.empty());
   EXPECT_EQ(observer.zhat(), before);
   for (Eigen::Index k = 51; k < 60; ++k) {
-    EXPECT_TRUE(observer.step(k, data.y.col(k), data.u.col(k)).failure.empty()) << k;
+    EXPECT_TRUE(observer.step(k, data.t[k], data.y.col(k), data.u.col(k)).failure.empty()) << k;
   }
 }
 
@@ -554,8 +556,8 @@ TEST(HighGainObserver, TaylorAndAdolcMapsGiveTheSameRun) {
   HighGainObserver<Lorenz> b(Lorenz{}, designed(o, adolc, Eigen::Vector3d(2.0, 3.0, 25.0)));
   double worst = 0.0, worst_z = 0.0, moved = 0.0;
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
-    const Eigen::VectorXd xa = a.step(k, data.y.col(k), data.u.col(k)).estimate;
-    const Eigen::VectorXd xb = b.step(k, data.y.col(k), data.u.col(k)).estimate;
+    const Eigen::VectorXd xa = a.step(k, data.t[k], data.y.col(k), data.u.col(k)).estimate;
+    const Eigen::VectorXd xb = b.step(k, data.t[k], data.y.col(k), data.u.col(k)).estimate;
     worst = std::max(worst, (xa - xb).norm() / (1.0 + xb.norm()));
     worst_z = std::max(worst_z, (a.zhat() - b.zhat()).norm() / (1.0 + b.zhat().norm()));
     moved = std::max(moved, (xa - Eigen::Vector3d(2.0, 3.0, 25.0)).norm());
@@ -574,11 +576,12 @@ TEST(HighGainObserver, LieAlphaIsSwitchedOffOnTheNonObservableSet) {
   o.sample_time = 1e-3;
   o.theta = 0.05;
   HighGainObserver<Lorenz> on_axis(Lorenz{}, designed(o, d, Eigen::Vector3d(0.0, 0.0, 10.0)));
-  const ObserverStep& s = on_axis.step(0, Eigen::VectorXd::Zero(1), Eigen::VectorXd());
-  EXPECT_LT(s.extras[6], 1e-12);  // alpha_weight: ∂q_4/∂x3 = 0 on the x3 axis
+  const ObserverStep& s = on_axis.step(0, 0.0, Eigen::VectorXd::Zero(1), Eigen::VectorXd());
+  EXPECT_LT(s.signals[6], 1e-12);  // alpha_weight: ∂q_4/∂x3 = 0 on the x3 axis
   HighGainObserver<Lorenz> off_axis(Lorenz{}, designed(o, d, Eigen::Vector3d(5.0, 5.0, 10.0)));
-  const ObserverStep& s2 = off_axis.step(0, Eigen::VectorXd::Constant(1, 5.0), Eigen::VectorXd());
-  EXPECT_GT(s2.extras[6], 0.99);
+  const ObserverStep& s2 =
+      off_axis.step(0, 0.0, Eigen::VectorXd::Constant(1, 5.0), Eigen::VectorXd());
+  EXPECT_GT(s2.signals[6], 0.99);
 }
 
 TEST(HighGainObserver, VanDerPolWithLieAlphaConverges) {
@@ -610,7 +613,8 @@ TEST(HighGainObserver, MissingSamplesAreBridged) {
   long missing = 0;
   double after_gap = 0.0;
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
-    missing += observer.step(k, data.y.col(k), data.u.col(k)).measurement_missing ? 1 : 0;
+    missing +=
+        observer.step(k, data.t[k], data.y.col(k), data.u.col(k)).measurement_missing ? 1 : 0;
     if (k >= 4410 && k < 4430) {
       after_gap = std::max(after_gap, (data.x.col(k) - observer.xhat()).norm());
     }
@@ -650,10 +654,11 @@ TEST(HighGainObserver, SamplesMustArriveInOrder) {
       OscillatorNonlinearOutput{},
       designed(oscillator_options(0.01), oscillator_design(true), Eigen::Vector2d(-0.3, 0.0)));
   const Eigen::VectorXd y = Eigen::VectorXd::Constant(1, -0.25), none(0);
-  observer.step(0, y, none);
-  observer.step(1, y, none);
-  EXPECT_THROW(observer.step(1, y, none), InvalidInput);
-  EXPECT_TRUE(observer.step(2, y, none).failure.empty());
+  observer.step(0, 0.0, y, none);
+  observer.step(1, 0.01, y, none);
+  EXPECT_THROW(observer.step(1, 0.01, y, none), InvalidInput);
+  EXPECT_EQ(observer.step(2, 0.025, y, none).failure, "non_uniform");  // between grid points
+  EXPECT_TRUE(observer.step(2, 0.02, y, none).failure.empty());
 }
 
 // A map that stops giving finite values when told to: the projection's failure keeps x̂.
@@ -685,10 +690,10 @@ TEST(HighGainObserver, FailedProjectionKeepsThePreviousEstimate) {
   d.alpha = explicit_alpha<OscillatorEmbedding>();
   OscillatorObserver observer(OscillatorNonlinearOutput{},
                               designed(oscillator_options(h), d, Eigen::Vector2d(-0.3, 0.0)));
-  for (Eigen::Index k = 0; k < 50; ++k) observer.step(k, data.y.col(k), data.u.col(k));
+  for (Eigen::Index k = 0; k < 50; ++k) observer.step(k, data.t[k], data.y.col(k), data.u.col(k));
   const Eigen::Vector2d before = observer.xhat();
   map->broken = true;
-  const ObserverStep& s = observer.step(50, data.y.col(50), data.u.col(50));
+  const ObserverStep& s = observer.step(50, data.t[50], data.y.col(50), data.u.col(50));
   EXPECT_EQ(s.failure, "projection");
   EXPECT_NE(s.failure_message.find("x̂ kept"), std::string::npos) << s.failure_message;
   EXPECT_EQ(s.estimate, Eigen::VectorXd(before));
@@ -820,7 +825,7 @@ TEST(HighGainObserverBadInput, TheProjectionEngineIsChecked) {
           OscillatorNonlinearOutput{},
           designed(oscillator_options(0.01), std::move(d), Eigen::Vector2d(-0.3, 0.0)),
           EngineRegistry<2>::global().create(spec, high_gain_projection_options()));
-      return "accepted: " + observer.engine();
+      return "accepted: " + observer.info().engine;
     } catch (const InvalidInput& e) {
       return std::string(e.what());
     }
@@ -834,12 +839,14 @@ TEST(HighGainObserverBadInput, TheProjectionEngineIsChecked) {
   EXPECT_EQ(OscillatorObserver(OscillatorNonlinearOutput{},
                                designed(oscillator_options(0.01), oscillator_design(false),
                                         Eigen::Vector2d(-0.3, 0.0)))
-                .engine(),
+                .info()
+                .engine,
             "ceres");
   EXPECT_EQ(OscillatorObserver(OscillatorNonlinearOutput{},
                                designed(oscillator_options(0.01), oscillator_design(true),
                                         Eigen::Vector2d(-0.3, 0.0)))
-                .engine(),
+                .info()
+                .engine,
             "explicit inverse");
 }
 

@@ -61,7 +61,7 @@ double relative_error_from(ModulatingFunctionObserver<Form>& observer, const Mea
                            Eigen::Index from, int* failures = nullptr) {
   double worst = 0.0, scale = 0.0;
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
-    const ObserverStep& s = observer.step_at(k, data.t[k], data.y.col(k), data.u.col(k));
+    const ObserverStep& s = observer.step(k, data.t[k], data.y.col(k), data.u.col(k));
     if (failures && !s.failure.empty()) ++*failures;
     const Eigen::VectorXd eta = observer.coordinates_at(data.x.col(k), data.t[k]);
     scale = std::max(scale, eta.norm());
@@ -76,7 +76,7 @@ double relative_error_from(ModulatingFunctionObserver<Form>& observer, const Mea
 double derivative_rms(Observer& observer, const Measurements& data, Eigen::Index from) {
   double sum = 0.0;
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
-    const ObserverStep& s = observer.step_at(k, data.t[k], data.y.col(k), data.u.col(k));
+    const ObserverStep& s = observer.step(k, data.t[k], data.y.col(k), data.u.col(k));
     if (k >= from) sum += std::pow(s.estimate[1] - data.x(1, k), 2);
   }
   return std::sqrt(sum / static_cast<double>(data.steps() - from));
@@ -193,7 +193,7 @@ TEST(ModulatingFunctionObserver, ExactOnAQuadraticThroughTheFir) {
     data.x.col(k) << data.y(0, k), -2.0 + 1.4 * t, 1.4;
   }
   ModulatingFunctionObserver<ChainForm<3>> observer(ChainForm<3>{}, options(delta, 0.5, 3));
-  EXPECT_EQ(observer.window(), 501);
+  EXPECT_EQ(observer.info().window, 501);
   EXPECT_LT(relative_error_from(observer, data, 500), 1e-9);  // measured 2.1e-10
 }
 
@@ -206,7 +206,7 @@ TEST(ModulatingFunctionObserver, LtiExactOneHorizonAfterStart) {
     o.quadrature = q;
     ModulatingFunctionObserver<LtiInjectionForm> observer(LtiInjectionForm{}, o);
     int failures = 0;
-    const double rel = relative_error_from(observer, data, observer.window() - 1, &failures);
+    const double rel = relative_error_from(observer, data, observer.info().window - 1, &failures);
     EXPECT_EQ(failures, 0);
     // Simpson: measured 2e-9 (the plant's own RK4 error); the trapezoid rule's O(δ²) is 4e-5.
     EXPECT_LT(rel, q == Quadrature::kSimpson ? 1e-6 : 1e-3);
@@ -217,7 +217,7 @@ TEST(ModulatingFunctionObserver, PendulumExactOneHorizonAfterStart) {
   const Measurements data =
       simulate_continuous(PendulumTimeVaryingFriction{}, Eigen::Vector2d(1.0, 0.0), 0.01, 6.0);
   ModulatingFunctionObserver<PendulumForm> observer(PendulumForm{}, options(0.01, 1.0));
-  EXPECT_LT(relative_error_from(observer, data, observer.window() - 1), 1e-6);
+  EXPECT_LT(relative_error_from(observer, data, observer.info().window - 1), 1e-6);
 }
 
 // Theorem 1: with |d| ≤ a_max/l the canonical error stays within the kernel's L1 gain times
@@ -233,8 +233,8 @@ TEST(ModulatingFunctionObserver, DisturbedPendulumStaysWithinTheBound) {
   ModulatingFunctionObserver<PendulumForm> observer(form, o);
   double worst = 0.0;
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
-    observer.step_at(k, data.t[k], data.y.col(k), data.u.col(k));
-    if (k < observer.window() - 1) continue;
+    observer.step(k, data.t[k], data.y.col(k), data.u.col(k));
+    if (k < observer.info().window - 1) continue;
     const Eigen::Vector2d error =
         observer.coordinates_at(data.x.col(k), data.t[k]) - Eigen::VectorXd(observer.eta());
     for (int j = 0; j < 2; ++j) {
@@ -280,7 +280,7 @@ TEST(ModulatingFunctionObserver, SampledDataBridgesAMissingSample) {
   ModulatingFunctionObserver<LtiInjectionForm> observer(LtiInjectionForm{}, o);
   int failures = 0;
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
-    const ObserverStep& s = observer.step(k, data.y.col(k), data.u.col(k));
+    const ObserverStep& s = observer.step(k, data.t[k], data.y.col(k), data.u.col(k));
     failures += s.failure.empty() ? 0 : 1;
     if (k == 500) {
       EXPECT_TRUE(s.measurement_missing);
@@ -310,7 +310,7 @@ TEST(ModulatingFunctionObserver, ATimeJumpIsSkippedAtOnceAndRecovers) {
     bool jumped_missing = false, ready_again = false;
     for (Eigen::Index k = 0; k < data.steps(); ++k) {
       const double t = data.t[k] + (k >= half ? 1e6 : 0.0);
-      const ObserverStep& s = observer.step_at(k, t, data.y.col(k), data.u.col(k));
+      const ObserverStep& s = observer.step(k, t, data.y.col(k), data.u.col(k));
       EXPECT_TRUE(s.failure.empty()) << s.failure_message;
       if (k == half) jumped_missing = s.measurement_missing && !s.ready;
       if (k > half + 150) ready_again = ready_again || s.ready;
@@ -348,13 +348,13 @@ TEST(ModulatingFunctionObserver, FirstOrderChainInBothModes) {
 TEST(ModulatingFunctionObserver, RepeatedOrDecreasingTimesAreRefused) {
   ModulatingFunctionObserver<LtiInjectionForm> observer(LtiInjectionForm{}, options(0.01, 1.0));
   const Eigen::VectorXd y = Eigen::VectorXd::Ones(1), u(0);
-  EXPECT_TRUE(observer.step_at(0, 0.0, y, u).failure.empty());
-  EXPECT_TRUE(observer.step_at(1, 0.01, y, u).failure.empty());
-  EXPECT_EQ(observer.step_at(2, 0.01, y, u).failure, "non_uniform");
-  EXPECT_EQ(observer.step_at(3, 0.01 + 1e-9, y, u).failure, "non_uniform");  // same grid point
-  EXPECT_EQ(observer.step_at(4, 0.005, y, u).failure, "non_uniform");
-  EXPECT_FALSE(observer.step_at(4, 0.005, y, u).ready);
-  EXPECT_TRUE(observer.step_at(5, 0.02, y, u).failure.empty());  // back on the grid
+  EXPECT_TRUE(observer.step(0, 0.0, y, u).failure.empty());
+  EXPECT_TRUE(observer.step(1, 0.01, y, u).failure.empty());
+  EXPECT_EQ(observer.step(2, 0.01, y, u).failure, "non_uniform");
+  EXPECT_EQ(observer.step(3, 0.01 + 1e-9, y, u).failure, "non_uniform");  // same grid point
+  EXPECT_EQ(observer.step(4, 0.005, y, u).failure, "non_uniform");
+  EXPECT_FALSE(observer.step(4, 0.005, y, u).ready);
+  EXPECT_TRUE(observer.step(5, 0.02, y, u).failure.empty());  // back on the grid
 }
 
 // Absolute (epoch) times carry their decimal rounding: still on the grid.
@@ -363,9 +363,9 @@ TEST(ModulatingFunctionObserver, AbsoluteTimesStayOnTheGrid) {
   const Eigen::VectorXd y = Eigen::VectorXd::Ones(1), u(0);
   for (long k = 0; k < 30; ++k) {
     const double t = std::stod("1700000000." + std::to_string(100 + k).substr(1));  // ….00, ….01
-    EXPECT_TRUE(observer.step_at(k, t, y, u).failure.empty()) << k;
+    EXPECT_TRUE(observer.step(k, t, y, u).failure.empty()) << k;
   }
-  EXPECT_TRUE(observer.step_at(30, 1700000000.30, y, u).ready);
+  EXPECT_TRUE(observer.step(30, 1700000000.30, y, u).ready);
 }
 
 // Resampling: samples every 15 ms onto a 10 ms grid are interpolated (short spans), a long gap
@@ -380,7 +380,7 @@ TEST(ModulatingFunctionObserver, ResamplingBridgesShortSpansNotGaps) {
   double worst = 0.0;
   long k = 0;
   for (Eigen::Index i = 0; i < fine.steps(); i += 3, ++k) {  // every 15 ms
-    const ObserverStep& s = observer.step_at(k, fine.t[i], fine.y.col(i), fine.u.col(i));
+    const ObserverStep& s = observer.step(k, fine.t[i], fine.y.col(i), fine.u.col(i));
     EXPECT_TRUE(s.failure.empty()) << s.failure_message;
     if (fine.t[i] > 1.5 && fine.t[i] < 5.0) {
       EXPECT_TRUE(s.ready) << fine.t[i];
@@ -393,7 +393,7 @@ TEST(ModulatingFunctionObserver, ResamplingBridgesShortSpansNotGaps) {
   // A 0.5 s gap (more than 4 δ): its grid points are missing, the window refills for 1 s.
   const double t_gap = fine.t[fine.steps() - 1] + 0.5;
   const Eigen::VectorXd y = fine.y.col(fine.steps() - 1);
-  EXPECT_FALSE(observer.step_at(k, t_gap, y, fine.u.col(0)).ready);
+  EXPECT_FALSE(observer.step(k, t_gap, y, fine.u.col(0)).ready);
 }
 
 TEST(ModulatingFunctionObserver, NanSampleInvalidatesTheWindowUntilRefilled) {
@@ -403,7 +403,7 @@ TEST(ModulatingFunctionObserver, NanSampleInvalidatesTheWindowUntilRefilled) {
   ModulatingFunctionObserver<LtiInjectionForm> observer(LtiInjectionForm{}, options(0.01, 1.0));
   Eigen::VectorXd kept;
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
-    const ObserverStep& s = observer.step(k, data.y.col(k), data.u.col(k));
+    const ObserverStep& s = observer.step(k, data.t[k], data.y.col(k), data.u.col(k));
     if (k == 199) kept = s.estimate;
     if (k == 200) {
       EXPECT_TRUE(s.measurement_missing);
@@ -438,7 +438,7 @@ TEST(ModulatingFunctionObserver, NonUniformTimesAreRefusedOrResampled) {
   ModulatingFunctionObserver<LtiInjectionForm> strict(LtiInjectionForm{}, options(0.01, 1.0));
   Eigen::VectorXd before;
   for (Eigen::Index k = 0; k < K; ++k) {
-    const ObserverStep& s = strict.step_at(k, sparse.t[k], sparse.y.col(k), sparse.u.col(k));
+    const ObserverStep& s = strict.step(k, sparse.t[k], sparse.y.col(k), sparse.u.col(k));
     if (k == 149) before = s.estimate;
     if (k == 150) {
       EXPECT_EQ(s.failure, "non_uniform");
@@ -450,7 +450,7 @@ TEST(ModulatingFunctionObserver, NonUniformTimesAreRefusedOrResampled) {
   o.resample = true;
   ModulatingFunctionObserver<LtiInjectionForm> resampling(LtiInjectionForm{}, o);
   for (Eigen::Index k = 0; k < K; ++k) {
-    const ObserverStep& s = resampling.step_at(k, sparse.t[k], sparse.y.col(k), sparse.u.col(k));
+    const ObserverStep& s = resampling.step(k, sparse.t[k], sparse.y.col(k), sparse.u.col(k));
     EXPECT_TRUE(s.failure.empty()) << k << ": " << s.failure_message;
     // One linearly interpolated sample in the window costs accuracy until it leaves it.
     if (k > 260) {
@@ -561,7 +561,7 @@ TEST(FiniteDifferenceObserver, DifferencesAPolynomialExactly) {
   Eigen::VectorXd y(1), u(0);
   for (long k = 0; k < 5; ++k) {
     y[0] = 0.5 * std::pow(0.1 * static_cast<double>(k), 2);  // y = t²/2: ∇y/δ = t − δ/2, ∇²y/δ² = 1
-    const ObserverStep& s = fd.step(k, y, u);
+    const ObserverStep& s = fd.step(k, 0.1 * static_cast<double>(k), y, u);
     EXPECT_EQ(s.ready, k >= 2);
     if (k >= 2) {
       EXPECT_NEAR(s.estimate[1], 0.1 * static_cast<double>(k) - 0.05, 1e-12);
@@ -583,6 +583,28 @@ TEST(FiniteDifferenceObserver, DifferencesAPolynomialExactly) {
             "FiniteDifferenceOptions::sample_time must be finite and > 0 (got -0.1)");
   EXPECT_EQ(refusal({.name = "", .states = 2, .sample_time = 0.1}),
             "FiniteDifferenceOptions::name must not be empty (got \"\")");
+}
+
+// The differences divide by δ: a sample off the grid t_0 + k δ is refused (not differenced
+// across the wrong span), and a skipped k restarts them like a missing sample.
+TEST(FiniteDifferenceObserver, SamplesOffTheGridOrSkippedRestartTheDifferences) {
+  FiniteDifferenceObserver fd({.states = 2, .sample_time = 0.1});
+  const Eigen::VectorXd u(0);
+  const auto y = [](double t) { return Eigen::VectorXd::Constant(1, 3.0 * t); };  // y' = 3
+  // Recorded times from t_0 = 5: the grid starts at the first sample.
+  EXPECT_FALSE(fd.step(0, 5.0, y(5.0), u).ready);
+  EXPECT_NEAR(fd.step(1, 5.1, y(5.1), u).estimate[1], 3.0, 1e-9);
+  const ObserverStep& off = fd.step(2, 5.25, y(5.25), u);
+  EXPECT_EQ(off.failure, "non_uniform");
+  EXPECT_NE(off.failure_message.find("finite_difference: sample k = 2 at t = 5.25"),
+            std::string::npos)
+      << off.failure_message;
+  EXPECT_FALSE(off.ready);
+  EXPECT_FALSE(fd.step(3, 5.3, y(5.3), u).ready);  // restarted: one sample so far
+  EXPECT_TRUE(fd.step(4, 5.4, y(5.4), u).ready);
+  EXPECT_FALSE(fd.step(6, 5.6, y(5.6), u).ready);  // k = 5 never came: restarted
+  EXPECT_NEAR(fd.step(7, 5.7, y(5.7), u).estimate[1], 3.0, 1e-9);
+  EXPECT_EQ(fd.step(8, std::nan(""), y(5.8), u).failure, "non_finite");
 }
 
 }  // namespace

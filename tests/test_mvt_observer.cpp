@@ -55,12 +55,12 @@ Trace run(MvtObserver<Model>& observer, const Measurements& data) {
   Trace trace;
   observer.reset();
   for (long k = 0; k < data.steps(); ++k) {
-    const ObserverStep& s = observer.step(k, data.y.col(k), data.u.col(k));
+    const ObserverStep& s = observer.step(k, data.t[k], data.y.col(k), data.u.col(k));
     if (!s.failure.empty()) ++trace.failures;
     const Eigen::VectorXd e = data.x.col(k) - s.estimate;
     trace.error.push_back(e.norm());
-    trace.tracking.push_back((e - s.extras.segment(1 + n, n)).norm());
-    trace.max_residual = std::max(trace.max_residual, s.extras[0]);
+    trace.tracking.push_back((e - s.signals.segment(1 + n, n)).norm());
+    trace.max_residual = std::max(trace.max_residual, s.signals[0]);
   }
   return trace;
 }
@@ -242,7 +242,7 @@ TEST(MvtObserver, JointBetaSolversGiveTheSameRun) {
     const Trace trace = run(joint, data);
     EXPECT_LE(trace.max_residual, 1e-8) << to_string(m);
     EXPECT_LE((joint.xhat() - rows.xhat()).norm(), 1e-9) << to_string(m);
-    EXPECT_EQ(joint.engine(), to_string(m));
+    EXPECT_EQ(joint.info().engine, to_string(m));
   }
 }
 
@@ -286,8 +286,9 @@ TEST(MvtObserver, MissingSamplesAreBridged) {
       started(options(MvtVariant::kOutputInjection), kChaoticXhat0, kCase2Error));
   const Trace trace = run(gapped, data);
   EXPECT_EQ(trace.failures, 0);
-  EXPECT_TRUE(gapped.step(4001, data.y.col(0).setConstant(std::nan("")), data.u.col(0))
-                  .measurement_missing);
+  EXPECT_TRUE(
+      gapped.step(4001, 4001 * kStep, data.y.col(0).setConstant(std::nan("")), data.u.col(0))
+          .measurement_missing);
   EXPECT_LE((gapped.xhat() - reference.xhat()).norm(), 1e-4);
 }
 
@@ -399,7 +400,7 @@ TEST(MvtObserverBadInput, NonFiniteFKeepsTheLastGoodState) {
   long first_failure = -1;
   Eigen::VectorXd last_good;
   for (long k = 0; k < steps; ++k) {
-    const ObserverStep& s = observer.step(k, data.y.col(k), data.u.col(k));
+    const ObserverStep& s = observer.step(k, data.t[k], data.y.col(k), data.u.col(k));
     if (!s.failure.empty()) {
       first_failure = k;
       EXPECT_EQ(s.failure, "non_finite");
@@ -417,8 +418,8 @@ TEST(MvtObserverBadInput, ModelWithoutJetSupportFallsBackToFiniteDifferences) {
   MvtObserver<DoubleOnly> observer(
       DoubleOnly{}, started(options(MvtVariant::kPublished), Eigen::Vector2d(0.5, 0.0),
                             Eigen::Vector2d(0.2, -0.1)));
-  ASSERT_EQ(observer.warnings().size(), 1u);
-  EXPECT_NE(observer.warnings()[0].find("central differences"), std::string::npos);
+  ASSERT_EQ(observer.info().warnings.size(), 1u);
+  EXPECT_NE(observer.info().warnings[0].find("central differences"), std::string::npos);
   const DoubleOnly model;
   MvtBetaSolver<DoubleOnly> solver(model, {});
   const Eigen::Vector2d xhat(0.5, 0.0), ehat(0.8, -0.3);
@@ -436,14 +437,15 @@ TEST(MvtObserverBadInput, NonFiniteInputKeepsTheState) {
   MvtObserver<FlexibleJointRobot> observer(
       robot, started(options(MvtVariant::kOutputInjection), kRobotXhat0, kRobotX0 - kRobotXhat0));
   const Eigen::VectorXd y = kRobotX0.head<3>(), u = Eigen::VectorXd::Zero(1);
-  observer.step(0, y, u);
-  observer.step(1, y, u);
+  observer.step(0, 0 * kStep, y, u);
+  observer.step(1, 1 * kStep, y, u);
   const Eigen::Vector4d kept = observer.xhat();
-  const ObserverStep& bad = observer.step(2, y, Eigen::VectorXd::Constant(1, std::nan("")));
+  const ObserverStep& bad =
+      observer.step(2, 2 * kStep, y, Eigen::VectorXd::Constant(1, std::nan("")));
   EXPECT_EQ(bad.failure, "non_finite");
   EXPECT_NE(bad.failure_message.find("u_k is not finite"), std::string::npos);
   EXPECT_EQ(observer.xhat(), kept);
-  EXPECT_TRUE(observer.step(3, y, u).failure.empty());  // the next good sample goes on
+  EXPECT_TRUE(observer.step(3, 3 * kStep, y, u).failure.empty());  // the next good sample goes on
   EXPECT_TRUE(observer.xhat().allFinite());
 }
 
@@ -452,21 +454,52 @@ TEST(MvtObserverBadInput, SamplesComeInOrderAndResetStartsAgain) {
   MvtObserver<ChaoticNoLinear> observer(
       ChaoticNoLinear{}, started(options(MvtVariant::kPublished), kChaoticXhat0, kCase2Error));
   const Eigen::VectorXd y = kChaoticX0.head<2>(), u(0);
-  observer.step(0, y, u);
-  const Eigen::Vector3d first = observer.step(1, y, u).estimate;
-  EXPECT_NE(
-      test::message_of([&] { observer.step(1, y, u); }).find("sample k = 1 does not come after"),
-      std::string::npos);
+  observer.step(0, 0 * kStep, y, u);
+  const Eigen::Vector3d first = observer.step(1, 1 * kStep, y, u).estimate;
+  EXPECT_NE(test::message_of([&] {
+              observer.step(1, 1 * kStep, y, u);
+            }).find("sample k = 1 does not come after"),
+            std::string::npos);
   observer.reset();
-  EXPECT_TRUE(observer.step(0, y, u).failure.empty());
-  EXPECT_EQ(observer.step(1, y, u).estimate, first);  // the same run again
+  EXPECT_TRUE(observer.step(0, 0 * kStep, y, u).failure.empty());
+  EXPECT_EQ(observer.step(1, 1 * kStep, y, u).estimate, first);  // the same run again
+}
+
+// Recorded times: the grid t_0 + k·T starts at the first sample (data from t_0 = 100 give the
+// run from 0, to the rounding of y's interpolation times); a time off the grid is refused with
+// the state held, and the next sample on it goes on.
+TEST(MvtObserverBadInput, TimesMustLieOnTheSampleGrid) {
+  Measurements data = simulate_continuous(ChaoticNoLinear{}, kChaoticX0, 1.0);
+  const auto make = [] {
+    return MvtObserver<ChaoticNoLinear>(
+        ChaoticNoLinear{}, started(options(MvtVariant::kPublished), kChaoticXhat0, kCase2Error));
+  };
+  MvtObserver<ChaoticNoLinear> reference = make(), shifted = make(), jittered = make();
+  for (long k = 0; k < data.steps(); ++k) {
+    const Eigen::VectorXd y = data.y.col(k), u = data.u.col(k);
+    const Eigen::VectorXd a = reference.step(k, data.t[k], y, u).estimate;
+    const ObserverStep& b = shifted.step(k, 100.0 + data.t[k], y, u);
+    ASSERT_TRUE(b.failure.empty()) << b.failure_message;
+    EXPECT_LT((b.estimate - a).norm(), 1e-9) << k;
+  }
+  EXPECT_GT((reference.xhat() - kChaoticXhat0).norm(), 0.1);  // it moved: not a trivial match
+  jittered.step(0, 0.0, data.y.col(0), data.u.col(0));
+  const Eigen::Vector3d kept = jittered.xhat();
+  const ObserverStep& off = jittered.step(1, 0.4 * kStep, data.y.col(1), data.u.col(1));
+  EXPECT_EQ(off.failure, "non_uniform");
+  EXPECT_NE(off.failure_message.find("off the uniform grid"), std::string::npos)
+      << off.failure_message;
+  EXPECT_EQ(jittered.xhat(), kept);
+  EXPECT_EQ(jittered.step(2, std::nan(""), data.y.col(2), data.u.col(2)).failure, "non_finite");
+  EXPECT_TRUE(jittered.step(3, 3 * kStep, data.y.col(3), data.u.col(3)).failure.empty());
+  EXPECT_NE(jittered.xhat(), kept);
 }
 
 TEST(MvtObserverBadInput, WrongSampleSizeIsAnError) {
   MvtObserver<ChaoticNoLinear> observer(
       ChaoticNoLinear{}, started(options(MvtVariant::kPublished), kChaoticXhat0, kCase2Error));
   EXPECT_NE(test::message_of([&] {
-              observer.step(0, Eigen::VectorXd::Zero(3), Eigen::VectorXd());
+              observer.step(0, 0 * kStep, Eigen::VectorXd::Zero(3), Eigen::VectorXd());
             }).find("the observer takes sizes 2 and 0"),
             std::string::npos);
 }

@@ -13,6 +13,7 @@
 #include "nlobs/observers/window_estimator.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 #include "nlobs/solvers/newton_engine.hpp"
+#include "test_support.hpp"
 
 namespace nlobs {
 namespace {
@@ -82,7 +83,7 @@ TEST(WindowEstimator, NoiseFreeRecoveryByEveryEngine) {
   observers.push_back(window_estimator("ceres", 1e-10, 6));
   auto result = run_observers(data, observers);
   for (size_t i = 0; i < observers.size(); ++i) {
-    const long from = observers[i]->window() - 1;
+    const long from = observers[i]->info().window - 1;
     const Eigen::MatrixXd err = (result.estimates[i] - data.x).rightCols(data.steps() - from);
     EXPECT_LT(err.cwiseAbs().maxCoeff(), 1e-6) << observers[i]->name();
   }
@@ -94,7 +95,7 @@ TEST(WindowEstimator, NotReadyThenCoastsThenSolves) {
   const Chua model = paper_modified_chua();
   Eigen::Vector3d coast = kGuess;
   for (long k = 0; k < 3; ++k) {
-    const ObserverStep& s = est->step(k, data.y.col(k), Eigen::VectorXd(0));
+    const ObserverStep& s = est->step(k, data.t[k], data.y.col(k), Eigen::VectorXd(0));
     if (k < 2) {
       EXPECT_FALSE(s.ready);
       EXPECT_FALSE(s.summary.has_value());
@@ -146,6 +147,18 @@ TEST(WindowEstimator, PropagatedWarmStartNeedsFewerIterations) {
   EXPECT_LT(r.metrics[1].iterations_mean * 10, r.metrics[0].iterations_mean);
 }
 
+// Every sample carries its time: measurements without one per sample are refused by name, not
+// run on a made-up time axis.
+TEST(RunObservers, MeasurementsWithoutTimesAreRefused) {
+  Measurements data = chua_data(20);
+  data.t.resize(19);
+  std::vector<std::unique_ptr<Observer>> observers;
+  observers.push_back(window_estimator("newton", 1e-10));
+  EXPECT_EQ(test::message_of([&] { run_observers(data, observers); }),
+            "run_observers: Measurements::t has 19 times for 20 samples; every sample needs its "
+            "time");
+}
+
 TEST(WindowEstimator, LongWindowAttenuatesNoiseInX3) {
   // With N = n = 3 noise is amplified ~37× in x3 (our working notes on [MGFF23]); least
   // squares on N = 6 (ours) cures it.
@@ -173,7 +186,7 @@ TEST(WindowEstimator, MultiOutputWindowByLeastSquares) {
   WindowEstimatorOptions options;
   options.initial_estimate = Eigen::Vector3d(-1.0, -0.5, -1.5);
   observers.push_back(make_window_estimator(model, "ceres", options, so));
-  EXPECT_EQ(observers[0]->window(), 2);
+  EXPECT_EQ(observers[0]->info().window, 2);
   const auto r = run_observers(data, observers);
   EXPECT_LT((r.estimates[0].rightCols(49) - data.x.rightCols(49)).cwiseAbs().maxCoeff(), 1e-8);
 }
@@ -200,7 +213,7 @@ TEST(WindowEstimator, OneSampleWindowWhenTheOutputIsTheState) {
   WindowEstimatorOptions options;
   options.initial_estimate = Eigen::Vector2d(0.0, 0.0);
   observers.push_back(make_window_estimator(model, "newton:tol=1e-13", options));
-  EXPECT_EQ(observers[0]->window(), 1);
+  EXPECT_EQ(observers[0]->info().window, 1);
   const auto r = run_observers(data, observers);
   EXPECT_LT((r.estimates[0] - data.x).cwiseAbs().maxCoeff(), 1e-12);
 }
@@ -219,7 +232,7 @@ TEST(Baselines, LuenbergerErrorFollowsALC) {
   Eigen::Vector2d x = x0, e = x0 - guess;
   for (long k = 0; k < 20; ++k) {
     const Eigen::VectorXd u = Eigen::VectorXd::Constant(1, std::sin(0.3 * static_cast<double>(k)));
-    const ObserverStep& s = obs.step(k, model.h(x), u);
+    const ObserverStep& s = obs.step(k, static_cast<double>(k), model.h(x), u);
     EXPECT_LT((x - s.estimate - e).norm(), 1e-12) << k;
     e = alc * e;
     x = model.f(x, Linear2::Input(u), k);
@@ -242,7 +255,7 @@ TEST(Baselines, EkfOnALinearSystemIsTheKalmanFilter) {
   double last = 0.0;
   for (long k = 0; k < 60; ++k) {
     const Eigen::VectorXd u = Eigen::VectorXd::Constant(1, 0.1);
-    last = (ekf.step(k, model.h(x), u).estimate - x).norm();
+    last = (ekf.step(k, static_cast<double>(k), model.h(x), u).estimate - x).norm();
     x = model.f(x, Linear2::Input(u), k);
   }
   EXPECT_LT(last, 1e-6);
@@ -260,8 +273,9 @@ TEST(Baselines, SlidingModeSaturates) {
   options.gamma = 0.5;
   SlidingModeObserver<Linear2> smo(model, options);
   // y − ŷ = 10 ≫ γ: the correction is R · sat(20) = R.
-  smo.step(0, Eigen::VectorXd::Constant(1, 10.0), Eigen::VectorXd::Zero(1));
-  const ObserverStep& s = smo.step(1, Eigen::VectorXd::Constant(1, 0.0), Eigen::VectorXd::Zero(1));
+  smo.step(0, 0.0, Eigen::VectorXd::Constant(1, 10.0), Eigen::VectorXd::Zero(1));
+  const ObserverStep& s =
+      smo.step(1, 1.0, Eigen::VectorXd::Constant(1, 0.0), Eigen::VectorXd::Zero(1));
   EXPECT_NEAR(s.estimate[0], 1.0, 1e-15);
   options.gamma = 0.0;
   EXPECT_THROW(SlidingModeObserver<Linear2>(model, options), InvalidInput);
@@ -273,7 +287,8 @@ TEST(WindowEstimator, TakesItsLabelFromTheEngine) {
   options.initial_estimate = kGuess;
   EXPECT_EQ(make_window_estimator(paper_modified_chua(), "newton:tol=1e-10", options)->name(),
             "window:newton:tol=1e-10");
-  EXPECT_EQ(make_window_estimator(paper_modified_chua(), "newton", options)->engine(), "newton");
+  EXPECT_EQ(make_window_estimator(paper_modified_chua(), "newton", options)->info().engine,
+            "newton");
   WindowEstimator<Chua> direct(paper_modified_chua(), options,
                                std::make_unique<NewtonEngine<3>>(NewtonOptions{}));
   EXPECT_EQ(direct.name(), "window:newton");

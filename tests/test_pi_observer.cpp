@@ -83,7 +83,8 @@ TEST(PiObserver, BankOnSamplesMatchesTheDirectFormToInterpolationAccuracy) {
   double worst = 0.0;
   for (long k = 0; k <= 5000; ++k) {
     const double t = h * static_cast<double>(k);
-    const auto& step = observer.step(k, Eigen::VectorXd::Constant(1, s_of(t)), Eigen::VectorXd());
+    const auto& step =
+        observer.step(k, t, Eigen::VectorXd::Constant(1, s_of(t)), Eigen::VectorXd());
     worst = std::max(worst, (step.estimate - e).cwiseAbs().maxCoeff());
     e = rk4(
         [&](double tau, const Eigen::Vector2d& x) {
@@ -93,7 +94,10 @@ TEST(PiObserver, BankOnSamplesMatchesTheDirectFormToInterpolationAccuracy) {
   }
   // y is interpolated linearly between samples: O(h²) in s, amplified by k_p² a in the γ form.
   EXPECT_LT(worst, 1e-4);
-  EXPECT_EQ(observer.extra_names(), (std::vector<std::string>{"eta", "eta.rate"}));
+  ASSERT_EQ(observer.info().signals.size(), 2u);  // the bank's stage signals, named by the bank
+  EXPECT_EQ(observer.info().signals[0].name, "eta");
+  EXPECT_EQ(observer.info().signals[1].name, "eta.rate");
+  EXPECT_EQ(observer.info().signals[1].kind, SignalKind::kDiagnostic);
 }
 
 TEST(PiBound, L1GainMatchesClosedFormsForRealRoots) {
@@ -183,7 +187,7 @@ TEST(PiBank, TwoStageCascadeEstimatesVelocityThenAcceleration) {
   double worst_v = 0, worst_acc = 0;
   for (long k = 0; k <= 20000; ++k) {
     const double t = h * static_cast<double>(k);
-    const auto& s = observer.step(k, Eigen::VectorXd::Constant(1, std::sin(t)), {});
+    const auto& s = observer.step(k, t, Eigen::VectorXd::Constant(1, std::sin(t)), {});
     if (t < 5.0) continue;
     worst_v = std::max(worst_v, std::abs(s.estimate[0] - std::cos(t)));
     worst_acc = std::max(worst_acc, std::abs(s.estimate[1] + std::sin(t)));
@@ -205,7 +209,7 @@ TEST(PiBank, VectorEtaOnSeveralOutputs) {
   double worst_a = 0, worst_b = 0;
   for (long k = 0; k <= 10000; ++k) {
     const double t = h * static_cast<double>(k);
-    const auto& s = observer.step(k, Eigen::Vector2d(std::sin(t), std::cos(2 * t)), {});
+    const auto& s = observer.step(k, t, Eigen::Vector2d(std::sin(t), std::cos(2 * t)), {});
     if (t < 3.0) continue;
     worst_a = std::max(worst_a, std::abs(s.estimate[0] - std::cos(t)));
     worst_b = std::max(worst_b, std::abs(s.estimate[1] + 2 * std::sin(2 * t)));
@@ -293,14 +297,14 @@ TEST(PiBank, MissingMeasurementsHoldTheStateAndTheGapIsIntegratedInSteps) {
   const double h = 1e-3;
   PiBankObserver full(bank, {.name = "full", .estimate = {eta.eta, eta.rate}, .sample_time = h});
   PiBankObserver gappy(bank, {.name = "gappy", .estimate = {eta.eta, eta.rate}, .sample_time = h});
-  const auto y = [&](long k) {
-    return Eigen::VectorXd::Constant(1, 2.0 * h * static_cast<double>(k));
-  };
+  const auto t = [&](long k) { return h * static_cast<double>(k); };
+  const auto y = [&](long k) { return Eigen::VectorXd::Constant(1, 2.0 * t(k)); };
   Eigen::VectorXd held;
   for (long k = 0; k < 400; ++k) {
-    const Eigen::VectorXd reference = full.step(k, y(k), {}).estimate;
+    const Eigen::VectorXd reference = full.step(k, t(k), y(k), {}).estimate;
     const bool missing = k >= 100 && k < 300;
-    const auto& s = gappy.step(k, missing ? Eigen::VectorXd::Constant(1, std::nan("")) : y(k), {});
+    const auto& s =
+        gappy.step(k, t(k), missing ? Eigen::VectorXd::Constant(1, std::nan("")) : y(k), {});
     EXPECT_EQ(s.measurement_missing, missing);
     if (k == 99) held = s.estimate;
     if (missing) {
@@ -310,7 +314,7 @@ TEST(PiBank, MissingMeasurementsHoldTheStateAndTheGapIsIntegratedInSteps) {
       EXPECT_LT((s.estimate - reference).cwiseAbs().maxCoeff(), 1e-9) << k;
     }
   }
-  EXPECT_THROW(gappy.step(400, Eigen::VectorXd::Zero(2), {}), InvalidInput);
+  EXPECT_THROW(gappy.step(400, t(400), Eigen::VectorXd::Zero(2), {}), InvalidInput);
 }
 
 TEST(PiBank, AFirstSampleWithNonFiniteSignalsDoesNotStart) {
@@ -320,11 +324,11 @@ TEST(PiBank, AFirstSampleWithNonFiniteSignalsDoesNotStart) {
   const auto eta = bank.add_pi(
       "eta", {.measured = inv, .gains = {8, 15}, .initial_estimates = Eigen::Vector2d::Zero()});
   PiBankObserver observer(bank, {.name = "pi", .estimate = {eta.eta}, .sample_time = 0.1});
-  const auto& first = observer.step(0, Eigen::VectorXd::Zero(1), {});
+  const auto& first = observer.step(0, 0.0, Eigen::VectorXd::Zero(1), {});
   EXPECT_EQ(first.failure, "non_finite");
   EXPECT_FALSE(first.ready);
   EXPECT_NE(first.failure_message.find("cannot start"), std::string::npos);
-  const auto& second = observer.step(1, Eigen::VectorXd::Constant(1, 2.0), {});
+  const auto& second = observer.step(1, 0.1, Eigen::VectorXd::Constant(1, 2.0), {});
   EXPECT_TRUE(second.failure.empty());
   EXPECT_TRUE(second.ready);
   EXPECT_NEAR(second.estimate[0], 0.0, 1e-12);  // started here, from η̂ = 0
@@ -345,10 +349,11 @@ TEST(PiBank, NonFiniteSignalKeepsTheLastGoodStateAndSaysWhere) {
   const auto inv = bank.add_signal("inverse", [y](const PiBank::Values& v) { return 1.0 / v[y]; });
   const auto eta = bank.add_pi("eta", {.measured = inv, .gains = {8, 15}});
   PiBankObserver observer(bank, {.name = "pi", .estimate = {eta.eta}, .sample_time = 0.5});
-  observer.step(0, Eigen::VectorXd::Constant(1, 1.0), {});
-  const Eigen::VectorXd good = observer.step(1, Eigen::VectorXd::Constant(1, 0.5), {}).estimate;
+  observer.step(0, 0.0, Eigen::VectorXd::Constant(1, 1.0), {});
+  const Eigen::VectorXd good =
+      observer.step(1, 0.5, Eigen::VectorXd::Constant(1, 0.5), {}).estimate;
   // [t1, t2] with y from 0.5 to −0.5: the RK4 midpoint hits y = 0.
-  const auto& bad = observer.step(2, Eigen::VectorXd::Constant(1, -0.5), {});
+  const auto& bad = observer.step(2, 1.0, Eigen::VectorXd::Constant(1, -0.5), {});
   EXPECT_EQ(bad.failure, "non_finite");
   EXPECT_NE(bad.failure_message.find("'inverse'"), std::string::npos) << bad.failure_message;
   EXPECT_NE(bad.failure_message.find("t = 0.75"), std::string::npos) << bad.failure_message;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "cli_test_files.hpp"
+#include "modulating_report.hpp"
 #include "output_directory.hpp"
 #include "run_command.hpp"
 #include "run_outputs.hpp"
@@ -232,6 +233,103 @@ TEST(RunOutputs, ObserversOfOneNameAreToldApart) {
   std::getline(csv, header);
   EXPECT_NE(header.find(",ekf.x1,ekf.x2,ekf.x3,ekf #2.x1,"), std::string::npos) << header;
   EXPECT_NE(header.find("ekf #3.x3"), std::string::npos) << header;
+}
+
+// ---- typed signals: the reports read a signal's kind, never its spelling --------------------
+
+// A user's own observer that estimates in coordinates of its own, w = 2x, and publishes ŵ under
+// names of its own: ŵ = (2y, 1 + t) for x = (y, 0), so ‖w − ŵ‖ = 1 + t exactly; its fit
+// residual is t / 4. `kind` says which coordinates; a signal spelt "zhat1" but of kind
+// kDiagnostic is never mistaken for an estimate.
+class OwnCoordinatesObserver final : public Observer {
+ public:
+  explicit OwnCoordinatesObserver(SignalKind kind) {
+    info_.name = "own";
+    info_.signals = {{"zhat1"},  // a diagnostic, whatever its name
+                     {"w_first", kind},
+                     {"w_second", kind},
+                     {"fit", SignalKind::kProjectionResidual}};
+    step_.signals.resize(4);
+  }
+  void reset() override {}
+  const ObserverStep& step(long, double t, const Eigen::VectorXd& y,
+                           const Eigen::VectorXd&) override {
+    step_.estimate = Eigen::Vector2d(y[0], 0.0);
+    step_.signals << -1e6, 2.0 * y[0], 1.0 + t, 0.25 * t;
+    return step_;
+  }
+  Eigen::VectorXd coordinates_at(const Eigen::VectorXd& x, double) const override {
+    return 2.0 * x;
+  }
+
+ private:
+  ObserverStep step_;
+};
+
+Measurements own_data() {
+  Measurements data;
+  const Eigen::Index K = 5;
+  data.t = Eigen::VectorXd::LinSpaced(K, 0.0, 2.0);
+  data.x = Eigen::MatrixXd::Zero(2, K);
+  data.x.row(0) = data.t.transpose().array().sin();
+  data.y = data.x.topRows(1);
+  data.u = Eigen::MatrixXd::Zero(0, K);
+  return data;
+}
+
+TEST(TypedSignals, AnOwnEmbeddedObserverGetsTheEmbeddedFigures) {
+  const Measurements data = own_data();
+  std::vector<std::unique_ptr<Observer>> observers;
+  observers.push_back(std::make_unique<OwnCoordinatesObserver>(SignalKind::kEmbeddedEstimate));
+  RunResult r = run_observers(data, observers, 2);
+  add_coordinate_errors(data, observers, r);
+  ASSERT_EQ(r.signal_info[0].size(), 5u);
+  EXPECT_EQ(r.signal_info[0][4].name, "z_error");
+  EXPECT_EQ(r.signal_info[0][4].kind, SignalKind::kEmbeddedError);
+  for (Eigen::Index k = 0; k < data.steps(); ++k) {
+    EXPECT_NEAR(r.signals[0](4, k), 1.0 + data.t[k], 1e-15) << k;
+  }
+  const auto m = embedded_metrics(r, 0);
+  ASSERT_TRUE(m.has_value());
+  double peak = 0.0;  // ‖ŵ‖ over the two estimate rows only (not the -1e6 diagnostic)
+  for (Eigen::Index k = 0; k < data.steps(); ++k) {
+    peak = std::max(peak, std::hypot(2.0 * data.y(0, k), 1.0 + data.t[k]));
+  }
+  EXPECT_DOUBLE_EQ(m->max_zhat_norm, peak);
+  EXPECT_DOUBLE_EQ(m->final_z_error, 3.0);
+  EXPECT_DOUBLE_EQ(m->max_residual_after, 0.5);  // t / 4 at t = 2
+  EXPECT_EQ(m->time_index_below, -1);
+  EXPECT_FALSE(modulating_metrics(r, 0, 0).has_value());  // not canonical coordinates
+}
+
+TEST(TypedSignals, AnOwnCanonicalObserverGetsTheModulatingFigures) {
+  const Measurements data = own_data();
+  std::vector<std::unique_ptr<Observer>> observers;
+  observers.push_back(std::make_unique<OwnCoordinatesObserver>(SignalKind::kCanonicalEstimate));
+  RunResult r = run_observers(data, observers, 0);
+  add_coordinate_errors(data, observers, r);
+  ASSERT_EQ(r.signal_info[0].size(), 6u);
+  EXPECT_EQ(r.signal_info[0][4].kind, SignalKind::kCanonicalError);
+  EXPECT_EQ(r.signal_info[0][5].name, "eta_norm");
+  const auto m = modulating_metrics(r, 0, 0);
+  ASSERT_TRUE(m.has_value());
+  double scale = 0.0;  // max_k ‖2 x_k‖
+  for (Eigen::Index k = 0; k < data.steps(); ++k)
+    scale = std::max(scale, 2.0 * data.x.col(k).norm());
+  EXPECT_DOUBLE_EQ(m->abs_after_horizon, 3.0);
+  EXPECT_DOUBLE_EQ(m->rel_after_horizon, 3.0 / scale);
+  EXPECT_FALSE(embedded_metrics(r, 0).has_value());
+}
+
+TEST(TypedSignals, ANameAloneMakesNoEstimate) {
+  const Measurements data = own_data();
+  std::vector<std::unique_ptr<Observer>> observers;
+  observers.push_back(std::make_unique<OwnCoordinatesObserver>(SignalKind::kDiagnostic));
+  RunResult r = run_observers(data, observers, 0);
+  add_coordinate_errors(data, observers, r);
+  EXPECT_EQ(r.signal_info[0].size(), 4u);  // no z_error, no eta_error: nothing of either kind
+  EXPECT_FALSE(embedded_metrics(r, 0).has_value());
+  EXPECT_FALSE(modulating_metrics(r, 0, 0).has_value());
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "nlobs/observers/interval_integrator.hpp"
@@ -99,22 +100,22 @@ TEST(SampledData, HoldStartIntegrateRejectInOnePlace) {
   ObserverStep step;
   const Eigen::VectorXd u = Eigen::VectorXd::Constant(1, 2.0),
                         y0 = Eigen::VectorXd::Constant(1, 1.0);
-  EXPECT_EQ(clock.receive("obs", 0, y0, u, step), Clock::kStart);
+  EXPECT_EQ(clock.receive("obs", 0, 0.0, y0, u, step), Clock::kStart);
   EXPECT_EQ(clock.time(), 0.0);
   clock.accept();
   // A missing y: held, said in the step; the input of that sample is not taken either.
-  EXPECT_EQ(clock.receive("obs", 1, Eigen::VectorXd::Constant(1, NAN),
+  EXPECT_EQ(clock.receive("obs", 1, 0.5, Eigen::VectorXd::Constant(1, NAN),
                           Eigen::VectorXd::Constant(1, 9.0), step),
             Clock::kHold);
   EXPECT_TRUE(step.measurement_missing);
   // A non-finite u: held, a failure naming u and t.
-  EXPECT_EQ(clock.receive("obs", 2, y0, Eigen::VectorXd::Constant(1, INFINITY), step),
+  EXPECT_EQ(clock.receive("obs", 2, 1.0, y0, Eigen::VectorXd::Constant(1, INFINITY), step),
             Clock::kHold);
   EXPECT_EQ(step.failure, "non_finite");
   EXPECT_NE(step.failure_message.find("obs: u_k is not finite at t = 1"), std::string::npos)
       << step.failure_message;
   // The next good sample integrates from the last taken one, across the gap, with u_0 held.
-  EXPECT_EQ(clock.receive("obs", 3, Eigen::VectorXd::Constant(1, 4.0),
+  EXPECT_EQ(clock.receive("obs", 3, 1.5, Eigen::VectorXd::Constant(1, 4.0),
                           Eigen::VectorXd::Constant(1, 5.0), step),
             Clock::kIntegrate);
   EXPECT_TRUE(step.failure.empty());
@@ -127,7 +128,7 @@ TEST(SampledData, HoldStartIntegrateRejectInOnePlace) {
   EXPECT_EQ(step.failure, "non_finite");
   EXPECT_EQ(step.failure_message, "obs: went wrong");
   EXPECT_NEAR(clock.output_at(0.75)[0], 1.0, 1e-15);  // the one sample left
-  EXPECT_EQ(clock.receive("obs", 4, Eigen::VectorXd::Constant(1, 3.0),
+  EXPECT_EQ(clock.receive("obs", 4, 2.0, Eigen::VectorXd::Constant(1, 3.0),
                           Eigen::VectorXd::Constant(1, 7.0), step),
             Clock::kIntegrate);
   EXPECT_EQ(clock.last_time(), 0.0);
@@ -136,22 +137,64 @@ TEST(SampledData, HoldStartIntegrateRejectInOnePlace) {
   EXPECT_EQ(clock.last_time(), 2.0);
   EXPECT_EQ(clock.held_input()[0], 7.0);  // u_4, for the next interval
   clock.reset();  // k = 0 again after a reset is a new start, not an order error
-  EXPECT_EQ(clock.receive("obs", 0, y0, u, step), Clock::kStart);
+  EXPECT_EQ(clock.receive("obs", 0, 0.0, y0, u, step), Clock::kStart);
 }
 
 TEST(SampledData, SizesAndOrderAreErrors) {
   Clock clock(1, 1, 0.5);
   ObserverStep step;
   const Eigen::VectorXd one = Eigen::VectorXd::Constant(1, 1.0);
-  EXPECT_EQ(test::message_of([&] { clock.receive("obs", 0, Eigen::VectorXd::Zero(2), one, step); }),
-            "obs: sample k = 0 has y of size 2 and u of size 1; the observer takes sizes 1 and 1");
-  ASSERT_EQ(clock.receive("obs", 3, one, one, step), Clock::kStart);
+  EXPECT_EQ(
+      test::message_of([&] { clock.receive("obs", 0, 0.0, Eigen::VectorXd::Zero(2), one, step); }),
+      "obs: sample k = 0 has y of size 2 and u of size 1; the observer takes sizes 1 and 1");
+  ASSERT_EQ(clock.receive("obs", 3, 1.5, one, one, step), Clock::kStart);
   clock.accept();
   EXPECT_NE(test::message_of([&] {
-              clock.receive("obs", 3, one, one, step);
+              clock.receive("obs", 3, 1.5, one, one, step);
             }).find("obs: sample k = 3 does not come after the last one"),
             std::string::npos);
-  EXPECT_EQ(clock.receive("obs", 4, one, one, step), Clock::kIntegrate);  // the clock goes on
+  EXPECT_EQ(clock.receive("obs", 4, 2.0, one, one, step), Clock::kIntegrate);  // the clock goes on
+}
+
+// The grid t_0 + k·T: t_0 from the first sample, the grid time returned (not the rounded one
+// given), off-grid, non-finite and too-large times refused with what and where.
+TEST(UniformGrid, PlacesSamplesOnTheGridFromTheFirstOne) {
+  UniformGrid grid(0.1);
+  ObserverStep step;
+  const double t0 = 100.3 - 3 * 0.1;
+  EXPECT_EQ(grid.place("obs", 3, 100.3, step), t0 + 3 * 0.1);                 // t_0 = 100.3 − 3 T
+  const std::optional<double> t4 = grid.place("obs", 4, 100.4 + 1e-9, step);  // rounding: on it
+  ASSERT_TRUE(t4.has_value());
+  EXPECT_EQ(*t4, t0 + 4 * 0.1);
+  EXPECT_FALSE(grid.place("obs", 5, 100.52, step).has_value());
+  EXPECT_EQ(step.failure, "non_uniform");
+  EXPECT_NE(step.failure_message.find("obs: sample k = 5 at t = 100.52 (T = 0.1)"),
+            std::string::npos)
+      << step.failure_message;
+  EXPECT_NE(step.failure_message.find("t_k = 100.5"), std::string::npos) << step.failure_message;
+  for (const double bad : {NAN, INFINITY, -INFINITY}) {
+    EXPECT_FALSE(grid.place("obs", 6, bad, step).has_value());
+    EXPECT_EQ(step.failure, "non_finite");
+  }
+  EXPECT_FALSE(grid.place("obs", 7, 1e300, step).has_value());  // its rounding spans the grid
+  EXPECT_EQ(step.failure, "non_uniform");
+  EXPECT_NE(step.failure_message.find("too large"), std::string::npos) << step.failure_message;
+  grid.reset();  // a new origin
+  EXPECT_EQ(grid.place("obs", 0, -5.0, step), -5.0);
+}
+
+TEST(SampledData, AnOffGridTimeIsHeldAndTheNextOneGoesOn) {
+  Clock clock(1, 1, 0.5);
+  ObserverStep step;
+  const Eigen::VectorXd one = Eigen::VectorXd::Constant(1, 1.0);
+  ASSERT_EQ(clock.receive("obs", 0, 0.0, one, one, step), Clock::kStart);
+  clock.accept();
+  EXPECT_EQ(clock.receive("obs", 1, 0.7, one, one, step), Clock::kHold);
+  EXPECT_EQ(step.failure, "non_uniform");
+  EXPECT_EQ(clock.receive("obs", 2, 1.0, one, one, step), Clock::kIntegrate);
+  EXPECT_TRUE(step.failure.empty());
+  EXPECT_EQ(clock.last_time(), 0.0);  // across the refused sample
+  EXPECT_EQ(clock.time(), 1.0);
 }
 
 // The PI bank now follows the same rule as the MVT and high-gain observers after a failed step:
@@ -165,13 +208,13 @@ TEST(SampledData, APiBankResumesFromTheLastGoodStateAfterAFailedStep) {
   PiBankObserver failing(bank, options), reference(bank, options);
   const auto sample = [](double v) { return Eigen::VectorXd::Constant(1, v); };
   for (PiBankObserver* o : {&failing, &reference}) {
-    o->step(0, sample(1.0), {});
-    o->step(1, sample(0.5), {});
+    o->step(0, 0.0, sample(1.0), {});
+    o->step(1, 0.5, sample(0.5), {});
   }
-  EXPECT_EQ(failing.step(2, sample(-0.5), {}).failure, "non_finite");   // y crosses 0 at t = 0.75
-  EXPECT_TRUE(reference.step(2, sample(NAN), {}).measurement_missing);  // the same, as missing
-  const Eigen::VectorXd after = failing.step(3, sample(0.6), {}).estimate;
-  EXPECT_EQ(after, reference.step(3, sample(0.6), {}).estimate);
+  EXPECT_EQ(failing.step(2, 1.0, sample(-0.5), {}).failure, "non_finite");   // y = 0 at t = 0.75
+  EXPECT_TRUE(reference.step(2, 1.0, sample(NAN), {}).measurement_missing);  // the same, missing
+  const Eigen::VectorXd after = failing.step(3, 1.5, sample(0.6), {}).estimate;
+  EXPECT_EQ(after, reference.step(3, 1.5, sample(0.6), {}).estimate);
   EXPECT_TRUE(after.allFinite());
 }
 
@@ -184,14 +227,14 @@ TEST(SampledData, ABankOfSignalsOnlyStillReportsANonFiniteSignal) {
   ASSERT_EQ(bank.state_size(), 0);
   PiBankObserver observer(bank, {.name = "pi", .estimate = {inv}, .sample_time = 0.5});
   const auto sample = [](double v) { return Eigen::VectorXd::Constant(1, v); };
-  EXPECT_EQ(observer.step(0, sample(2.0), {}).estimate[0], 0.5);
-  const ObserverStep& bad = observer.step(1, sample(0.0), {});
+  EXPECT_EQ(observer.step(0, 0.0, sample(2.0), {}).estimate[0], 0.5);
+  const ObserverStep& bad = observer.step(1, 0.5, sample(0.0), {});
   EXPECT_EQ(bad.failure, "non_finite");
   EXPECT_NE(bad.failure_message.find("signal 'inverse' is not finite at t = 0.5"),
             std::string::npos)
       << bad.failure_message;
   EXPECT_EQ(bad.estimate[0], 0.5);  // the last good one
-  EXPECT_EQ(observer.step(2, sample(4.0), {}).estimate[0], 0.25);
+  EXPECT_EQ(observer.step(2, 1.0, sample(4.0), {}).estimate[0], 0.25);
 }
 
 // Hostile values: an integrator at 1e308 with rate 1e308 overflows within the first interval.
@@ -203,9 +246,9 @@ TEST(SampledData, AnOverflowingBankStateIsRefusedNotPublished) {
       "blow", [](const PiBank::Values& v) { return 1e308 + 0.0 * v.time(); }, 1e308);
   PiBankObserver observer(bank, {.name = "pi", .estimate = {blow}, .sample_time = 1.0});
   const auto sample = [](double v) { return Eigen::VectorXd::Constant(1, v); };
-  EXPECT_EQ(observer.step(0, sample(1.0), {}).estimate[0], 1e308);
+  EXPECT_EQ(observer.step(0, 0.0, sample(1.0), {}).estimate[0], 1e308);
   for (long k = 1; k < 4; ++k) {
-    const ObserverStep& s = observer.step(k, sample(1.0), {});
+    const ObserverStep& s = observer.step(k, static_cast<double>(k), sample(1.0), {});
     EXPECT_EQ(s.failure, "non_finite") << k;
     // Each later sample integrates from the last good state (t = 0), whose first RK4 step
     // already overflows at its end, t = 1.

@@ -264,7 +264,9 @@ PiBankObserver::PiBankObserver(PiBank bank, PiBankOptions options)
           "signal " + std::to_string(id));
     }
   }
-  extra_ids_ = bank_.stage_signals();
+  published_ = bank_.stage_signals();
+  info_.name = options_.name;
+  for (const PiBank::Signal s : published_) info_.signals.push_back({bank_.signal_name(s)});
   const Eigen::Index n = bank_.state_size();
   for (Eigen::VectorXd* v : {&state_, &x_, &dx_}) v->resize(n);
   trial_.resize(static_cast<size_t>(n));
@@ -277,31 +279,25 @@ PiBankObserver::PiBankObserver(PiBank bank, PiBankOptions options)
       static_cast<int>(n), [this](double t, const double* s, double* ds) { return rate(t, s, ds); },
       o);
   step_.estimate.resize(static_cast<Eigen::Index>(options_.estimate.size()));
-  step_.extras.resize(static_cast<Eigen::Index>(extra_ids_.size()));
+  step_.signals.resize(static_cast<Eigen::Index>(published_.size()));
   // A dry evaluation: a stage reading a later signal fails here, at construction.
   bank_.evaluate(0.0, Eigen::VectorXd::Zero(bank_.outputs()), Eigen::VectorXd::Zero(bank_.inputs()),
                  Eigen::VectorXd::Zero(n), signals_, &dx_);
   reset();
 }
 
-std::vector<std::string> PiBankObserver::extra_names() const {
-  std::vector<std::string> names;
-  for (const auto& s : extra_ids_) names.push_back(bank_.signal_name(s));
-  return names;
-}
-
 void PiBankObserver::reset() {
   clock_.reset();
   step_.estimate.setConstant(std::nan(""));
-  step_.extras.setConstant(std::nan(""));
+  step_.signals.setConstant(std::nan(""));
 }
 
 void PiBankObserver::publish() {
   for (size_t i = 0; i < options_.estimate.size(); ++i) {
     step_.estimate[static_cast<Eigen::Index>(i)] = signals_[options_.estimate[i].id];
   }
-  for (size_t i = 0; i < extra_ids_.size(); ++i) {
-    step_.extras[static_cast<Eigen::Index>(i)] = signals_[extra_ids_[i].id];
+  for (size_t i = 0; i < published_.size(); ++i) {
+    step_.signals[static_cast<Eigen::Index>(i)] = signals_[published_[i].id];
   }
 }
 
@@ -341,19 +337,19 @@ bool PiBankObserver::integrate(double t0, double t1, const Eigen::VectorXd& y1,
   return true;
 }
 
-const ObserverStep& PiBankObserver::step(long k, const Eigen::VectorXd& y,
+const ObserverStep& PiBankObserver::step(long k, double t, const Eigen::VectorXd& y,
                                          const Eigen::VectorXd& u) {
   step_.ready = clock_.started();
-  switch (clock_.receive(options_.name, k, y, u, step_)) {
+  switch (clock_.receive(options_.name, k, t, y, u, step_)) {
     case SampledData<Eigen::Dynamic, Eigen::Dynamic>::kHold:
       return step_;  // the integral states keep their value
     case SampledData<Eigen::Dynamic, Eigen::Dynamic>::kStart: {
-      const double t = clock_.time();
-      state_ = bank_.initial_state(t, y, u);
-      const PiBank::Signal bad = bank_.evaluate(t, y, u, state_, signals_, nullptr);
+      const double t0 = clock_.time();  // the grid time of t
+      state_ = bank_.initial_state(t0, y, u);
+      const PiBank::Signal bad = bank_.evaluate(t0, y, u, state_, signals_, nullptr);
       if (bad.id >= 0 || !state_.allFinite()) {  // not started: try again at the next sample
         std::ostringstream os;
-        os << options_.name << ": cannot start at t = " << t << ": signal '"
+        os << options_.name << ": cannot start at t = " << t0 << ": signal '"
            << (bad.id >= 0 ? bank_.signal_name(bad) : std::string("state")) << "' is not finite";
         clock_.reject(step_, os.str());
         return step_;

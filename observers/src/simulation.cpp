@@ -54,9 +54,14 @@ RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Ob
                         const std::function<void(long done, long total)>& progress) {
   RunResult result;
   const long steps = static_cast<long>(data.steps());
+  if (data.t.size() != data.steps()) {
+    throw InvalidInput("run_observers: Measurements::t has " + std::to_string(data.t.size()) +
+                       " times for " + std::to_string(data.steps()) +
+                       " samples; every sample needs its time");
+  }
   if (settle_index < 0) {
     Eigen::Index longest = 1;
-    for (const auto& o : observers) longest = std::max(longest, o->window());
+    for (const auto& o : observers) longest = std::max(longest, o->info().window);
     settle_index = static_cast<long>(longest) - 1;
   }
   result.settle_index = settle_index;
@@ -66,30 +71,35 @@ RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Ob
     observer->reset();
     ObserverMetrics m;
     m.name = observer->name();
-    m.engine = observer->engine();
+    m.engine = observer->info().engine;
     m.first_window_iterations = -1;
     Eigen::MatrixXd estimate(data.x.rows() > 0 ? data.x.rows() : 0, steps);
-    Eigen::MatrixXd extras(static_cast<Eigen::Index>(observer->extra_names().size()), steps);
+    Eigen::MatrixXd signals(static_cast<Eigen::Index>(observer->info().signals.size()), steps);
     long iterations_sum = 0, evaluations_sum = 0;
     double elapsed_ns = 0.0;
     for (long k = 0; k < steps; ++k) {
       const Eigen::VectorXd y = data.y.col(k), u = data.u.col(k);
       const auto t0 = std::chrono::steady_clock::now();
-      const ObserverStep& s = data.t.size() == data.steps() ? observer->step_at(k, data.t[k], y, u)
-                                                            : observer->step(k, y, u);
+      const ObserverStep& s = observer->step(k, data.t[k], y, u);
       elapsed_ns +=
           std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count();
       if (estimate.rows() == 0) estimate.resize(s.estimate.size(), steps);
+      if (s.estimate.size() != estimate.rows() || s.signals.size() != signals.rows()) {
+        // An observer of a user's own that breaks its promise: named, never written past.
+        std::ostringstream os;
+        os << "run_observers: " << m.name << " at sample k = " << k << " published an estimate of "
+           << s.estimate.size() << " entries and " << s.signals.size() << " signals; expected "
+           << estimate.rows() << " and " << signals.rows() << " (ObserverInfo::signals)";
+        throw InvalidInput(os.str());
+      }
       estimate.col(k) = s.estimate;
-      if (extras.rows() > 0) extras.col(k) = s.extras;
+      if (signals.rows() > 0) signals.col(k) = s.signals;
       // The first failing step's reason: the engine's (status, message, why not used) before
       // the observer's own, which often follows from it. Built once.
       const auto note_first = [&](const auto& why) {
         if (!m.first_failure.empty()) return;
         std::ostringstream os;
-        os << "k = " << k;
-        if (data.t.size() == data.steps()) os << " (t = " << data.t[k] << ")";
-        os << ": " << why();
+        os << "k = " << k << " (t = " << data.t[k] << "): " << why();
         m.first_failure = os.str();
       };
       if (s.summary && !s.summary->usable()) {
@@ -132,8 +142,8 @@ RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Ob
     }
     result.metrics.push_back(std::move(m));
     result.estimates.push_back(std::move(estimate));
-    result.extras.push_back(std::move(extras));
-    result.extra_names.push_back(observer->extra_names());
+    result.signals.push_back(std::move(signals));
+    result.signal_info.push_back(observer->info().signals);
   }
   return result;
 }

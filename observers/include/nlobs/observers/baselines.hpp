@@ -48,11 +48,12 @@ class LuenbergerObserver final : public Observer {
                           model_.outputs());
     detail::require_size("LuenbergerOptions", "initial_estimate", options_.initial_estimate,
                          model_.states());
+    info_.name = options_.name;
     reset();
   }
-  std::string name() const override { return options_.name; }
   void reset() override { x_ = options_.initial_estimate; }
-  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
+  const ObserverStep& step(long k, double /*t*/, const Eigen::VectorXd& y,
+                           const Eigen::VectorXd& u) override {
     step_.estimate = x_;
     step_.failure.clear();
     step_.failure_message.clear();
@@ -88,11 +89,12 @@ class SlidingModeObserver final : public Observer {
     detail::require_shape("SlidingModeOptions", "q", options_.q, n, p);
     detail::require_shape("SlidingModeOptions", "r", options_.r, n, p);
     detail::require_size("SlidingModeOptions", "initial_estimate", options_.initial_estimate, n);
+    info_.name = options_.name;
     reset();
   }
-  std::string name() const override { return options_.name; }
   void reset() override { x_ = options_.initial_estimate; }
-  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
+  const ObserverStep& step(long k, double /*t*/, const Eigen::VectorXd& y,
+                           const Eigen::VectorXd& u) override {
     step_.estimate = x_;
     step_.failure.clear();
     step_.failure_message.clear();
@@ -135,8 +137,9 @@ template <DiscreteModel Model>
 class ExtendedKalmanFilter final : public Observer {
  public:
   ExtendedKalmanFilter(Model model, EkfOptions options)
-      : model_(std::move(model)), name_(options.name), initial_(options.initial_estimate) {
+      : model_(std::move(model)), initial_(options.initial_estimate) {
     options.validate();
+    info_.name = options.name;
     const Eigen::Index n = model_.states(), p = model_.outputs();
     q_ = options.process_covariance.size()
              ? options.process_covariance
@@ -152,12 +155,12 @@ class ExtendedKalmanFilter final : public Observer {
     detail::require_shape("EkfOptions", "initial_covariance", p0_, n, n);
     reset();
   }
-  std::string name() const override { return name_; }
   void reset() override {
     x_ = initial_;
     p_ = p0_;
   }
-  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
+  const ObserverStep& step(long k, double /*t*/, const Eigen::VectorXd& y,
+                           const Eigen::VectorXd& u) override {
     const Eigen::Index n = model_.states();
     step_.failure.clear();
     step_.failure_message.clear();
@@ -228,7 +231,6 @@ class ExtendedKalmanFilter final : public Observer {
   }
 
   Model model_;
-  std::string name_;
   Eigen::VectorXd initial_, x_;
   Eigen::MatrixXd q_, r_, p0_, p_;
   ObserverStep step_;

@@ -8,6 +8,7 @@
 
 #include "nlobs/observers/observer.hpp"
 #include "nlobs/observers/option_checks.hpp"
+#include "nlobs/observers/sampled_data.hpp"
 
 namespace nlobs {
 
@@ -24,49 +25,59 @@ struct FiniteDifferenceOptions {
   }
 };
 
+// Samples must lie on the uniform grid t_0 + k·δ (failure "non_uniform" otherwise): the
+// differences divide by δ. A missing, off-grid or skipped sample (k not the last k + 1)
+// restarts them.
 class FiniteDifferenceObserver final : public Observer {
  public:
   explicit FiniteDifferenceObserver(FiniteDifferenceOptions options)
-      : options_(detail::validated(std::move(options))),
-        n_(options_.states),
-        delta_(options_.sample_time) {
-    history_.resize(n_);
-    differences_.resize(n_);
+      : options_(detail::validated(std::move(options))), grid_(options_.sample_time) {
+    const Eigen::Index n = options_.states;
+    history_.resize(n);
+    differences_.resize(n);
+    estimate_.resize(n);
+    info_.name = options_.name;
+    info_.window = n;
     reset();
   }
 
-  std::string name() const override { return options_.name; }
-  Eigen::Index window() const override { return n_; }
   void reset() override {
+    grid_.reset();
     history_.setZero();
     filled_ = 0;
-    step_.estimate = Eigen::VectorXd::Zero(n_);
+    last_k_ = -1;
+    step_.estimate = Eigen::VectorXd::Zero(options_.states);
     step_.ready = false;
     step_.failure.clear();
     step_.failure_message.clear();
   }
-  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd&) override {
+  const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
+                           const Eigen::VectorXd&) override {
+    const Eigen::Index n = options_.states;
     step_.failure.clear();
     step_.failure_message.clear();
     step_.measurement_missing = !(y.size() == 1 && std::isfinite(y[0]));
-    if (step_.measurement_missing) {  // the differences restart after a gap
-      filled_ = 0;
+    const bool consecutive = k == last_k_ + 1;
+    last_k_ = k;
+    if (!grid_.place(options_.name, k, t, step_) || step_.measurement_missing || !consecutive) {
+      filled_ = 0;  // the differences restart after a gap
+    }
+    if (!step_.failure.empty() || step_.measurement_missing) {
       step_.ready = false;
       return step_;
     }
-    for (Eigen::Index i = n_ - 1; i > 0; --i) history_[i] = history_[i - 1];
+    for (Eigen::Index i = n - 1; i > 0; --i) history_[i] = history_[i - 1];
     history_[0] = y[0];  // newest first
-    if (filled_ < n_) ++filled_;
-    step_.ready = filled_ == n_;
+    if (filled_ < n) ++filled_;
+    step_.ready = filled_ == n;
     if (!step_.ready) return step_;
     // ∇ⁱ y_k from the newest n samples: repeated differences, newest first.
     differences_ = history_;
     double scale = 1.0;
-    estimate_.resize(n_);
     estimate_[0] = differences_[0];
-    for (Eigen::Index i = 1; i < n_; ++i) {
-      for (Eigen::Index m = 0; m + i < n_; ++m) differences_[m] -= differences_[m + 1];
-      scale *= delta_;
+    for (Eigen::Index i = 1; i < n; ++i) {
+      for (Eigen::Index m = 0; m + i < n; ++m) differences_[m] -= differences_[m + 1];
+      scale *= options_.sample_time;
       estimate_[i] = differences_[0] / scale;
     }
     accept_finite(estimate_, step_.estimate, step_, options_.name, k, "the differences");  // huge y
@@ -75,10 +86,10 @@ class FiniteDifferenceObserver final : public Observer {
 
  private:
   FiniteDifferenceOptions options_;
-  Eigen::Index n_;
-  double delta_;
+  UniformGrid grid_;
   Eigen::VectorXd history_, differences_, estimate_;
   Eigen::Index filled_ = 0;
+  long last_k_ = -1;
   ObserverStep step_;
 };
 

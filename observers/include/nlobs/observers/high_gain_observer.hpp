@@ -161,13 +161,8 @@ class HighGainObserver final : public Observer {
   HighGainObserver(const HighGainObserver&) = delete;
   HighGainObserver& operator=(const HighGainObserver&) = delete;
 
-  std::string name() const override { return options_.name; }
-  std::string engine() const override {
-    return design_.inverse ? "explicit inverse" : engine_->label();
-  }
-  std::vector<std::string> extra_names() const override { return extra_names_; }
-  std::vector<std::string> warnings() const override { return warnings_; }
-  Eigen::VectorXd coordinates_of(const Eigen::VectorXd& x) const override {
+  // z = q_N(x), NaN where q_N is not finite (the model is autonomous: t does not enter).
+  Eigen::VectorXd coordinates_at(const Eigen::VectorXd& x, double /*t*/) const override {
     Eigen::VectorXd z(N_);
     if (x.size() != n || !design_.map->value(x, z)) z.setConstant(std::nan(""));
     return z;
@@ -184,7 +179,8 @@ class HighGainObserver final : public Observer {
 
   void reset() override;
 
-  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override;
+  const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
+                           const Eigen::VectorXd& u) override;
 
  private:
   // The observer's right-hand side at t for the state s = (ẑ, x̄) with y(t) given: [HG-EMB23].
@@ -234,7 +230,6 @@ class HighGainObserver final : public Observer {
   double spectral_radius_ = 1.0;
   std::unique_ptr<Engine<n>> engine_;
   std::optional<RootProblem<n, Eigen::Dynamic>> problem_;
-  std::vector<std::string> warnings_, extra_names_;
   State xhat0_ = State::Zero(), xhat_ = State::Zero(), xbar_ = State::Zero();
   Eigen::VectorXd zhat0_, zhat_, zs_, z_, zhat_projected_, grad_alpha_, grad_sat_;
   Eigen::MatrixXd dq_;
@@ -322,12 +317,18 @@ HighGainObserver<Model>::HighGainObserver(Model model, HighGainOptions options,
   }
   if (integrator_ == HighGainIntegrator::kCvode && !ModelDerivatives<Model>::kAutoDiff &&
       predict_) {
-    warnings_.push_back(options_.name + ": ∂f for the implicit stepper by central differences");
+    info_.warnings.push_back(options_.name +
+                             ": ∂f for the implicit stepper by central differences");
   }
-  for (Eigen::Index i = 0; i < N_; ++i) extra_names_.push_back("zhat" + std::to_string(i + 1));
-  extra_names_.push_back("projection_residual");
-  extra_names_.push_back("jumps");
-  extra_names_.push_back("alpha_weight");
+  info_.name = options_.name;
+  info_.engine = design_.inverse ? "explicit inverse" : engine_->label();
+  auto& signals = info_.signals;
+  for (Eigen::Index i = 0; i < N_; ++i) {
+    signals.push_back({"zhat" + std::to_string(i + 1), SignalKind::kEmbeddedEstimate});
+  }
+  signals.push_back({"projection_residual", SignalKind::kProjectionResidual});
+  signals.push_back({"jumps", SignalKind::kJumpCount});
+  signals.push_back({"alpha_weight"});
   allocate();
   reset();
 }
@@ -346,10 +347,10 @@ void HighGainObserver<Model>::reset() {
 }
 
 template <ContinuousModel Model>
-const ObserverStep& HighGainObserver<Model>::step(long k, const Eigen::VectorXd& y,
+const ObserverStep& HighGainObserver<Model>::step(long k, double t, const Eigen::VectorXd& y,
                                                   const Eigen::VectorXd& u) {
   step_.ready = true;
-  switch (clock_.receive(options_.name, k, y, u, step_)) {
+  switch (clock_.receive(options_.name, k, t, y, u, step_)) {
     case SampledData<1, Model::kInputs>::kHold:
       return publish();
     case SampledData<1, Model::kInputs>::kStart:
@@ -458,7 +459,7 @@ void HighGainObserver<Model>::allocate() {
   x_.resize(n);
   state_.assign(static_cast<size_t>(state_size()), 0.0);
   step_.estimate.resize(n);
-  step_.extras.resize(static_cast<Eigen::Index>(extra_names_.size()));
+  step_.signals.resize(static_cast<Eigen::Index>(info_.signals.size()));
   IntervalIntegratorOptions o;
   o.scheme =
       integrator_ == HighGainIntegrator::kCvode ? IntervalScheme::kCvode : IntervalScheme::kRk4;
@@ -644,10 +645,10 @@ void HighGainObserver<Model>::update_weight() {
 template <ContinuousModel Model>
 const ObserverStep& HighGainObserver<Model>::publish() {
   step_.estimate = xhat_;
-  step_.extras.head(N_) = zhat_;
-  step_.extras[N_] = residual_;
-  step_.extras[N_ + 1] = static_cast<double>(jumps_);
-  step_.extras[N_ + 2] = lie_alpha_ ? weight_ : 1.0;
+  step_.signals.head(N_) = zhat_;
+  step_.signals[N_] = residual_;
+  step_.signals[N_ + 1] = static_cast<double>(jumps_);
+  step_.signals[N_ + 2] = lie_alpha_ ? weight_ : 1.0;
   return step_;
 }
 

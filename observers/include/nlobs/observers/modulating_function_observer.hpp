@@ -28,6 +28,7 @@
 #include "nlobs/observers/modulating_kernel.hpp"
 #include "nlobs/observers/observer.hpp"
 #include "nlobs/observers/option_checks.hpp"
+#include "nlobs/observers/sampled_data.hpp"
 #include "nlobs/solvers/status.hpp"
 
 namespace nlobs {
@@ -118,31 +119,28 @@ class ModulatingFunctionObserver final : public Observer {
       }
     }
     channels_.resize(2 * (L_ + 1), n + 1);
-    step_.extras.resize(static_cast<Eigen::Index>(extra_names().size()));
+    info_.name = options_.name;
+    info_.window = L_ + 1;  // the harness's "after the window" is "one horizon after start"
+    for (int j = 0; j < n; ++j) {
+      info_.signals.push_back({"eta" + std::to_string(j + 1), SignalKind::kCanonicalEstimate});
+    }
+    info_.signals.push_back({"yhat"});
+    if (options_.disturbance_gains.size() != 0) {
+      info_.signals.push_back({"eta_bound", SignalKind::kCanonicalBound});
+      if (every_ != 0) {
+        info_.warnings.push_back(options_.name +
+                                 ": the disturbance bound is Theorem 1's (FIR mode); it is not "
+                                 "reported in sampled-data mode");
+      }
+    }
+    step_.signals.resize(static_cast<Eigen::Index>(info_.signals.size()));
     reset();
   }
 
-  std::string name() const override { return options_.name; }
-  // The horizon in samples: the harness's "after the window" is "one horizon after start".
-  Eigen::Index window() const override { return L_ + 1; }
-  std::vector<std::string> extra_names() const override {
-    std::vector<std::string> names;
-    for (int j = 0; j < n; ++j) names.push_back("eta" + std::to_string(j + 1));
-    names.push_back("yhat");
-    if (options_.disturbance_gains.size() != 0) names.push_back("eta_bound");
-    return names;
-  }
+  // η = T(t) x, the canonical state of the true x at t (empty for an x of the wrong size).
   Eigen::VectorXd coordinates_at(const Eigen::VectorXd& x, double t) const override {
     if (x.size() != nx) return {};
     return form_.canonical(t, State(x));
-  }
-  std::vector<std::string> warnings() const override {
-    if (options_.disturbance_gains.size() != 0 && every_ != 0) {
-      return {options_.name +
-              ": the disturbance bound is Theorem 1's (FIR mode); it is not "
-              "reported in sampled-data mode"};
-    }
-    return {};
   }
 
   void reset() override {
@@ -160,15 +158,13 @@ class ModulatingFunctionObserver final : public Observer {
     step_.ready = false;
     step_.measurement_missing = false;
     step_.estimate = initial_;
-    step_.extras.setConstant(std::numeric_limits<double>::quiet_NaN());
+    step_.signals.setConstant(std::numeric_limits<double>::quiet_NaN());
   }
 
-  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override {
-    return step_at(k, static_cast<double>(k) * options_.sample_time, y, u);
-  }
-
-  const ObserverStep& step_at(long k, double t, const Eigen::VectorXd& y,
-                              const Eigen::VectorXd& u) override {
+  // Sample k at t: its grid point comes from t (t_0 + m δ, t_0 the first sample's time), not
+  // from k, so that recorded data with gaps and, with `resample`, off-grid times are placed.
+  const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
+                           const Eigen::VectorXd& u) override {
     step_.failure.clear();
     step_.failure_message.clear();
     step_.measurement_missing = false;
@@ -185,9 +181,7 @@ class ModulatingFunctionObserver final : public Observer {
     const double delta = options_.sample_time;
     const double position = (t - t0_) / delta;
     const double grid = std::round(position);
-    // Recorded times carry their decimal rounding: a few ulps of t, relative to δ.
-    const double tolerance =
-        1e-6 + 4.0 * std::numeric_limits<double>::epsilon() * std::abs(t) / delta;
+    const double tolerance = grid_tolerance(t, delta);  // sampled_data.hpp
     if (!(tolerance < 0.25)) {  // t's rounding spans the grid step: no grid time to place it at
       return refuse(k, "non_uniform",
                     "t = " + fmt(t) + " is too large for a grid step of " + fmt(delta) +
@@ -392,9 +386,9 @@ class ModulatingFunctionObserver final : public Observer {
   }
 
   void publish() {
-    step_.extras.head(n) = eta_;
-    step_.extras[n] = yhat_;
-    if (options_.disturbance_gains.size() != 0) step_.extras[n + 1] = bound_.norm();
+    step_.signals.head(n) = eta_;
+    step_.signals[n] = yhat_;
+    if (options_.disturbance_gains.size() != 0) step_.signals[n + 1] = bound_.norm();
   }
 
   const ObserverStep& refuse(long k, const std::string& failure, const std::string& message) {

@@ -96,10 +96,6 @@ class MvtObserver final : public Observer {
   MvtObserver(const MvtObserver&) = delete;
   MvtObserver& operator=(const MvtObserver&) = delete;
 
-  std::string name() const override { return options_.name; }
-  std::string engine() const override { return std::string(to_string(options_.beta.method)); }
-  std::vector<std::string> extra_names() const override { return extra_names_; }
-  std::vector<std::string> warnings() const override { return warnings_; }
   const MvtOptions& options() const { return options_; }
 
   void reset() override;
@@ -121,7 +117,8 @@ class MvtObserver final : public Observer {
   bool derivatives(double t, const State& xhat, const State& ehat, const Output& y, const Input& u,
                    State& dxhat, State& dehat);
 
-  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override;
+  const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
+                           const Eigen::VectorXd& u) override;
 
  private:
   // y = C x with C = [I_m 0]: h(x) must equal the first m states at a few distinct points.
@@ -137,7 +134,6 @@ class MvtObserver final : public Observer {
   MvtOptions options_;
   State xhat0_ = State::Zero(), ehat0_ = State::Zero();
   std::unique_ptr<MvtBetaSolver<Model>> beta_solver_;
-  std::vector<std::string> warnings_, extra_names_;
   State xhat_ = State::Zero(), ehat_ = State::Zero(), beta_ = State::Zero(), gains_ = State::Zero();
   Jacobian d_ = Jacobian::Zero(), j_w_ = Jacobian::Zero();
   SampledData<P, M> clock_{P, M, options_.sample_time};  // y between samples: the cubic
@@ -160,17 +156,20 @@ MvtObserver<Model>::MvtObserver(Model model, MvtOptions options)
   }
   check_output_map();
   beta_solver_ = std::make_unique<MvtBetaSolver<Model>>(model_, options_.beta);
+  info_.name = options_.name;
+  info_.engine = std::string(to_string(options_.beta.method));
   if constexpr (!ModelDerivatives<Model>::kAutoDiff) {
-    warnings_.push_back(options_.name +
-                        ": the model's vector field does not accept ceres::Jet; ∂F by central "
-                        "differences (β and D are then accurate to ~1e-7 only)");
+    info_.warnings.push_back(options_.name +
+                             ": the model's vector field does not accept ceres::Jet; ∂F by "
+                             "central differences (β and D are then accurate to ~1e-7 only)");
   }
-  extra_names_.push_back("residual");
-  for (int i = 0; i < N; ++i) extra_names_.push_back("beta" + std::to_string(i + 1));
-  for (int i = 0; i < N; ++i) extra_names_.push_back("ehat" + std::to_string(i + 1));
-  for (int i = 0; i < N; ++i) extra_names_.push_back("gain" + std::to_string(i + 1));
+  auto& signals = info_.signals;
+  signals.push_back({"residual", SignalKind::kSolveResidual});  // ‖X(β)‖ over the step
+  for (int i = 0; i < N; ++i) signals.push_back({"beta" + std::to_string(i + 1)});
+  for (int i = 0; i < N; ++i) signals.push_back({"ehat" + std::to_string(i + 1)});
+  for (int i = 0; i < N; ++i) signals.push_back({"gain" + std::to_string(i + 1)});
   step_.estimate.resize(N);
-  step_.extras.resize(static_cast<Eigen::Index>(extra_names_.size()));
+  step_.signals.resize(static_cast<Eigen::Index>(signals.size()));
   reset();
 }
 
@@ -238,11 +237,11 @@ bool MvtObserver<Model>::derivatives(double t, const State& xhat, const State& e
 }
 
 template <ContinuousModel Model>
-const ObserverStep& MvtObserver<Model>::step(long k, const Eigen::VectorXd& y,
+const ObserverStep& MvtObserver<Model>::step(long k, double t, const Eigen::VectorXd& y,
                                              const Eigen::VectorXd& u) {
   step_.ready = true;
   max_residual_ = 0.0;
-  switch (clock_.receive(options_.name, k, y, u, step_)) {
+  switch (clock_.receive(options_.name, k, t, y, u, step_)) {
     case SampledData<P, M>::kHold:
       return publish();
     case SampledData<P, M>::kStart: {
@@ -328,10 +327,10 @@ bool MvtObserver<Model>::integrate(double t0, double t1) {
 template <ContinuousModel Model>
 const ObserverStep& MvtObserver<Model>::publish() {
   step_.estimate = xhat_;
-  step_.extras[0] = max_residual_;
-  step_.extras.segment(1, N) = beta_;
-  step_.extras.segment(1 + N, N) = ehat_;
-  step_.extras.segment(1 + 2 * N, N) = gains_;
+  step_.signals[0] = max_residual_;
+  step_.signals.segment(1, N) = beta_;
+  step_.signals.segment(1 + N, N) = ehat_;
+  step_.signals.segment(1 + 2 * N, N) = gains_;
   return step_;
 }
 

@@ -1,8 +1,14 @@
 #pragma once
 // What the simulation harness runs side by side: anything that turns a stream of samples
-// (y_k, u_k) into estimates x̂_k. Sizes are dynamic at this interface; observers keep their
+// (t_k, y_k, u_k) into estimates x̂_k. Sizes are dynamic at this interface; observers keep their
 // own (possibly fixed-size) state inside.
+//
+// The interface is three calls, as control-toolbox's estimators and mherb/kalman's filters have
+// it: reset(), step(k, t, y, u) and, for observers that estimate in other coordinates,
+// coordinates_at(x, t). What does not change during a run — name, engine, window length,
+// warnings, the signals published beside x̂ — is one ObserverInfo, set by the constructor.
 #include <Eigen/Core>
+#include <cstddef>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -13,13 +19,68 @@
 
 namespace nlobs {
 
+// What a published signal is, so that a report finds it by its role and not by its spelling.
+// An observer of a user's own that publishes ẑ as kEmbeddedEstimate gets [HG-EMB23]'s figures;
+// one that publishes a per-sample residual as kSolveResidual gets its largest value reported.
+enum class SignalKind {
+  kDiagnostic,          // written beside x̂ (trajectory.csv, signals plots); no report reads it
+  kSolveResidual,       // residual of the per-sample solve, e.g. ‖X(β)‖ of [MGFF23]: its max
+  kEmbeddedEstimate,    // ẑ_i, the estimate in embedded coordinates z = q(x) ([HG-EMB23]), in
+                        // order; coordinates_at(x, t) gives q(x)
+  kProjectionResidual,  // ‖q(x̂) − ẑ‖ of the projection back to x ([HG-EMB23])
+  kJumpCount,           // the projection's jumps (restarts) so far
+  kCanonicalEstimate,   // η̂_j, the estimate in canonical coordinates η = T(t)x ([MF-LTV]), in
+                        // order; coordinates_at(x, t) gives T(t)x
+  kCanonicalBound,      // a guaranteed bound on the canonical error (Theorem 1 of [MF-LTV])
+  // Added by a harness that knows the true x (cli add_coordinate_errors), never published:
+  kEmbeddedError,   // ‖q(x) − ẑ‖₂
+  kCanonicalError,  // ‖T(t)x − η̂‖₂
+  kCanonicalNorm,   // ‖T(t)x‖₂, the scale of the relative canonical error
+};
+
+struct SignalInfo {
+  std::string name;  // a column name: "beta1", "zhat2", "eta1_hat" (no commas needed)
+  SignalKind kind = SignalKind::kDiagnostic;
+};
+
+// The rows of `signals` of one kind, in order (empty when none).
+inline std::vector<Eigen::Index> signal_rows(const std::vector<SignalInfo>& signals,
+                                             SignalKind kind) {
+  std::vector<Eigen::Index> rows;
+  for (std::size_t i = 0; i < signals.size(); ++i) {
+    if (signals[i].kind == kind) rows.push_back(static_cast<Eigen::Index>(i));
+  }
+  return rows;
+}
+
+// The first row of one kind.
+inline std::optional<Eigen::Index> signal_row(const std::vector<SignalInfo>& signals,
+                                              SignalKind kind) {
+  for (std::size_t i = 0; i < signals.size(); ++i) {
+    if (signals[i].kind == kind) return static_cast<Eigen::Index>(i);
+  }
+  return std::nullopt;
+}
+
+struct ObserverInfo {
+  std::string name;    // e.g. "window:steffensen", "luenberger": reports, columns, plots
+  std::string engine;  // the label of the engine it solves with (Engine::label()); empty if none
+  // Samples before the first full estimate (a window estimator's N, a modulating horizon's
+  // L + 1; 0 otherwise): the harness's "after the window" starts at the longest one's N − 1.
+  Eigen::Index window = 0;
+  // What a user should know about the set-up (e.g. derivatives by finite differences because
+  // the model does not support AD); printed and kept in summary.json.
+  std::vector<std::string> warnings;
+  std::vector<SignalInfo> signals;  // the entries of ObserverStep::signals, in order
+};
+
 struct ObserverStep {
   Eigen::VectorXd estimate;          // x̂_k; finite (accept_finite() keeps it so)
   bool ready = true;                 // false while a window fills (the estimate coasts on f)
   bool measurement_missing = false;  // y_k had a non-finite entry: skipped, estimate coasts
   std::optional<Summary> summary;    // the engine's summary when this step solved a window
-  Eigen::VectorXd extras;  // further named signals (extra_names()), e.g. η̂₁ of a PI bank
-  // Empty, or why this step kept the last good state ("non_finite", "non_finite_estimate", …).
+  Eigen::VectorXd signals;           // the values of ObserverInfo::signals at this step
+  // Empty, or why this step kept the last good state ("non_finite", "non_uniform", …).
   std::string failure;
   std::string failure_message;  // what and where, for the report
 };
@@ -27,33 +88,33 @@ struct ObserverStep {
 class Observer {
  public:
   virtual ~Observer() = default;
-  virtual std::string name() const = 0;              // e.g. "window:steffensen", "luenberger"
-  virtual std::string engine() const { return {}; }  // engine spec, for window estimators
-  // Window length N for window estimators (0 otherwise): the harness's "after the window".
-  virtual Eigen::Index window() const { return 0; }
-  // Names of the signals in ObserverStep::extras (written beside x̂ by `nlobs run`).
-  virtual std::vector<std::string> extra_names() const { return {}; }
-  // What a user should know about this observer's set-up (e.g. derivatives by finite
-  // differences because the model does not support AD); printed and kept in summary.json.
-  virtual std::vector<std::string> warnings() const { return {}; }
-  // Observers that estimate in other coordinates (the high-gain observer's z = q_N(x), published
-  // as the extras zhat1…): the image of a true state, so that a harness can measure the error
-  // there. Empty for observers that estimate x directly.
-  virtual Eigen::VectorXd coordinates_of(const Eigen::VectorXd& /*x*/) const { return {}; }
-  // The same at time t, for coordinates that move with t (the modulating-function observer's
-  // canonical state of a time-varying system).
-  virtual Eigen::VectorXd coordinates_at(const Eigen::VectorXd& x, double /*t*/) const {
-    return coordinates_of(x);
+
+  const ObserverInfo& info() const { return info_; }
+  const std::string& name() const { return info_.name; }
+
+  virtual void reset() = 0;  // back to the initial estimate, empty window
+  // Sample k (consecutive from 0, in order) taken at time t. A non-finite entry of y is a
+  // missing measurement. Discrete-time observers (window estimators, Luenberger, sliding mode,
+  // EKF) run on k and record t; the sampled-data ones (MVT, high-gain, PI bank, modulating)
+  // need t on their uniform grid t_0 + k·T and refuse a sample off it (failure "non_uniform").
+  virtual const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
+                                   const Eigen::VectorXd& u) = 0;
+  // For observers that estimate in other coordinates (signals of kind kEmbeddedEstimate or
+  // kCanonicalEstimate): the image of a true state x at time t there, so that a harness can
+  // measure the error in those coordinates. Empty for observers that estimate x directly.
+  virtual Eigen::VectorXd coordinates_at(const Eigen::VectorXd& /*x*/, double /*t*/) const {
+    return {};
   }
-  virtual void reset() = 0;  // back to the initial guess, empty window
-  // Sample k (consecutive from 0). A non-finite y means a missing measurement.
-  virtual const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) = 0;
-  // Sample k taken at time t (recorded data carry their times): observers that need uniform
-  // sampling check it here; the others ignore t.
-  virtual const ObserverStep& step_at(long k, double /*t*/, const Eigen::VectorXd& y,
-                                      const Eigen::VectorXd& u) {
-    return step(k, y, u);
-  }
+
+ protected:
+  Observer() = default;
+  explicit Observer(ObserverInfo info) : info_(std::move(info)) {}
+  Observer(const Observer&) = default;
+  Observer& operator=(const Observer&) = default;
+  Observer(Observer&&) = default;
+  Observer& operator=(Observer&&) = default;
+
+  ObserverInfo info_;  // filled by the constructor; constant during a run
 };
 
 // Marks a step whose estimate (or what it is computed from) was not finite and was not taken.

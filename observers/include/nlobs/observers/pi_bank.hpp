@@ -151,10 +151,9 @@ struct PiBankOptions {
 class PiBankObserver final : public Observer {
  public:
   PiBankObserver(PiBank bank, PiBankOptions options);
-  std::string name() const override { return options_.name; }
-  std::vector<std::string> extra_names() const override;
   void reset() override;
-  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override;
+  const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
+                           const Eigen::VectorXd& u) override;
   const PiBank& bank() const { return bank_; }
 
  private:
@@ -166,8 +165,8 @@ class PiBankObserver final : public Observer {
   void publish();
 
   PiBank bank_;
-  PiBankOptions options_;  // validated; options_.estimate are the bank's signals
-  std::vector<PiBank::Signal> extra_ids_;
+  PiBankOptions options_;                  // validated; options_.estimate are the bank's signals
+  std::vector<PiBank::Signal> published_;  // the stage signals, as ObserverInfo::signals
   // y between samples: the line through the last two good ones.
   SampledData<Eigen::Dynamic, Eigen::Dynamic> clock_;
   std::optional<IntervalIntegrator> interval_;

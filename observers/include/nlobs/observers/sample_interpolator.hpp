@@ -37,8 +37,8 @@ class SampleInterpolator {
   }
 
   Output at(double t) const {
-    Output y = Output::Zero(ys_.rows());
-    for (int j = 0; j < count_; ++j) y += basis(j, t) * ys_.col(j);
+    Output y;
+    at(t, y);
     return y;
   }
 

@@ -27,7 +27,7 @@ struct Measurements {
   Eigen::MatrixXd x;  // true states (empty when the data came from a file)
   Eigen::MatrixXd y;
   Eigen::MatrixXd u;
-  Eigen::VectorXd t;
+  Eigen::VectorXd t;  // t_k of every sample (run_observers needs one per sample)
   bool has_truth() const { return x.size() > 0; }
   Eigen::Index steps() const { return y.cols(); }
   std::string stop_message;  // why the simulation ended early (domain), empty otherwise
@@ -148,13 +148,15 @@ struct ObserverMetrics {
 struct RunResult {
   std::vector<ObserverMetrics> metrics;
   std::vector<Eigen::MatrixXd> estimates;  // per observer: n × K
-  std::vector<Eigen::MatrixXd> extras;     // per observer: extra_names() × K (may be empty)
-  std::vector<std::vector<std::string>> extra_names;  // per observer
-  long settle_index = 0;                              // first sample of "after the window"
+  std::vector<Eigen::MatrixXd> signals;    // per observer: its published signals × K (or 0 × K)
+  std::vector<std::vector<SignalInfo>> signal_info;  // per observer: ObserverInfo::signals
+  long settle_index = 0;                             // first sample of "after the window"
 };
 
-// Runs every observer over the same measurements (each reset first). `settle_index`: the
-// first sample counted in mse_after_window (the longest window's N − 1 when negative).
+// Runs every observer over the same measurements (each reset first), sample k at its time
+// data.t[k] (required: InvalidInput when data.t does not have one time per sample).
+// `settle_index`: the first sample counted in mse_after_window (the longest
+// ObserverInfo::window's N − 1 when negative).
 RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Observer>>& observers,
                         long settle_index = -1,
                         const std::function<void(long done, long total)>& progress = {});

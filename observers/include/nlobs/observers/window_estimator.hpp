@@ -80,30 +80,19 @@ class WindowEstimator final : public Observer {
   // window. The engine's label() (its spec when it came from the registry) names it in reports.
   WindowEstimator(Model model, WindowEstimatorOptions options, std::unique_ptr<Engine<N>> engine);
 
-  std::string name() const override {
-    if (!options_.name.empty()) return options_.name;
-    std::string out = "window:";
-    out += spec_;
-    if (!square_) out += ",N=" + std::to_string(state_->window.length());
-    return out;
-  }
   // An engine for the first window after each reset only (e.g. one that records its trace for
   // a convergence plot), so that the engine of every other step stays lean.
   void set_first_window_engine(std::unique_ptr<Engine<N>> engine) {
     first_engine_ = std::move(engine);
   }
-  std::string engine() const override { return spec_; }
-  Eigen::Index window() const override { return state_->window.length(); }
   const OutputWindow<Model>& output_window() const { return state_->window; }
   const WindowEstimatorOptions& options() const { return options_; }
-  // What the run found: Ψ = I not contracting at the first window (and the Ψ chosen), a guess
-  // at a singular point of the window map.
-  std::vector<std::string> warnings() const override { return warnings_; }
   // Ψ in use (kAuto until the first window decides it).
   WindowGain gain() const { return active_gain_; }
 
   void reset() override;
-  const ObserverStep& step(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) override;
+  const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
+                           const Eigen::VectorXd& u) override;
 
  private:
   struct Shared {
@@ -151,7 +140,6 @@ class WindowEstimator final : public Observer {
   bool gain_valid_ = false;   // newton: Ψ was formed at least once
   bool gain_chosen_ = false;  // the first window decided Ψ (kAuto) and checked it
   bool warned_singular_ = false;
-  std::vector<std::string> warnings_;
   // Relative offset of a guess at a singular point of the window map; an LU pivot below this
   // fraction of the largest |∂H/∂w| entry counts as zero (as in NewtonEngine).
   static constexpr double kPerturbation = 1e-3;
@@ -205,6 +193,13 @@ WindowEstimator<Model>::WindowEstimator(Model model, WindowEstimatorOptions opti
     }
     root_ = std::make_unique<RootProblem<N, Dynamic>>(window_residual_problem(state_->window));
   }
+  info_.engine = spec_;
+  info_.window = state_->window.length();
+  info_.name = options_.name;
+  if (info_.name.empty()) {
+    info_.name = "window:" + spec_;
+    if (!square_) info_.name += ",N=" + std::to_string(state_->window.length());
+  }
   reset();
 }
 
@@ -221,7 +216,7 @@ void WindowEstimator<Model>::reset() {
   gain_valid_ = false;
   gain_chosen_ = false;
   warned_singular_ = false;
-  warnings_.clear();
+  info_.warnings.clear();  // what the last run found
   if (square_) {
     const Eigen::Index n = state_->window.states();
     state_->gain = options_.gain == WindowGain::kScalar
@@ -231,7 +226,7 @@ void WindowEstimator<Model>::reset() {
 }
 
 template <DiscreteModel Model>
-const ObserverStep& WindowEstimator<Model>::step(long k, const Eigen::VectorXd& y,
+const ObserverStep& WindowEstimator<Model>::step(long k, double /*t*/, const Eigen::VectorXd& y,
                                                  const Eigen::VectorXd& u) {
   const OutputWindow<Model>& window = state_->window;
   const Eigen::Index length = window.length();
@@ -317,7 +312,7 @@ Summary WindowEstimator<Model>::solve_window(Engine<N>& engine, State& w, long k
          << " is a singular point of the window map (" << s.message
          << "): the state is not observable from the window there (an equilibrium?); solves "
             "from such a guess restart from a perturbed one";
-      warnings_.push_back(os.str());
+      info_.warnings.push_back(os.str());
     }
     for (Eigen::Index i = 0; i < w.size(); ++i) {
       const double sign = i % 2 == 0 ? 1.0 : -1.0;
@@ -390,7 +385,7 @@ void WindowEstimator<Model>::choose_gain(const Engine<N>& engine, const State& w
   } else {
     os << "; engine '" << spec_ << "' needs a contraction: psi = auto or newton makes G contract";
   }
-  warnings_.push_back(os.str());
+  info_.warnings.push_back(os.str());
 }
 
 template <DiscreteModel Model>

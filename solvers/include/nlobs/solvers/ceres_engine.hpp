@@ -188,9 +188,12 @@ class CeresEngine : public Engine<N> {
     return s;
   }
 
-// GCC cannot see that TinySolver's cost is set by the (now pre-checked) first evaluation.
+// GCC cannot see that TinySolver's cost is set by the (now pre-checked) first evaluation
+// (clang has no such warning, and would warn about the unknown group).
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
   template <int M>
   Summary run_tiny(const detail::ResidualSource<N, M>& source, Vector<N>& x) {
     Workspace<M> w;  // fixed sizes: on the stack, nothing allocated
@@ -220,7 +223,9 @@ class CeresEngine : public Engine<N> {
     if (p.allFinite()) x = p;
     return finish<M>(source, w, x, status, summary.iterations);
   }
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 
   // The cost functor TinySolver wants: sizes as enums, column-major Jacobian.
   template <int M>

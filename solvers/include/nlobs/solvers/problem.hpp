@@ -66,6 +66,7 @@ class FixedPointProblem {
   template <typename G>
   static FixedPointProblem with_autodiff(G g, Index n = N) {
     JacobianMap dg = [g, n](const VectorType& x, JacobianType& jac) mutable {
+      static_cast<void>(n);  // read at Dynamic size only
       if constexpr (N == Dynamic) jac.resize(n, n);
       autodiff_jacobian<N, N>(g, x, jac);
     };
@@ -77,6 +78,7 @@ class FixedPointProblem {
   static FixedPointProblem with_jacobian(G g, DG dg, Index n = N,
                                          JacobianSource source = JacobianSource::kUserSupplied) {
     JacobianMap jm = [dg = std::move(dg), n](const VectorType& x, JacobianType& jac) mutable {
+      static_cast<void>(n);  // read at Dynamic size only
       if constexpr (N == Dynamic) jac.resize(n, n);
       detail::invoke_map(dg, x, jac);
     };
