@@ -4,6 +4,7 @@
 
 #include "model_visit.hpp"
 #include "nlobs/observers/modulating_function_observer.hpp"
+#include "nlobs/solvers/engine_registry.hpp"
 
 namespace nlobs::cli {
 namespace {
@@ -19,7 +20,6 @@ std::unique_ptr<Observer> build(Form form, const ModulatingSpec& spec, const Eig
   o.quadrature = spec.quadrature == "trapezoid" ? Quadrature::kTrapezoid : Quadrature::kSimpson;
   o.kernel.order = spec.order;
   o.kernel.degree = spec.degree;
-  o.kernel.engine = spec.engine;
   o.kernel.noise_weights = spec.noise_weights;
   if (o.kernel.noise_weights.size() == 0) {
     Vector<Form::n> a;
@@ -38,7 +38,13 @@ std::unique_ptr<Observer> build(Form form, const ModulatingSpec& spec, const Eig
       throw InvalidInput("'disturbance_bound': this model has no unknown disturbance");
     }
   }
-  return std::make_unique<ModulatingFunctionObserver<Form>>(std::move(form), std::move(o));
+  // The design engine from its spec after the options' own checks, so that a bad spec cannot
+  // hide a bad option.
+  o.validate();
+  return std::make_unique<ModulatingFunctionObserver<Form>>(
+      std::move(form), std::move(o),
+      EngineRegistry<Eigen::Dynamic>::global().create(spec.engine,
+                                                      modulating_kernel_solver_options()));
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "nlobs/observers/finite_difference_observer.hpp"
 #include "nlobs/observers/modulating_function_observer.hpp"
 #include "nlobs/observers/simulation.hpp"
+#include "nlobs/solvers/engine_registry.hpp"
 #include "test_support.hpp"
 
 namespace nlobs {
@@ -171,11 +172,37 @@ TEST(ModulatingKernels, BadOptionsNameTheOption) {
             std::string::npos);
   o = {};
   o.degree = 6;
-  o.engine = "no-such-engine";
-  EXPECT_NE(message_of([&] { ModulatingKernels(2, 1.0, o); }).find("engine"), std::string::npos);
-  o.engine = "newton";
-  EXPECT_NE(message_of([&] { ModulatingKernels(2, 1.0, o); }).find("square systems"),
-            std::string::npos);
+  const auto engine = [](const char* spec) {
+    return EngineRegistry<Eigen::Dynamic>::global().create(spec,
+                                                           modulating_kernel_solver_options());
+  };
+  EXPECT_EQ(message_of([&] { ModulatingKernels(2, 1.0, o, engine("newton")); }),
+            "modulating kernel: engine 'newton' solves square systems only; use ceres or nlopt");
+  // At the minimal degree there is nothing to optimise: any engine is accepted and unused.
+  o.degree = 0;
+  EXPECT_EQ(ModulatingKernels(2, 1.0, o, engine("newton")).engine(), "newton");
+}
+
+// The design engine is an object like every other engine (here NLopt's, by its spec, and
+// Ceres' by default): both reach the same noise-optimal kernel.
+TEST(ModulatingKernels, TheDesignEngineIsAnObject) {
+  ModulatingKernelOptions o;
+  o.degree = 8;
+  o.noise_weights = Eigen::Vector2d(1.0, 2.0);
+  const ModulatingKernels ceres(2, 1.0, o);
+  const ModulatingKernels nlopt(
+      2, 1.0, o,
+      EngineRegistry<Eigen::Dynamic>::global().create("nlopt", modulating_kernel_solver_options()));
+  EXPECT_EQ(ceres.engine(), "ceres");
+  EXPECT_EQ(nlopt.engine(), "nlopt");
+  ASSERT_TRUE(ceres.optimisation().has_value());
+  ASSERT_TRUE(nlopt.optimisation().has_value());
+  for (int j = 0; j < 2; ++j) {
+    EXPECT_NEAR(nlopt.noise_gain(j), ceres.noise_gain(j), 1e-6 * ceres.noise_gain(j)) << j;
+    for (const double s : {0.1, 0.5, 0.9}) {
+      EXPECT_NEAR(nlopt.value(j, 0, s), ceres.value(j, 0, s), 1e-6) << j << " " << s;
+    }
+  }
 }
 
 // The chain y''' = 0 on a quadratic: the FIR (Simpson) reconstructs y, y', y'' one horizon in.

@@ -28,12 +28,20 @@ constexpr double kGradientTolerance = 1e-6;
 
 }  // namespace
 
-ModulatingKernels::ModulatingKernels(int n, double horizon, ModulatingKernelOptions options)
+SolverOptions modulating_kernel_solver_options() {
+  SolverOptions solver;
+  solver.stop.step_tolerance = 1e-14;
+  solver.stop.max_iterations = 200;
+  return solver;
+}
+
+ModulatingKernels::ModulatingKernels(int n, double horizon, ModulatingKernelOptions options,
+                                     std::unique_ptr<Engine<Eigen::Dynamic>> engine)
     : n_(n),
       r_(options.order == 0 ? n : options.order),
       d_(0),
       T_(horizon),
-      engine_(options.engine) {
+      engine_(engine ? engine->label() : std::string("ceres")) {
   if (n < 1) fail("the number of canonical states n must be >= 1");
   if (!(horizon > 0.0) || !std::isfinite(horizon)) fail("horizon must be finite and > 0");
   if (r_ < n) {
@@ -97,18 +105,13 @@ ModulatingKernels::ModulatingKernels(int n, double horizon, ModulatingKernelOpti
   }
 
   C_ = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>::Zero(d_ + 1, n);
-  std::unique_ptr<Engine<Eigen::Dynamic>> engine;
   if (m > n) {
-    SolverOptions solver;
-    solver.stop.step_tolerance = 1e-14;
-    solver.stop.max_iterations = 200;
-    try {
-      engine = EngineRegistry<Eigen::Dynamic>::global().create(options.engine, solver);
-    } catch (const InvalidInput& e) {
-      fail(std::string("engine: ") + e.what());
+    if (!engine) {
+      engine = EngineRegistry<Eigen::Dynamic>::global().create("ceres",
+                                                               modulating_kernel_solver_options());
     }
     if (!engine->least_squares()) {
-      fail("engine '" + options.engine + "' solves square systems only; use ceres or nlopt");
+      fail("engine '" + engine_ + "' solves square systems only; use ceres or nlopt");
     }
   }
   for (int j = 0; j < n; ++j) {
@@ -139,15 +142,14 @@ ModulatingKernels::ModulatingKernels(int n, double horizon, ModulatingKernelOpti
         try {
           s = engine->solve_least_squares(problem, q);
         } catch (const std::exception& e) {
-          fail("engine '" + options.engine + "' failed on the noise-optimal kernel: " + e.what());
+          fail("engine '" + engine_ + "' failed on the noise-optimal kernel: " + e.what());
         }
         gradient = QJ.transpose() * (r0 + QJ * q);
       }
       if (!q.allFinite() || gradient.norm() > kGradientTolerance * (1.0 + r0.norm())) {
         std::ostringstream os;
-        os << "the noise-optimal kernel " << j << " did not converge with engine '"
-           << options.engine << "' (status " << to_string(s.status) << ", ‖Jᵀr‖ " << gradient.norm()
-           << ")";
+        os << "the noise-optimal kernel " << j << " did not converge with engine '" << engine_
+           << "' (status " << to_string(s.status) << ", ‖Jᵀr‖ " << gradient.norm() << ")";
         fail(os.str());
       }
       summary_ = s;

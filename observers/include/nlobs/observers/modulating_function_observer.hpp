@@ -71,13 +71,15 @@ class ModulatingFunctionObserver final : public Observer {
   using Eta = Vector<n>;
   using State = Vector<nx>;
 
-  // Throws InvalidInput naming the field: ModulatingOptions::validate()'s checks, the kernel
-  // options (modulating_kernel.hpp), an initial estimate of other than Form::state_size entries
-  // or disturbance gains of other than n.
-  ModulatingFunctionObserver(Form form, ModulatingOptions options)
+  // `kernel_engine` solves the noise-optimal kernel design (ModulatingKernels; none given:
+  // Ceres), once, here. Throws InvalidInput naming the field: ModulatingOptions::validate()'s
+  // checks, the kernel options (modulating_kernel.hpp), an initial estimate of other than
+  // Form::state_size entries or disturbance gains of other than n.
+  ModulatingFunctionObserver(Form form, ModulatingOptions options,
+                             std::unique_ptr<Engine<Eigen::Dynamic>> kernel_engine = nullptr)
       : form_(std::move(form)),
         options_(detail::validated(std::move(options))),
-        kernels_(make_kernels()) {
+        kernels_(make_kernels(std::move(kernel_engine))) {
     detail::require_size("ModulatingOptions", "initial_estimate", options_.initial_estimate, nx);
     if (options_.disturbance_gains.size() != 0 && options_.disturbance_gains.size() != n) {
       detail::invalid_option("ModulatingOptions", "disturbance_gains",
@@ -262,11 +264,12 @@ class ModulatingFunctionObserver final : public Observer {
 
  private:
   // validate() checked that T is a whole number L ≥ 4 of δ (even for Simpson).
-  ModulatingKernels make_kernels() {
+  ModulatingKernels make_kernels(std::unique_ptr<Engine<Eigen::Dynamic>> engine) {
     const double delta = options_.sample_time;
     L_ = std::lround(options_.horizon / delta);
     // Designed on the span the FIR covers (T within 1e-6 of it).
-    return ModulatingKernels(n, static_cast<double>(L_) * delta, options_.kernel);
+    return ModulatingKernels(n, static_cast<double>(L_) * delta, options_.kernel,
+                             std::move(engine));
   }
 
   // One grid time: a measured output (FIR mode; sampled mode at multiples of h) or the

@@ -11,9 +11,11 @@
 // (white noise on y enters η̂_j with this gain) — a linear least-squares problem solved with one
 // of the library's engines. Everything here runs once, offline.
 #include <Eigen/Core>
+#include <memory>
 #include <optional>
 #include <string>
 
+#include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/summary.hpp"
 
 namespace nlobs {
@@ -24,18 +26,25 @@ struct ModulatingKernelOptions {
   // ā_0…ā_{n−1} of the noise cost (the constant or nominal coefficients); empty: zeros, which
   // minimises ∫ (φ⁽ⁿ⁾)².
   Eigen::VectorXd noise_weights;
-  std::string engine = "ceres";  // least-squares engine for the noise-optimal kernel
 };
+
+// The solver options of the default design engine (Ceres): step tolerance 1e-14, 200
+// iterations. Give an engine built from a spec the same (the CLI does):
+// EngineRegistry<Eigen::Dynamic>::global().create(spec, modulating_kernel_solver_options()).
+SolverOptions modulating_kernel_solver_options();
 
 class ModulatingKernels {
  public:
   static constexpr int kMaxDegree = 29;  // the cost is integrated exactly by 30-point Gauss
 
-  // n ≥ 1 canonical states, horizon T > 0. Throws InvalidInput naming the option when r < n,
+  // n ≥ 1 canonical states, horizon T > 0; `engine` solves the noise-optimal kernel's least
+  // squares above the minimal degree (none given: Ceres with modulating_kernel_solver_options();
+  // it is used during the design only). Throws InvalidInput naming the option when r < n,
   // d < r + n − 1 or d > kMaxDegree, T is not finite and positive, the weights have the wrong
-  // size or are not finite, the engine is unknown or cannot do least squares, or the
-  // optimisation does not converge.
-  ModulatingKernels(int n, double horizon, ModulatingKernelOptions options = {});
+  // size or are not finite, the engine cannot do least squares, or the optimisation does not
+  // converge.
+  ModulatingKernels(int n, double horizon, ModulatingKernelOptions options = {},
+                    std::unique_ptr<Engine<Eigen::Dynamic>> engine = nullptr);
 
   int states() const { return n_; }
   double horizon() const { return T_; }
@@ -50,7 +59,7 @@ class ModulatingKernels {
     return C_;
   }
   // The engine's summary of the last noise-optimal kernel (none at the minimal degree); its
-  // `engine` view is empty, as the engine lives only during the design: engine() names it.
+  // `engine` view is empty, as the engine lives only during the design: engine() is its label.
   const std::optional<Summary>& optimisation() const { return summary_; }
   const std::string& engine() const { return engine_; }
 
