@@ -7,8 +7,8 @@
 
 #include "nlobs/models/discretization.hpp"
 #include "nlobs/models/systems.hpp"
-#include "nlobs/observers/mvt_observer.hpp"
-#include "nlobs/observers/simulation.hpp"
+#include "nlobs/observers/core/simulation.hpp"
+#include "nlobs/observers/mvt/mvt_observer.hpp"
 
 namespace {
 

@@ -6,8 +6,8 @@
 
 #include "nlobs/models/discretization.hpp"
 #include "nlobs/models/systems.hpp"
-#include "nlobs/observers/pi_bank.hpp"
-#include "nlobs/observers/simulation.hpp"
+#include "nlobs/observers/core/simulation.hpp"
+#include "nlobs/observers/pi/pi_bank.hpp"
 
 namespace {
 

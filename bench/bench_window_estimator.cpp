@@ -5,8 +5,8 @@
 #include <benchmark/benchmark.h>
 
 #include "nlobs/models/modified_chua.hpp"
-#include "nlobs/observers/simulation.hpp"
-#include "nlobs/observers/window_estimator.hpp"
+#include "nlobs/observers/core/simulation.hpp"
+#include "nlobs/observers/window/window_estimator.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 
 namespace {

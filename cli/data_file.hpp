@@ -13,7 +13,7 @@
 #include <iosfwd>
 #include <string>
 
-#include "nlobs/observers/simulation.hpp"
+#include "nlobs/observers/core/simulation.hpp"
 
 namespace nlobs::cli {
 

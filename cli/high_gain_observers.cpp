@@ -3,10 +3,10 @@
 #include <type_traits>
 
 #include "model_visit.hpp"
-#include "nlobs/observers/embedded_forms.hpp"
-#include "nlobs/observers/high_gain_observer.hpp"
-#include "nlobs/observers/lie_observability_map.hpp"
-#include "nlobs/observers/taylor_observability_map.hpp"
+#include "nlobs/models/embedded_forms.hpp"
+#include "nlobs/observers/high_gain/high_gain_observer.hpp"
+#include "nlobs/observers/high_gain/lie_observability_map.hpp"
+#include "nlobs/observers/high_gain/taylor_observability_map.hpp"
 
 namespace nlobs::cli {
 namespace {

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "json_reader.hpp"
-#include "nlobs/observers/observer.hpp"
+#include "nlobs/observers/core/observer.hpp"
 
 namespace nlobs::cli {
 

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "json_reader.hpp"
-#include "nlobs/observers/any_model.hpp"
+#include "nlobs/observers/core/any_model.hpp"
 
 namespace nlobs::cli {
 

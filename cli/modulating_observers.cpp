@@ -3,7 +3,7 @@
 #include <type_traits>
 
 #include "model_visit.hpp"
-#include "nlobs/observers/modulating_function_observer.hpp"
+#include "nlobs/observers/modulating/modulating_function_observer.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 
 namespace nlobs::cli {

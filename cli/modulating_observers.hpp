@@ -9,7 +9,7 @@
 #include <string>
 
 #include "json_reader.hpp"
-#include "nlobs/observers/observer.hpp"
+#include "nlobs/observers/core/observer.hpp"
 
 namespace nlobs::cli {
 

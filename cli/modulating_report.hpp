@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "nlobs/observers/simulation.hpp"
+#include "nlobs/observers/core/simulation.hpp"
 #include "run_command.hpp"
 #include "scenario.hpp"
 

@@ -1,7 +1,7 @@
 #include "mvt_observers.hpp"
 
 #include "model_visit.hpp"
-#include "nlobs/observers/mvt_observer.hpp"
+#include "nlobs/observers/mvt/mvt_observer.hpp"
 
 namespace nlobs::cli {
 

@@ -1,15 +1,15 @@
 #pragma once
 // The PI observer banks of [FFMG19]'s examples, by name, for scenario files (docs/cli.md):
 //   {"type": "pi_bank", "bank": "lander", "gains": [[6, 25], [49, 700]], ...}
-// Users build their own banks with the C++ API (nlobs/observers/pi_bank.hpp).
+// Users build their own banks with the C++ API (nlobs/observers/pi/pi_bank.hpp).
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "nlobs/observers/any_model.hpp"
-#include "nlobs/observers/pi_bank.hpp"
+#include "nlobs/observers/core/any_model.hpp"
+#include "nlobs/observers/pi/pi_bank.hpp"
 
 namespace nlobs::cli {
 

@@ -17,7 +17,7 @@
 #include "data_file.hpp"
 #include "gnuplot.hpp"
 #include "modulating_report.hpp"
-#include "nlobs/observers/simulation.hpp"
+#include "nlobs/observers/core/simulation.hpp"
 #include "run_outputs.hpp"
 #include "run_support.hpp"
 #include "scenario.hpp"

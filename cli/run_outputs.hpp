@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "nlobs/observers/simulation.hpp"
+#include "nlobs/observers/core/simulation.hpp"
 #include "output_directory.hpp"
 #include "scenario.hpp"
 

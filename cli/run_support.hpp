@@ -11,7 +11,7 @@
 #include <string_view>
 #include <vector>
 
-#include "nlobs/observers/simulation.hpp"
+#include "nlobs/observers/core/simulation.hpp"
 #include "run_command.hpp"
 #include "scenario.hpp"
 

@@ -9,10 +9,10 @@
 #include "input_file.hpp"
 #include "json_reader.hpp"
 #include "model_catalog.hpp"
-#include "nlobs/observers/baselines.hpp"
-#include "nlobs/observers/finite_difference_observer.hpp"
-#include "nlobs/observers/pi_bound.hpp"
-#include "nlobs/observers/window_estimator.hpp"
+#include "nlobs/observers/baselines/baselines.hpp"
+#include "nlobs/observers/baselines/finite_difference_observer.hpp"
+#include "nlobs/observers/pi/pi_bound.hpp"
+#include "nlobs/observers/window/window_estimator.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 
 namespace nlobs::cli {

@@ -14,8 +14,8 @@
 #include "high_gain_observers.hpp"
 #include "modulating_observers.hpp"
 #include "mvt_observers.hpp"
-#include "nlobs/observers/any_model.hpp"
-#include "nlobs/observers/observer.hpp"
+#include "nlobs/observers/core/any_model.hpp"
+#include "nlobs/observers/core/observer.hpp"
 #include "pi_banks.hpp"
 
 namespace nlobs::cli {

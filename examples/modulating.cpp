@@ -6,9 +6,9 @@
 
 #include "nlobs/models/discretization.hpp"
 #include "nlobs/models/systems.hpp"
-#include "nlobs/observers/finite_difference_observer.hpp"
-#include "nlobs/observers/modulating_function_observer.hpp"
-#include "nlobs/observers/simulation.hpp"
+#include "nlobs/observers/baselines/finite_difference_observer.hpp"
+#include "nlobs/observers/core/simulation.hpp"
+#include "nlobs/observers/modulating/modulating_function_observer.hpp"
 
 int main() {
   using namespace nlobs;

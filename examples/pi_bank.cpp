@@ -1,14 +1,14 @@
 // A bank of model-free PI observers ([FFMG19], example 5): the lunar lander's velocity x2 = ẏ,
 // its mass from ẋ2, and the unknown mass-loss term f from the mass — three stages, one bank.
-#include "nlobs/observers/pi_bank.hpp"
+#include "nlobs/observers/pi/pi_bank.hpp"
 
 #include <cmath>
 #include <cstdio>
 
 #include "nlobs/models/discretization.hpp"
 #include "nlobs/models/systems.hpp"
-#include "nlobs/observers/pi_bound.hpp"
-#include "nlobs/observers/simulation.hpp"
+#include "nlobs/observers/core/simulation.hpp"
+#include "nlobs/observers/pi/pi_bound.hpp"
 
 int main() {
   using namespace nlobs;

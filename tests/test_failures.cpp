@@ -10,9 +10,9 @@
 
 #include "nlobs/models/discretization.hpp"
 #include "nlobs/models/systems.hpp"
-#include "nlobs/observers/baselines.hpp"
-#include "nlobs/observers/simulation.hpp"
-#include "nlobs/observers/window_estimator.hpp"
+#include "nlobs/observers/baselines/baselines.hpp"
+#include "nlobs/observers/core/simulation.hpp"
+#include "nlobs/observers/window/window_estimator.hpp"
 #include "nlobs/solvers/dynamic_size_engine.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 #include "nlobs/solvers/solvers.hpp"

@@ -9,12 +9,12 @@
 #include <random>
 
 #include "nlobs/models/discretization.hpp"
+#include "nlobs/models/embedded_forms.hpp"
 #include "nlobs/models/systems.hpp"
-#include "nlobs/observers/embedded_forms.hpp"
-#include "nlobs/observers/high_gain_observer.hpp"
-#include "nlobs/observers/lie_observability_map.hpp"
-#include "nlobs/observers/simulation.hpp"
-#include "nlobs/observers/taylor_observability_map.hpp"
+#include "nlobs/observers/core/simulation.hpp"
+#include "nlobs/observers/high_gain/high_gain_observer.hpp"
+#include "nlobs/observers/high_gain/lie_observability_map.hpp"
+#include "nlobs/observers/high_gain/taylor_observability_map.hpp"
 #include "short_tests.hpp"
 
 namespace nlobs {

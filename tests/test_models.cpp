@@ -7,7 +7,7 @@
 #include "nlobs/models/modified_chua.hpp"
 #include "nlobs/models/odeint_discretization.hpp"
 #include "nlobs/models/systems.hpp"
-#include "nlobs/observers/simulation.hpp"
+#include "nlobs/observers/core/simulation.hpp"
 #include "nlobs/solvers/status.hpp"
 
 namespace nlobs {

@@ -9,9 +9,9 @@
 #include <string>
 
 #include "nlobs/models/discretization.hpp"
-#include "nlobs/observers/finite_difference_observer.hpp"
-#include "nlobs/observers/modulating_function_observer.hpp"
-#include "nlobs/observers/simulation.hpp"
+#include "nlobs/observers/baselines/finite_difference_observer.hpp"
+#include "nlobs/observers/core/simulation.hpp"
+#include "nlobs/observers/modulating/modulating_function_observer.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 #include "test_support.hpp"
 

@@ -8,8 +8,8 @@
 #include <utility>
 #include <vector>
 
-#include "nlobs/observers/pi_bank.hpp"
-#include "nlobs/observers/pi_bound.hpp"
+#include "nlobs/observers/pi/pi_bank.hpp"
+#include "nlobs/observers/pi/pi_bound.hpp"
 #include "test_support.hpp"
 
 namespace nlobs {

@@ -166,7 +166,7 @@ TEST(PlotRows, ShortTablesWhole_LongOnesKeepEveryExtreme) {
 TEST(RunOutputs, ASecondRunLeavesNothingOfTheFirst) {
   const fs::path dir = scratch("two-runs");
   std::ostringstream out, err;
-  // pi-linear writes signals_N.png (its banks publish extras); chua-fp writes none.
+  // pi-linear writes signals_N.png (its banks publish signals); chua-fp writes none.
   run_scenario("pi-linear", {.steps = 200, .out_dir = dir.string()}, out, err);
   if (have_gnuplot()) {  // the run's own signal plots are kept (and named in its "wrote" line)
     EXPECT_TRUE(fs::exists(dir / "signals_1.png"));

@@ -9,9 +9,9 @@
 #include <optional>
 #include <vector>
 
-#include "nlobs/observers/interval_integrator.hpp"
-#include "nlobs/observers/pi_bank.hpp"
-#include "nlobs/observers/sampled_data.hpp"
+#include "nlobs/observers/core/interval_integrator.hpp"
+#include "nlobs/observers/core/sampled_data.hpp"
+#include "nlobs/observers/pi/pi_bank.hpp"
 #include "test_support.hpp"
 
 namespace nlobs {

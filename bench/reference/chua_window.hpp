@@ -6,7 +6,7 @@
 #include <memory>
 
 #include "nlobs/models/modified_chua.hpp"
-#include "nlobs/observers/window_problems.hpp"
+#include "nlobs/observers/window/window_problems.hpp"
 
 namespace nlobs::reference {
 

@@ -3,8 +3,8 @@
 // (scripts/compile-cost reports its time).
 #include <cstdio>
 #include <nlobs/models/modified_chua.hpp>
-#include <nlobs/observers/simulation.hpp>
-#include <nlobs/observers/window_estimator.hpp>
+#include <nlobs/observers/core/simulation.hpp>
+#include <nlobs/observers/window/window_estimator.hpp>
 #include <nlobs/solvers/ceres_engine.hpp>
 #include <nlobs/solvers/engine_registry.hpp>
 

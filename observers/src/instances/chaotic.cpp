@@ -1,5 +1,5 @@
 // The observer the CLI builds for ChaoticNoLinear, compiled once (its header declares it extern).
-#include "nlobs/observers/mvt_observer.hpp"
+#include "nlobs/observers/mvt/mvt_observer.hpp"
 
 namespace nlobs {
 

@@ -1,6 +1,6 @@
 // The observer the CLI builds for LunarLanderImmersed, compiled once (its header declares it
 // extern).
-#include "nlobs/observers/mvt_observer.hpp"
+#include "nlobs/observers/mvt/mvt_observer.hpp"
 
 namespace nlobs {
 

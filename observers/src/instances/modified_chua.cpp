@@ -1,8 +1,8 @@
 // The observers the CLI builds for ModifiedChua, compiled once (their headers declare them extern):
 // the MVT observer, the high-gain observer and its Taylor-mode observability maps.
-#include "nlobs/observers/high_gain_observer.hpp"
-#include "nlobs/observers/mvt_observer.hpp"
-#include "nlobs/observers/taylor_observability_map.hpp"
+#include "nlobs/observers/high_gain/high_gain_observer.hpp"
+#include "nlobs/observers/high_gain/taylor_observability_map.hpp"
+#include "nlobs/observers/mvt/mvt_observer.hpp"
 
 namespace nlobs {
 

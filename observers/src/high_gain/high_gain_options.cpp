@@ -2,7 +2,7 @@
 // (the observer itself is a template over the model).
 #include <string>
 
-#include "nlobs/observers/high_gain_observer.hpp"
+#include "nlobs/observers/high_gain/high_gain_observer.hpp"
 
 namespace nlobs {
 

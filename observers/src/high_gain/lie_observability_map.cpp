@@ -1,4 +1,4 @@
-#include "nlobs/observers/lie_observability_map.hpp"
+#include "nlobs/observers/high_gain/lie_observability_map.hpp"
 
 #include <adolc/drivers/odedrivers.h>
 

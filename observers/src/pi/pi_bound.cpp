@@ -1,4 +1,4 @@
-#include "nlobs/observers/pi_bound.hpp"
+#include "nlobs/observers/pi/pi_bound.hpp"
 
 #include <algorithm>
 #include <complex>

@@ -1,4 +1,4 @@
-#include "nlobs/observers/window_estimator.hpp"
+#include "nlobs/observers/window/window_estimator.hpp"
 
 namespace nlobs {
 

@@ -1,4 +1,4 @@
-#include "nlobs/observers/simulation.hpp"
+#include "nlobs/observers/core/simulation.hpp"
 
 #include <algorithm>
 #include <sstream>

@@ -1,4 +1,4 @@
-#include "nlobs/observers/stiff_integrator.hpp"
+#include "nlobs/observers/core/stiff_integrator.hpp"
 
 #include <cvode/cvode.h>
 #include <nvector/nvector_serial.h>

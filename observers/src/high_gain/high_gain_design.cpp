@@ -1,4 +1,4 @@
-#include "nlobs/observers/high_gain_design.hpp"
+#include "nlobs/observers/high_gain/high_gain_design.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>

@@ -1,12 +1,12 @@
-#include "nlobs/observers/interval_integrator.hpp"
+#include "nlobs/observers/core/interval_integrator.hpp"
 
 #include <algorithm>
 #include <boost/numeric/odeint.hpp>
 #include <cmath>
 #include <optional>
 
-#include "nlobs/observers/option_checks.hpp"
-#include "nlobs/observers/stiff_integrator.hpp"
+#include "nlobs/observers/core/option_checks.hpp"
+#include "nlobs/observers/core/stiff_integrator.hpp"
 
 namespace nlobs {
 namespace {

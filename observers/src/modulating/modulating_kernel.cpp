@@ -1,4 +1,4 @@
-#include "nlobs/observers/modulating_kernel.hpp"
+#include "nlobs/observers/modulating/modulating_kernel.hpp"
 
 #include <Eigen/QR>
 #include <boost/math/quadrature/gauss.hpp>

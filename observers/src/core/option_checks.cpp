@@ -1,4 +1,4 @@
-#include "nlobs/observers/option_checks.hpp"
+#include "nlobs/observers/core/option_checks.hpp"
 
 #include <array>
 #include <charconv>

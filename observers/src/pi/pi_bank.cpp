@@ -1,10 +1,10 @@
-#include "nlobs/observers/pi_bank.hpp"
+#include "nlobs/observers/pi/pi_bank.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
-#include "nlobs/observers/option_checks.hpp"
+#include "nlobs/observers/core/option_checks.hpp"
 #include "nlobs/solvers/status.hpp"
 
 namespace nlobs {

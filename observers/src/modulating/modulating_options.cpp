@@ -2,8 +2,8 @@
 #include <sstream>
 #include <string>
 
-#include "nlobs/observers/modulating_function_observer.hpp"
-#include "nlobs/observers/option_checks.hpp"
+#include "nlobs/observers/core/option_checks.hpp"
+#include "nlobs/observers/modulating/modulating_function_observer.hpp"
 
 namespace nlobs {
 namespace {

@@ -1,4 +1,6 @@
-#include "nlobs/observers/mvt_observer.hpp"
+#include "nlobs/observers/mvt/mvt_options.hpp"
+
+#include "nlobs/observers/core/option_checks.hpp"
 
 namespace nlobs {
 

@@ -1,4 +1,4 @@
-#include "nlobs/observers/baselines.hpp"
+#include "nlobs/observers/baselines/baselines.hpp"
 
 #include <Eigen/Cholesky>
 #include <cmath>

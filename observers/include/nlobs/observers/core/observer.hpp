@@ -1,0 +1,143 @@
+#pragma once
+// What the simulation harness runs side by side: anything that turns a stream of samples
+// (t_k, y_k, u_k) into estimates x̂_k. Sizes are dynamic at this interface; observers keep their
+// own (possibly fixed-size) state inside.
+//
+// The interface is three calls, as control-toolbox's estimators and mherb/kalman's filters have
+// it: reset(), step(k, t, y, u) and, for observers that estimate in other coordinates,
+// coordinates_at(x, t). What does not change during a run — name, engine, window length,
+// warnings, the signals published beside x̂ — is one ObserverInfo, set by the constructor.
+#include <Eigen/Core>
+#include <cstddef>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "nlobs/solvers/summary.hpp"
+
+namespace nlobs {
+
+// What a published signal is, so that a report finds it by its role and not by its spelling.
+// An observer of a user's own that publishes ẑ as kEmbeddedEstimate gets [HG-EMB23]'s figures;
+// one that publishes a per-sample residual as kSolveResidual gets its largest value reported.
+enum class SignalKind {
+  kDiagnostic,          // written beside x̂ (trajectory.csv, signals plots); no report reads it
+  kSolveResidual,       // residual of the per-sample solve, e.g. ‖X(β)‖ of [MGFF23]: its max
+  kEmbeddedEstimate,    // ẑ_i, the estimate in embedded coordinates z = q(x) ([HG-EMB23]), in
+                        // order; coordinates_at(x, t) gives q(x)
+  kProjectionResidual,  // ‖q(x̂) − ẑ‖ of the projection back to x ([HG-EMB23])
+  kJumpCount,           // the projection's jumps (restarts) so far
+  kCanonicalEstimate,   // η̂_j, the estimate in canonical coordinates η = T(t)x ([MF-LTV]), in
+                        // order; coordinates_at(x, t) gives T(t)x
+  kCanonicalBound,      // a guaranteed bound on the canonical error (Theorem 1 of [MF-LTV])
+  // Added by a harness that knows the true x (cli add_coordinate_errors), never published:
+  kEmbeddedError,   // ‖q(x) − ẑ‖₂
+  kCanonicalError,  // ‖T(t)x − η̂‖₂
+  kCanonicalNorm,   // ‖T(t)x‖₂, the scale of the relative canonical error
+};
+
+struct SignalInfo {
+  std::string name;  // a column name: "beta1", "zhat2", "eta1_hat" (no commas needed)
+  SignalKind kind = SignalKind::kDiagnostic;
+};
+
+// The rows of `signals` of one kind, in order (empty when none).
+inline std::vector<Eigen::Index> signal_rows(const std::vector<SignalInfo>& signals,
+                                             SignalKind kind) {
+  std::vector<Eigen::Index> rows;
+  for (std::size_t i = 0; i < signals.size(); ++i) {
+    if (signals[i].kind == kind) rows.push_back(static_cast<Eigen::Index>(i));
+  }
+  return rows;
+}
+
+// The first row of one kind.
+inline std::optional<Eigen::Index> signal_row(const std::vector<SignalInfo>& signals,
+                                              SignalKind kind) {
+  for (std::size_t i = 0; i < signals.size(); ++i) {
+    if (signals[i].kind == kind) return static_cast<Eigen::Index>(i);
+  }
+  return std::nullopt;
+}
+
+struct ObserverInfo {
+  std::string name;    // e.g. "window:steffensen", "luenberger": reports, columns, plots
+  std::string engine;  // the label of the engine it solves with (Engine::label()); empty if none
+  // Samples before the first full estimate (a window estimator's N, a modulating horizon's
+  // L + 1; 0 otherwise): the harness's "after the window" starts at the longest one's N − 1.
+  Eigen::Index window = 0;
+  // What a user should know about the set-up (e.g. derivatives by finite differences because
+  // the model does not support AD); printed and kept in summary.json.
+  std::vector<std::string> warnings;
+  std::vector<SignalInfo> signals;  // the entries of ObserverStep::signals, in order
+};
+
+struct ObserverStep {
+  Eigen::VectorXd estimate;          // x̂_k; finite (accept_finite() keeps it so)
+  bool ready = true;                 // false while a window fills (the estimate coasts on f)
+  bool measurement_missing = false;  // y_k had a non-finite entry: skipped, estimate coasts
+  std::optional<Summary> summary;    // the engine's summary when this step solved a window
+  Eigen::VectorXd signals;           // the values of ObserverInfo::signals at this step
+  // Empty, or why this step kept the last good state ("non_finite", "non_uniform", …).
+  std::string failure;
+  std::string failure_message;  // what and where, for the report
+};
+
+class Observer {
+ public:
+  virtual ~Observer() = default;
+
+  const ObserverInfo& info() const { return info_; }
+  const std::string& name() const { return info_.name; }
+
+  virtual void reset() = 0;  // back to the initial estimate, empty window
+  // Sample k (consecutive from 0, in order) taken at time t. A non-finite entry of y is a
+  // missing measurement. Discrete-time observers (window estimators, Luenberger, sliding mode,
+  // EKF) run on k and record t; the sampled-data ones (MVT, high-gain, PI bank, modulating)
+  // need t on their uniform grid t_0 + k·T and refuse a sample off it (failure "non_uniform").
+  virtual const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
+                                   const Eigen::VectorXd& u) = 0;
+  // For observers that estimate in other coordinates (signals of kind kEmbeddedEstimate or
+  // kCanonicalEstimate): the image of a true state x at time t there, so that a harness can
+  // measure the error in those coordinates. Empty for observers that estimate x directly.
+  virtual Eigen::VectorXd coordinates_at(const Eigen::VectorXd& /*x*/, double /*t*/) const {
+    return {};
+  }
+
+ protected:
+  Observer() = default;
+  explicit Observer(ObserverInfo info) : info_(std::move(info)) {}
+  Observer(const Observer&) = default;
+  Observer& operator=(const Observer&) = default;
+  Observer(Observer&&) = default;
+  Observer& operator=(Observer&&) = default;
+
+  ObserverInfo info_;  // filled by the constructor; constant during a run
+};
+
+// Marks a step whose estimate (or what it is computed from) was not finite and was not taken.
+inline void mark_non_finite_estimate(ObserverStep& step, std::string message) {
+  step.failure = "non_finite_estimate";
+  step.failure_message = std::move(message);
+}
+
+// The one rule for an observer's own state: `next` replaces `state` only when it is finite;
+// otherwise the state keeps its last finite value and the step says so (failure
+// "non_finite_estimate", with who, k and what overflowed). Returns whether `next` was taken.
+template <typename State>
+bool accept_finite(const State& next, State& state, ObserverStep& step, const std::string& who,
+                   long k, const char* what = "the next estimate") {
+  if (next.allFinite()) {
+    state = next;
+    return true;
+  }
+  std::ostringstream os;
+  os << who << ": " << what << " at sample k = " << k
+     << " is not finite; kept the last finite estimate";
+  mark_non_finite_estimate(step, os.str());
+  return false;
+}
+
+}  // namespace nlobs

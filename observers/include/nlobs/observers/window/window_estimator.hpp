@@ -1,0 +1,422 @@
+#pragma once
+// Window estimator = any engine × any output window ([MGFF23]). Once the window of N samples
+// is full, at each k it solves for w = x̂[k−N+1] and outputs x̂[k] = f^{N−1}(w*):
+//   square window (N·p = n): G(w) = w + Ψ (Y − H(w)) with any engine (Picard, Aitken,
+//     Steffensen, Anderson, Newton, Ceres, NLopt); Ψ = I is the paper's form, Ψ = (∂H/∂w)⁻¹
+//     (the chord form of the Newton observer) makes G contract wherever ∂H/∂w is invertible;
+//   longer window (N·p > n): min ½‖Y − H(w)‖² with a least-squares engine (Ceres, NLopt).
+// A solve's answer is used only when its Summary is usable() (the solver layer's one policy).
+// Otherwise — and before the window is full, and at a missing (non-finite) measurement — the
+// estimate coasts on the model, x̂[k] = f(x̂[k−1], u[k−1], k−1), from the initial guess at
+// k = 0; the next solve starts from the coasted estimate of its first sample (never from the
+// answer of a failed solve), so a run that fails is retried at every sample and recovers once
+// the data allow. After a missing sample the window refills from scratch. The estimate is
+// never non-finite: a coasting step that overflows keeps the last finite estimate and marks
+// the step (failure "non_finite_estimate").
+// Warm start of a solve that follows a usable one: the previous solution w* (the paper's
+// choice) or its propagation f(w*) to the next window's first sample (measured better; the
+// default, docs/observers.md). The engine's Summary of each solve is exposed per step.
+//
+//   auto estimator = make_window_estimator(model, "newton:tol=1e-10", options);  // by spec, or
+//   WindowEstimator<Model> estimator(model, options, std::make_unique<CeresEngine<3>>(...));
+#include <Eigen/LU>
+#include <cmath>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <string_view>
+
+#include "nlobs/observers/core/observer.hpp"
+#include "nlobs/observers/window/output_window.hpp"
+#include "nlobs/observers/window/window_problems.hpp"
+#include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/engine_registry.hpp"
+#include "nlobs/solvers/spectral_radius.hpp"
+
+namespace nlobs {
+
+enum class WarmStart {
+  kPrevious,    // w0 = w* of the previous window (the paper)
+  kPropagated,  // w0 = f(w*): the previous solution moved to the new window's first sample
+};
+
+// Ψ of the square window's G(w) = w + Ψ (Y − H(w)) (docs/observers.md, "When fixed-point
+// engines apply"). Picard-type engines converge near w* only when ρ(I − Ψ ∂H/∂w) < 1.
+enum class WindowGain {
+  kAuto,      // engines that need a contraction: identity when ρ(I − ∂H/∂w) < 1 at the first
+              // window's guess, else newton (with a warning); every other engine: identity
+  kIdentity,  // Ψ = I, the paper's form (a warning when it does not contract at the first window)
+  kScalar,    // Ψ = gain_scale · I
+  kNewton,  // Ψ = (∂H/∂w)⁻¹ at the guess, kept across windows and refreshed when a solve's
+            // contraction estimate reaches 1 or a solve is not usable (chord Newton)
+};
+
+std::string_view to_string(WindowGain gain);
+
+struct WindowEstimatorOptions {
+  // Name in reports; empty: "window:<engine label>", with ",N=<N>" for a longer window.
+  std::string name;
+  // x̂[0], and the first window's guess for w = x̂[k−N+1]: n finite numbers (required).
+  Eigen::VectorXd initial_estimate;
+  Eigen::Index window = 0;  // N; 0 = the square window n / p
+  WarmStart warm_start = WarmStart::kPropagated;
+  WindowGain gain = WindowGain::kAuto;  // Ψ (square windows only)
+  double gain_scale = 1.0;              // Ψ = gain_scale · I for WindowGain::kScalar
+  // Throws InvalidInput naming the field for a negative window, a gain_scale that is 0 or not
+  // finite, or an initial estimate that is empty or not finite. The constructor calls it and
+  // checks the sizes against the model.
+  void validate() const;
+};
+
+template <DiscreteModel Model>
+class WindowEstimator final : public Observer {
+ public:
+  static constexpr int N = Model::kStates;
+  using State = Vector<N>;
+  using Gain = Matrix<N, N>;
+
+  // Throws InvalidInput for invalid options, a window that cannot determine the state, an
+  // initial estimate of the wrong size, a missing engine, or a square-system engine on a longer
+  // window. The engine's label() (its spec when it came from the registry) names it in reports.
+  WindowEstimator(Model model, WindowEstimatorOptions options, std::unique_ptr<Engine<N>> engine);
+
+  // An engine for the first window after each reset only (e.g. one that records its trace for
+  // a convergence plot), so that the engine of every other step stays lean.
+  void set_first_window_engine(std::unique_ptr<Engine<N>> engine) {
+    first_engine_ = std::move(engine);
+  }
+  const OutputWindow<Model>& output_window() const { return state_->window; }
+  const WindowEstimatorOptions& options() const { return options_; }
+  // Ψ in use (kAuto until the first window decides it).
+  WindowGain gain() const { return active_gain_; }
+
+  void reset() override;
+  const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
+                           const Eigen::VectorXd& u) override;
+
+ private:
+  struct Shared {
+    Shared(Model m, Eigen::Index length) : window(std::move(m), length) {}
+    OutputWindow<Model> window;
+    Gain gain;  // Ψ, read by the gain problem at every evaluation
+  };
+
+  static Eigen::Index window_length(const Model& model, const WindowEstimatorOptions& o) {
+    o.validate();
+    if (o.window > 0) return o.window;
+    const Eigen::Index n = model.states(), p = model.outputs();
+    return (n + p - 1) / p;  // the square window when p divides n
+  }
+
+  void require_least_squares_engine() const;
+  // The estimate kept for the window's first sample k − N + 1, coasted on the model.
+  State coasted_guess(long k) const;
+  Summary solve_window(Engine<N>& engine, State& w, long k);
+  Summary solve_once(Engine<N>& engine, State& w);
+  void choose_gain(const Engine<N>& engine, const State& w, long k);
+  // Ψ = (∂H/∂w)⁻¹ at w; false (Ψ unchanged) where ∂H/∂w is singular or not finite.
+  bool refresh_newton_gain(const State& w);
+  bool window_jacobian(const State& w, Gain& dh) const;  // dh = ∂H/∂w
+
+  WindowEstimatorOptions options_;
+  std::unique_ptr<Engine<N>> engine_;
+  std::string spec_;
+  State initial_guess_;
+  std::unique_ptr<Shared> state_;
+  std::unique_ptr<FixedPointProblem<N>> fixed_point_;   // Ψ = I
+  std::unique_ptr<FixedPointProblem<N>> gain_point_;    // Ψ = state_->gain
+  std::unique_ptr<RootProblem<N, N>> square_residual_;  // Y − H(w): ∂H/∂w for Ψ
+  std::unique_ptr<RootProblem<N, Dynamic>> root_;
+  bool square_ = true;
+  ObserverStep step_;
+  State coast_, next_guess_;
+  Eigen::VectorXd last_u_;
+  std::vector<State> history_;  // estimates of the last N samples, by k mod N
+  bool have_solution_ = false;
+  std::unique_ptr<Engine<N>> first_engine_;
+  bool solved_once_ = false;
+  WindowGain active_gain_ = WindowGain::kAuto;
+  bool gain_stale_ = true;    // newton: refresh Ψ before the next solve
+  bool gain_valid_ = false;   // newton: Ψ was formed at least once
+  bool gain_chosen_ = false;  // the first window decided Ψ (kAuto) and checked it
+  bool warned_singular_ = false;
+  // Relative offset of a guess at a singular point of the window map; an LU pivot below this
+  // fraction of the largest |∂H/∂w| entry counts as zero (as in NewtonEngine).
+  static constexpr double kPerturbation = 1e-3;
+  static constexpr double kSingularPivot = 1e-13;
+};
+
+// The one-line form: the engine named by a spec of EngineRegistry<N> ("newton:tol=1e-10"),
+// `base` supplying the stop criteria the spec does not set. Throws InvalidInput for an unknown
+// engine or option and everything the constructor refuses.
+template <DiscreteModel Model>
+std::unique_ptr<WindowEstimator<Model>> make_window_estimator(Model model,
+                                                              std::string_view engine_spec,
+                                                              WindowEstimatorOptions options,
+                                                              SolverOptions base = {}) {
+  auto engine = EngineRegistry<Model::kStates>::global().create(engine_spec, std::move(base));
+  return std::make_unique<WindowEstimator<Model>>(std::move(model), std::move(options),
+                                                  std::move(engine));
+}
+
+template <DiscreteModel Model>
+WindowEstimator<Model>::WindowEstimator(Model model, WindowEstimatorOptions options,
+                                        std::unique_ptr<Engine<N>> engine)
+    : options_(std::move(options)),
+      engine_(std::move(engine)),
+      state_(std::make_unique<Shared>(std::move(model), window_length(model, options_))) {
+  if (!engine_) throw InvalidInput("WindowEstimator: no engine");
+  spec_ = engine_->label();
+  const Eigen::Index n = state_->window.states();
+  if (options_.initial_estimate.size() != n) {
+    std::ostringstream os;
+    os << "WindowEstimatorOptions::initial_estimate has " << options_.initial_estimate.size()
+       << " entries; the model has " << n << " states";
+    throw InvalidInput(os.str());
+  }
+  initial_guess_ = options_.initial_estimate;
+  square_ = state_->window.rows() == n;
+  // Built once; they read the window, which never moves (it lives behind a unique_ptr).
+  if (square_) {
+    state_->gain = Gain::Identity(n, n);
+    fixed_point_ = std::make_unique<FixedPointProblem<N>>(square_window_problem(state_->window));
+    gain_point_ = std::make_unique<FixedPointProblem<N>>(
+        square_window_problem(state_->window, &state_->gain));
+    square_residual_ = std::make_unique<RootProblem<N, N>>(square_window_residual(state_->window));
+  } else {
+    require_least_squares_engine();
+    if (options_.gain == WindowGain::kScalar || options_.gain == WindowGain::kNewton) {
+      throw InvalidInput("WindowEstimatorOptions::gain = " + std::string(to_string(options_.gain)) +
+                         " applies to square windows (N*p = n); a window of N = " +
+                         std::to_string(state_->window.length()) +
+                         " is solved in the least-squares sense, without Psi");
+    }
+    root_ = std::make_unique<RootProblem<N, Dynamic>>(window_residual_problem(state_->window));
+  }
+  info_.engine = spec_;
+  info_.window = state_->window.length();
+  info_.name = options_.name;
+  if (info_.name.empty()) {
+    info_.name = "window:" + spec_;
+    if (!square_) info_.name += ",N=" + std::to_string(state_->window.length());
+  }
+  reset();
+}
+
+template <DiscreteModel Model>
+void WindowEstimator<Model>::reset() {
+  state_->window.clear();
+  step_ = ObserverStep{};
+  coast_ = initial_guess_;
+  history_.assign(static_cast<size_t>(state_->window.length()), initial_guess_);
+  have_solution_ = false;
+  solved_once_ = false;
+  active_gain_ = options_.gain;
+  gain_stale_ = true;
+  gain_valid_ = false;
+  gain_chosen_ = false;
+  warned_singular_ = false;
+  info_.warnings.clear();  // what the last run found
+  if (square_) {
+    const Eigen::Index n = state_->window.states();
+    state_->gain = options_.gain == WindowGain::kScalar
+                       ? Gain(options_.gain_scale * Gain::Identity(n, n))
+                       : Gain(Gain::Identity(n, n));
+  }
+}
+
+template <DiscreteModel Model>
+const ObserverStep& WindowEstimator<Model>::step(long k, double /*t*/, const Eigen::VectorXd& y,
+                                                 const Eigen::VectorXd& u) {
+  const OutputWindow<Model>& window = state_->window;
+  const Eigen::Index length = window.length();
+  step_.summary.reset();
+  step_.failure.clear();
+  step_.failure_message.clear();
+  step_.measurement_missing = !y.allFinite();
+  if (step_.measurement_missing) {
+    state_->window.clear();  // consecutive samples only: refill after the gap
+    have_solution_ = false;
+  } else {
+    state_->window.push(k, y, u);
+  }
+  step_.ready = window.full();
+  bool solved = false;
+  if (step_.ready) {
+    // Guess for w = x̂[k−N+1]: the warm start after a usable solve, else the estimate kept
+    // for that sample (coasted on the model; for N = 1 that is f(x̂[k−1]), not yet kept).
+    State w = have_solution_ ? next_guess_ : coasted_guess(k);
+    have_solution_ = false;
+    Engine<N>& engine = (first_engine_ && !solved_once_) ? *first_engine_ : *engine_;
+    solved_once_ = true;
+    step_.summary = solve_window(engine, w, k);
+    if (step_.summary->usable()) {
+      const State w1 = window.propagate(w, 1);  // x̂[k−N+2]
+      // x̂[k] = f^{N−1}(w*): w* itself for a one-sample window.
+      const State estimate = length == 1 ? w : window.propagate(w1, length - 2, 1);
+      if (w1.allFinite() && estimate.allFinite()) {
+        solved = have_solution_ = true;
+        next_guess_ = options_.warm_start == WarmStart::kPrevious ? w : w1;
+        coast_ = estimate;
+      } else {
+        std::ostringstream os;
+        os << name() << ": the window's solution at sample k = " << k
+           << " carried to x̂[k] by the model is not finite; the estimate coasts";
+        mark_non_finite_estimate(step_, os.str());
+      }
+    }
+  }
+  // Otherwise x̂[k] comes from the model, f(x̂[k−1], u[k−1], k−1), from the guess at k = 0.
+  if (!solved && k > 0) {
+    const State next =
+        window.model().f(coast_, typename OutputWindow<Model>::Input(last_u_), k - 1);
+    accept_finite(next, coast_, step_, name(), k,
+                  "the state coasted on the model from the last estimate");
+  }
+  last_u_ = u;
+  history_[static_cast<size_t>(k % length)] = coast_;
+  step_.estimate = coast_;
+  return step_;
+}
+
+template <DiscreteModel Model>
+auto WindowEstimator<Model>::coasted_guess(long k) const -> State {
+  const Eigen::Index length = state_->window.length();
+  if (length > 1) return history_[static_cast<size_t>((k + 1) % length)];
+  if (k == 0) return initial_guess_;
+  const State next =
+      state_->window.model().f(coast_, typename OutputWindow<Model>::Input(last_u_), k - 1);
+  return next.allFinite() ? next : coast_;
+}
+
+template <DiscreteModel Model>
+Summary WindowEstimator<Model>::solve_window(Engine<N>& engine, State& w, long k) {
+  if (!square_) {
+    Summary s = engine.solve_least_squares(*root_, w);
+    if (!s.answer_recorded) s.record_answer(w, engine.options().stop, /*minimised=*/true);
+    return s;
+  }
+  const State guess = w;
+  if (!gain_chosen_) {
+    choose_gain(engine, guess, k);
+    gain_chosen_ = true;
+  }
+  Summary s = solve_once(engine, w);
+  if (s.status == Status::kSingularJacobian) {
+    // A guess where ∂H/∂w is singular (an equilibrium, say) is a point the window cannot see
+    // from: leave it by a small deterministic offset rather than stay stuck at it.
+    if (!warned_singular_) {
+      warned_singular_ = true;
+      std::ostringstream os;
+      os << name() << ": the guess w = [" << guess.transpose() << "] at k = " << k
+         << " is a singular point of the window map (" << s.message
+         << "): the state is not observable from the window there (an equilibrium?); solves "
+            "from such a guess restart from a perturbed one";
+      info_.warnings.push_back(os.str());
+    }
+    for (Eigen::Index i = 0; i < w.size(); ++i) {
+      const double sign = i % 2 == 0 ? 1.0 : -1.0;
+      w[i] = guess[i] + sign * kPerturbation * (1.0 + 0.1 * static_cast<double>(i)) *
+                            std::max(1.0, std::abs(guess[i]));
+    }
+    if (active_gain_ == WindowGain::kNewton) gain_stale_ = true;
+    const int evaluations = s.function_evaluations, jacobians = s.jacobian_evaluations;
+    s = solve_once(engine, w);
+    s.function_evaluations += evaluations;  // the step's cost is both solves'
+    s.jacobian_evaluations += jacobians;
+  }
+  if (active_gain_ == WindowGain::kNewton &&
+      (!s.usable() || (s.contraction_estimate && !(*s.contraction_estimate < 1.0)))) {
+    gain_stale_ = true;
+  }
+  return s;
+}
+
+template <DiscreteModel Model>
+Summary WindowEstimator<Model>::solve_once(Engine<N>& engine, State& w) {
+  int gain_jacobians = 0;  // ∂H/∂w for Ψ: counted in the step's Summary
+  if (active_gain_ == WindowGain::kNewton && gain_stale_) {
+    ++gain_jacobians;
+    if (refresh_newton_gain(w)) {
+      gain_stale_ = false;
+      gain_valid_ = true;
+    } else if (!gain_valid_) {
+      Summary s;
+      s.engine = engine.name();
+      s.status = Status::kSingularJacobian;
+      s.jacobian_evaluations = gain_jacobians;
+      s.message = "dH/dw is singular or not finite at the guess: no gain Psi = (dH/dw)^-1";
+      s.record_answer(w, engine.options().stop);
+      return s;
+    }
+  }
+  const FixedPointProblem<N>& problem =
+      active_gain_ == WindowGain::kIdentity ? *fixed_point_ : *gain_point_;
+  Summary s = engine.solve(problem, w);
+  if (!s.answer_recorded) s.record_answer(w, engine.options().stop);
+  s.jacobian_evaluations += gain_jacobians;
+  return s;
+}
+
+template <DiscreteModel Model>
+void WindowEstimator<Model>::choose_gain(const Engine<N>& engine, const State& w, long k) {
+  if (active_gain_ == WindowGain::kNewton) return;
+  if (!engine.needs_contraction()) {
+    if (active_gain_ == WindowGain::kAuto) active_gain_ = WindowGain::kIdentity;
+    return;
+  }
+  const Eigen::Index n = w.size();
+  Gain dh(n, n);
+  const Gain& psi = state_->gain;  // I, or gain_scale·I (reset()); newton never reaches here
+  double rho = std::nan("");
+  if (window_jacobian(w, dh)) rho = spectral_radius(Gain(Gain::Identity(n, n) - psi * dh));
+  if (rho < 1.0) {
+    if (active_gain_ == WindowGain::kAuto) active_gain_ = WindowGain::kIdentity;
+    return;
+  }
+  std::ostringstream os;
+  os << name() << ": Psi = ";
+  if (active_gain_ == WindowGain::kScalar) os << options_.gain_scale << " ";
+  os << "I does not contract at the first window (spectral radius of dG = I - Psi dH/dw is " << rho
+     << " at the guess, k = " << k << ")";
+  if (active_gain_ == WindowGain::kAuto) {
+    active_gain_ = WindowGain::kNewton;
+    os << "; chose psi = newton (Psi = (dH/dw)^-1, the chord Newton map)";
+  } else {
+    os << "; engine '" << spec_ << "' needs a contraction: psi = auto or newton makes G contract";
+  }
+  info_.warnings.push_back(os.str());
+}
+
+template <DiscreteModel Model>
+bool WindowEstimator<Model>::refresh_newton_gain(const State& w) {
+  const Eigen::Index n = w.size();
+  Gain dh(n, n);
+  if (!window_jacobian(w, dh)) return false;
+  const Eigen::PartialPivLU<Gain> lu(dh);
+  const auto pivots = lu.matrixLU().diagonal().cwiseAbs();
+  if (!(pivots.minCoeff() > kSingularPivot * dh.cwiseAbs().maxCoeff())) return false;
+  const Gain inverse = lu.inverse();
+  if (!inverse.allFinite()) return false;
+  state_->gain = inverse;
+  return true;
+}
+
+template <DiscreteModel Model>
+bool WindowEstimator<Model>::window_jacobian(const State& w, Gain& dh) const {
+  square_residual_->jacobian(w, dh);  // ∂(Y − H)/∂w
+  dh = -dh;
+  return dh.allFinite();
+}
+
+template <DiscreteModel Model>
+void WindowEstimator<Model>::require_least_squares_engine() const {
+  if (engine_->least_squares()) return;
+  std::ostringstream os;
+  os << "a window of N = " << state_->window.length() << " samples gives " << state_->window.rows()
+     << " > " << state_->window.states() << " equations; engine '" << spec_
+     << "' solves square systems only: use ceres or nlopt (or N = n/p)";
+  throw InvalidInput(os.str());
+}
+
+}  // namespace nlobs
