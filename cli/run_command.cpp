@@ -75,7 +75,12 @@ void add_coordinate_errors(const Measurements& data,
     std::vector<Eigen::Index> rows = signal_rows(info, SignalKind::kEmbeddedEstimate);
     const bool canonical = rows.empty();
     if (canonical) rows = signal_rows(info, SignalKind::kCanonicalEstimate);
-    if (rows.empty()) continue;
+    // Nothing to compare with (no coordinates_at), or done already (a second call).
+    if (rows.empty() || data.steps() == 0 ||
+        observers[i]->coordinates_at(data.x.col(0), data.t[0]).size() == 0 ||
+        signal_row(info, canonical ? SignalKind::kCanonicalError : SignalKind::kEmbeddedError)) {
+      continue;
+    }
     const Eigen::Index K = data.steps();
     const auto size = static_cast<Eigen::Index>(rows.size());
     Eigen::MatrixXd& signals = r.signals[i];

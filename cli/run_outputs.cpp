@@ -15,7 +15,7 @@ namespace nlobs::cli {
 namespace {
 
 // One column of a run's tables: a row of a column-major matrix (a state of the truth or of an
-// estimate, an extra signal), or the distance |a - b| of two such rows (an estimate's error).
+// estimate, a published signal), or the distance |a - b| of two such rows (an estimate's error).
 struct ColumnRef {
   const double* a = nullptr;
   Eigen::Index stride_a = 1;
@@ -31,7 +31,7 @@ ColumnRef row_of(const Eigen::MatrixXd& m, Eigen::Index i) {
 }
 
 // trajectories.csv's columns: t, the truth x1..xn (simulations), every observer's estimate,
-// every observer's extra signals; with `errors`, then |x_i - xhat_i| per observer and state.
+// every observer's published signals; with `errors`, then |x_i - xhat_i| per observer and state.
 ColumnTable run_table(const Measurements& data, const RunResult& r, bool errors,
                       std::vector<ColumnRef>& refs, std::string& header) {
   const Eigen::Index n = r.estimates.empty() ? data.x.rows() : r.estimates.front().rows();
@@ -191,9 +191,9 @@ std::string plot_script(OutputDirectory& dir, const Measurements& data, const Ru
   const Eigen::Index n = r.estimates.empty() ? 0 : r.estimates.front().rows();
   const long observers = static_cast<long>(r.metrics.size());
   const long offset = data.has_truth() ? n : 0;
-  long extra_columns = 0;
-  for (const auto& info : r.signal_info) extra_columns += static_cast<long>(info.size());
-  const long first_error = 2 + offset + observers * n + extra_columns;  // |x - xhat| columns
+  long signal_columns = 0;
+  for (const auto& info : r.signal_info) signal_columns += static_cast<long>(info.size());
+  const long first_error = 2 + offset + observers * n + signal_columns;  // |x - xhat| columns
   std::ostringstream g;
   g << "set datafile separator ','\nset key outside right\nset grid\n"
     << "set terminal pngcairo noenhanced size 1200," << 300 * std::max<Eigen::Index>(n, 1) << "\n";

@@ -11,6 +11,7 @@
 #include "nlobs/models/embedded_forms.hpp"
 #include "nlobs/models/modified_chua.hpp"
 #include "nlobs/models/systems.hpp"
+#include "nlobs/observers/baselines/finite_difference_observer.hpp"
 #include "nlobs/observers/core/simulation.hpp"
 #include "nlobs/observers/high_gain/high_gain_observer.hpp"
 #include "nlobs/observers/high_gain/taylor_observability_map.hpp"
@@ -262,6 +263,23 @@ TEST(Allocations, HighGainStepWithTaylorMapAndProjectionAllocatesNothing) {
 
 // A modulating-function step (FIR mode and sampled-data mode with the predictor): ring buffers
 // and weights are allocated at construction.
+// The backward differences place each sample on their grid (UniformGrid) and difference it:
+// nothing allocated on the way, the restart after a skipped grid point included.
+TEST(Allocations, BackwardDifferenceStepAllocatesNothing) {
+  FiniteDifferenceObserver fd({.states = 3, .sample_time = 0.01});
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(1), u(0);
+  fd.step(0, 0.0, y, u);
+  const long before = g_allocations.load();
+  bool ready = false;
+  for (long k = 1; k < 100; ++k) {
+    const long m = k < 50 ? k : k + 1;  // grid point 50 never comes
+    y[0] = std::sin(0.01 * static_cast<double>(m));
+    ready = fd.step(k, 0.01 * static_cast<double>(m), y, u).ready;
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_TRUE(ready);
+}
+
 TEST(Allocations, ModulatingFunctionStepAllocatesNothing) {
   for (double period : {0.0, 0.1}) {
     ModulatingOptions o;

@@ -533,6 +533,37 @@ class BrokenPromiseObserver final : public Observer {
   ObserverStep step_;
 };
 
+// One that publishes what only the harness may add (the error in its coordinates): a report
+// would read it in place of the harness's own row, so it is refused by name.
+class ImpostorObserver final : public Observer {
+ public:
+  ImpostorObserver() {
+    info_.name = "impostor";
+    info_.signals = {{"my_error", SignalKind::kEmbeddedError}};
+  }
+  void reset() override {}
+  const ObserverStep& step(long, double, const Eigen::VectorXd&, const Eigen::VectorXd&) override {
+    step_.estimate = Eigen::Vector2d::Zero();
+    step_.signals = Eigen::VectorXd::Zero(1);
+    return step_;
+  }
+
+ private:
+  ObserverStep step_;
+};
+
+TEST(Harness, AnObserverPublishingAHarnessKindIsRefused) {
+  SimulationOptions so;
+  so.steps = 3;
+  const Measurements data = simulate(Linear2{}, Eigen::Vector2d(1.0, -1.0), so);
+  std::vector<std::unique_ptr<Observer>> observers;
+  observers.push_back(std::make_unique<ImpostorObserver>());
+  EXPECT_NE(test::message_of([&] { run_observers(data, observers); })
+                .find("run_observers: impostor publishes the signal 'my_error' of a kind only "
+                      "the harness adds"),
+            std::string::npos);
+}
+
 TEST(Harness, AnObserverPublishingOtherSizesThanItNamesIsRefused) {
   SimulationOptions so;
   so.steps = 10;

@@ -382,6 +382,7 @@ TEST(ModulatingFunctionObserver, RepeatedOrDecreasingTimesAreRefused) {
   EXPECT_EQ(observer.step(4, 0.005, y, u).failure, "non_uniform");
   EXPECT_FALSE(observer.step(4, 0.005, y, u).ready);
   EXPECT_TRUE(observer.step(5, 0.02, y, u).failure.empty());  // back on the grid
+  EXPECT_EQ(observer.step(6, std::nan(""), y, u).failure, "non_finite");
 }
 
 // Absolute (epoch) times carry their decimal rounding: still on the grid.

@@ -495,6 +495,29 @@ TEST(MvtObserverBadInput, TimesMustLieOnTheSampleGrid) {
   EXPECT_NE(jittered.xhat(), kept);
 }
 
+// A dropped row of recorded data (the time jumps by 2T while k goes on by one) is a gap,
+// bridged like a missing y: the same estimates, bit for bit, as the run that saw it missing.
+TEST(MvtObserverBadInput, ADroppedRowIsAGap) {
+  const Measurements data = simulate_continuous(ChaoticNoLinear{}, kChaoticX0, 1.0);
+  const auto make = [] {
+    return MvtObserver<ChaoticNoLinear>(
+        ChaoticNoLinear{}, started(options(MvtVariant::kPublished), kChaoticXhat0, kCase2Error));
+  };
+  MvtObserver<ChaoticNoLinear> missing = make(), dropped = make();
+  long j = 0;
+  for (long k = 0; k < data.steps(); ++k) {
+    const bool gone = k == 700 || k == 701;
+    Eigen::VectorXd y = data.y.col(k);
+    if (gone) y.setConstant(std::nan(""));
+    const Eigen::VectorXd a = missing.step(k, data.t[k], y, data.u.col(k)).estimate;
+    if (gone) continue;  // the row never arrives
+    const ObserverStep& b = dropped.step(j++, data.t[k], data.y.col(k), data.u.col(k));
+    ASSERT_TRUE(b.failure.empty()) << k << ": " << b.failure_message;
+    ASSERT_EQ(b.estimate, a) << k;
+  }
+  EXPECT_EQ(j, data.steps() - 2);
+}
+
 TEST(MvtObserverBadInput, WrongSampleSizeIsAnError) {
   MvtObserver<ChaoticNoLinear> observer(
       ChaoticNoLinear{}, started(options(MvtVariant::kPublished), kChaoticXhat0, kCase2Error));

@@ -289,6 +289,9 @@ TEST(TypedSignals, AnOwnEmbeddedObserverGetsTheEmbeddedFigures) {
   for (Eigen::Index k = 0; k < data.steps(); ++k) {
     EXPECT_NEAR(r.signals[0](4, k), 1.0 + data.t[k], 1e-15) << k;
   }
+  add_coordinate_errors(data, observers, r);  // a second call adds nothing
+  EXPECT_EQ(r.signal_info[0].size(), 5u);
+  EXPECT_EQ(r.signals[0].rows(), 5);
   const auto m = embedded_metrics(r, 0);
   ASSERT_TRUE(m.has_value());
   double peak = 0.0;  // ‖ŵ‖ over the two estimate rows only (not the -1e6 diagnostic)

@@ -156,31 +156,43 @@ TEST(SampledData, SizesAndOrderAreErrors) {
   EXPECT_EQ(clock.receive("obs", 4, 2.0, one, one, step), Clock::kIntegrate);  // the clock goes on
 }
 
-// The grid t_0 + k·T: t_0 from the first sample, the grid time returned (not the rounded one
-// given), off-grid, non-finite and too-large times refused with what and where.
-TEST(UniformGrid, PlacesSamplesOnTheGridFromTheFirstOne) {
+// Samples placed by time on t_0 + m·T: t_0 the first sample's time (whatever its k), the grid
+// time returned (not the rounded one given), skipped points a gap; off-grid, repeated,
+// non-finite and too-large times refused with what and where.
+TEST(UniformGrid, PlacesSamplesByTheirTime) {
   UniformGrid grid(0.1);
   ObserverStep step;
-  const double t0 = 100.3 - 3 * 0.1;
-  EXPECT_EQ(grid.place("obs", 3, 100.3, step), t0 + 3 * 0.1);                 // t_0 = 100.3 − 3 T
-  const std::optional<double> t4 = grid.place("obs", 4, 100.4 + 1e-9, step);  // rounding: on it
-  ASSERT_TRUE(t4.has_value());
-  EXPECT_EQ(*t4, t0 + 4 * 0.1);
-  EXPECT_FALSE(grid.place("obs", 5, 100.52, step).has_value());
+  std::optional<GridPoint> p = grid.place("obs", 3, 100.3, step);
+  ASSERT_TRUE(p.has_value());
+  EXPECT_EQ(p->index, 0);
+  EXPECT_EQ(p->time, 100.3);
+  p = grid.place("obs", 4, 100.4 + 1e-9, step);  // recorded rounding: on the grid
+  ASSERT_TRUE(p.has_value());
+  EXPECT_EQ(p->index, 1);
+  EXPECT_EQ(p->time, 100.3 + 1 * 0.1);
+  p = grid.place("obs", 5, 100.7, step);  // three points later: a gap, not an error
+  ASSERT_TRUE(p.has_value());
+  EXPECT_EQ(p->index, 4);
+  EXPECT_FALSE(grid.place("obs", 6, 100.72, step).has_value());
   EXPECT_EQ(step.failure, "non_uniform");
-  EXPECT_NE(step.failure_message.find("obs: sample k = 5 at t = 100.52 (T = 0.1)"),
+  EXPECT_NE(step.failure_message.find("obs: sample k = 6 at t = 100.72 (T = 0.1)"),
             std::string::npos)
       << step.failure_message;
-  EXPECT_NE(step.failure_message.find("t_k = 100.5"), std::string::npos) << step.failure_message;
+  EXPECT_NE(step.failure_message.find("nearest grid time 100.7"), std::string::npos)
+      << step.failure_message;
+  EXPECT_FALSE(grid.place("obs", 7, 100.7, step).has_value());  // that time again
+  EXPECT_NE(step.failure_message.find("does not come after"), std::string::npos)
+      << step.failure_message;
   for (const double bad : {NAN, INFINITY, -INFINITY}) {
-    EXPECT_FALSE(grid.place("obs", 6, bad, step).has_value());
+    EXPECT_FALSE(grid.place("obs", 8, bad, step).has_value());
     EXPECT_EQ(step.failure, "non_finite");
   }
-  EXPECT_FALSE(grid.place("obs", 7, 1e300, step).has_value());  // its rounding spans the grid
+  EXPECT_FALSE(grid.place("obs", 9, 1e300, step).has_value());  // its rounding spans the grid
   EXPECT_EQ(step.failure, "non_uniform");
   EXPECT_NE(step.failure_message.find("too large"), std::string::npos) << step.failure_message;
-  grid.reset();  // a new origin
-  EXPECT_EQ(grid.place("obs", 0, -5.0, step), -5.0);
+  EXPECT_EQ(grid.place("obs", 10, 100.8, step)->index, 5);  // the refusals placed nothing
+  grid.reset();                                             // a new origin
+  EXPECT_EQ(grid.place("obs", 0, -5.0, step)->time, -5.0);
 }
 
 TEST(SampledData, AnOffGridTimeIsHeldAndTheNextOneGoesOn) {

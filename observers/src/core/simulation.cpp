@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace nlobs {
 namespace {
@@ -67,14 +70,27 @@ RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Ob
   result.settle_index = settle_index;
   const long total = steps * static_cast<long>(observers.size());
   long done = 0;
+  // Every observer's x̂ has the truth's size, or (without truth) the first observer's: the
+  // reports lay the estimates side by side.
+  Eigen::Index states = data.has_truth() ? data.x.rows() : 0;
   for (auto& observer : observers) {
     observer->reset();
     ObserverMetrics m;
     m.name = observer->name();
     m.engine = observer->info().engine;
     m.first_window_iterations = -1;
-    Eigen::MatrixXd estimate(data.x.rows() > 0 ? data.x.rows() : 0, steps);
-    Eigen::MatrixXd signals(static_cast<Eigen::Index>(observer->info().signals.size()), steps);
+    // Read once: the table below is sized from it, whatever the observer does later.
+    std::vector<SignalInfo> published = observer->info().signals;
+    for (const SignalInfo& signal : published) {
+      if (signal.kind == SignalKind::kEmbeddedError || signal.kind == SignalKind::kCanonicalError ||
+          signal.kind == SignalKind::kCanonicalNorm) {
+        throw InvalidInput("run_observers: " + m.name + " publishes the signal '" + signal.name +
+                           "' of a kind only the harness adds (the error and norm in the "
+                           "observer's coordinates, from the truth)");
+      }
+    }
+    Eigen::MatrixXd estimate(states, steps);
+    Eigen::MatrixXd signals(static_cast<Eigen::Index>(published.size()), steps);
     long iterations_sum = 0, evaluations_sum = 0;
     double elapsed_ns = 0.0;
     for (long k = 0; k < steps; ++k) {
@@ -83,7 +99,14 @@ RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Ob
       const ObserverStep& s = observer->step(k, data.t[k], y, u);
       elapsed_ns +=
           std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count();
-      if (estimate.rows() == 0) estimate.resize(s.estimate.size(), steps);
+      if (states == 0) {  // the first observer without truth sets the size
+        states = s.estimate.size();
+        if (states == 0) {
+          throw InvalidInput("run_observers: " + m.name +
+                             " published an empty estimate at k = " + std::to_string(k));
+        }
+        estimate.resize(states, steps);
+      }
       if (s.estimate.size() != estimate.rows() || s.signals.size() != signals.rows()) {
         // An observer of a user's own that breaks its promise: named, never written past.
         std::ostringstream os;
@@ -143,7 +166,7 @@ RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Ob
     result.metrics.push_back(std::move(m));
     result.estimates.push_back(std::move(estimate));
     result.signals.push_back(std::move(signals));
-    result.signal_info.push_back(observer->info().signals);
+    result.signal_info.push_back(std::move(published));
   }
   return result;
 }

@@ -4,6 +4,7 @@
 // Its noise gain grows as 1/δⁱ — what the modulating-function observer's integration avoids.
 #include <Eigen/Core>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "nlobs/observers/core/observer.hpp"
@@ -25,9 +26,9 @@ struct FiniteDifferenceOptions {
   }
 };
 
-// Samples must lie on the uniform grid t_0 + k·δ (failure "non_uniform" otherwise): the
-// differences divide by δ. A missing, off-grid or skipped sample (k not the last k + 1)
-// restarts them.
+// Samples are placed by their time on the uniform grid t_0 + m·δ (UniformGrid: off the grid is
+// the failure "non_uniform"): the differences divide by δ, so a sample off the grid, a missing
+// one and a skipped grid point (a dropped row) restart them.
 class FiniteDifferenceObserver final : public Observer {
  public:
   explicit FiniteDifferenceObserver(FiniteDifferenceOptions options)
@@ -45,7 +46,7 @@ class FiniteDifferenceObserver final : public Observer {
     grid_.reset();
     history_.setZero();
     filled_ = 0;
-    last_k_ = -1;
+    last_index_ = -1;
     step_.estimate = Eigen::VectorXd::Zero(options_.states);
     step_.ready = false;
     step_.failure.clear();
@@ -56,13 +57,14 @@ class FiniteDifferenceObserver final : public Observer {
     const Eigen::Index n = options_.states;
     step_.failure.clear();
     step_.failure_message.clear();
-    step_.measurement_missing = !(y.size() == 1 && std::isfinite(y[0]));
-    const bool consecutive = k == last_k_ + 1;
-    last_k_ = k;
-    if (!grid_.place(options_.name, k, t, step_) || step_.measurement_missing || !consecutive) {
+    step_.measurement_missing = false;
+    const std::optional<GridPoint> point = grid_.place(options_.name, k, t, step_);
+    if (point) step_.measurement_missing = !(y.size() == 1 && std::isfinite(y[0]));
+    if (!point || step_.measurement_missing || point->index != last_index_ + 1) {
       filled_ = 0;  // the differences restart after a gap
     }
-    if (!step_.failure.empty() || step_.measurement_missing) {
+    if (point) last_index_ = point->index;
+    if (!point || step_.measurement_missing) {
       step_.ready = false;
       return step_;
     }
@@ -89,7 +91,7 @@ class FiniteDifferenceObserver final : public Observer {
   UniformGrid grid_;
   Eigen::VectorXd history_, differences_, estimate_;
   Eigen::Index filled_ = 0;
-  long last_k_ = -1;
+  long last_index_ = -1;  // the grid index of the last sample placed
   ObserverStep step_;
 };
 

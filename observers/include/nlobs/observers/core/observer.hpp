@@ -5,8 +5,9 @@
 //
 // The interface is three calls, as control-toolbox's estimators and mherb/kalman's filters have
 // it: reset(), step(k, t, y, u) and, for observers that estimate in other coordinates,
-// coordinates_at(x, t). What does not change during a run — name, engine, window length,
-// warnings, the signals published beside x̂ — is one ObserverInfo, set by the constructor.
+// coordinates_at(x, t). What describes the observer — name, engine, window length, warnings,
+// the signals published beside x̂ — is one ObserverInfo, set by the constructor (a window
+// estimator adds to its warnings what a run finds; reset() clears those).
 #include <Eigen/Core>
 #include <cstddef>
 #include <optional>
@@ -32,7 +33,8 @@ enum class SignalKind {
   kCanonicalEstimate,   // η̂_j, the estimate in canonical coordinates η = T(t)x ([MF-LTV]), in
                         // order; coordinates_at(x, t) gives T(t)x
   kCanonicalBound,      // a guaranteed bound on the canonical error (Theorem 1 of [MF-LTV])
-  // Added by a harness that knows the true x (cli add_coordinate_errors), never published:
+  // Added by a harness that knows the true x (cli add_coordinate_errors); run_observers refuses
+  // an observer that publishes one:
   kEmbeddedError,   // ‖q(x) − ẑ‖₂
   kCanonicalError,  // ‖T(t)x − η̂‖₂
   kCanonicalNorm,   // ‖T(t)x‖₂, the scale of the relative canonical error
@@ -69,13 +71,16 @@ struct ObserverInfo {
   // L + 1; 0 otherwise): the harness's "after the window" starts at the longest one's N − 1.
   Eigen::Index window = 0;
   // What a user should know about the set-up (e.g. derivatives by finite differences because
-  // the model does not support AD); printed and kept in summary.json.
+  // the model does not support AD), and what a window estimator's run found (a Ψ that does not
+  // contract; cleared by reset()); printed and kept in summary.json.
   std::vector<std::string> warnings;
   std::vector<SignalInfo> signals;  // the entries of ObserverStep::signals, in order
 };
 
 struct ObserverStep {
-  Eigen::VectorXd estimate;          // x̂_k; finite (accept_finite() keeps it so)
+  // x̂_k; finite once the observer has started (a PI bank publishes NaN before its first good
+  // sample; accept_finite() keeps it finite after).
+  Eigen::VectorXd estimate;
   bool ready = true;                 // false while a window fills (the estimate coasts on f)
   bool measurement_missing = false;  // y_k had a non-finite entry: skipped, estimate coasts
   std::optional<Summary> summary;    // the engine's summary when this step solved a window
@@ -93,10 +98,12 @@ class Observer {
   const std::string& name() const { return info_.name; }
 
   virtual void reset() = 0;  // back to the initial estimate, empty window
-  // Sample k (consecutive from 0, in order) taken at time t. A non-finite entry of y is a
-  // missing measurement. Discrete-time observers (window estimators, Luenberger, sliding mode,
-  // EKF) run on k and record t; the sampled-data ones (MVT, high-gain, PI bank, modulating)
-  // need t on their uniform grid t_0 + k·T and refuse a sample off it (failure "non_uniform").
+  // Sample k (0, 1, 2, … in order) taken at time t. A non-finite entry of y is a missing
+  // measurement. Discrete-time observers (window estimators, Luenberger, sliding mode, EKF) run
+  // on k and ignore t; the sampled-data ones (MVT, high-gain, PI bank, backward differences,
+  // modulating functions) place the sample by t on their uniform grid t_0 + m·T (t_0 the first
+  // sample's time; skipped grid points are a gap) and refuse one off it (failure "non_uniform")
+  // or with a non-finite t ("non_finite").
   virtual const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
                                    const Eigen::VectorXd& u) = 0;
   // For observers that estimate in other coordinates (signals of kind kEmbeddedEstimate or
@@ -114,7 +121,7 @@ class Observer {
   Observer(Observer&&) = default;
   Observer& operator=(Observer&&) = default;
 
-  ObserverInfo info_;  // filled by the constructor; constant during a run
+  ObserverInfo info_;  // filled by the constructor (see ObserverInfo::warnings)
 };
 
 // Marks a step whose estimate (or what it is computed from) was not finite and was not taken.

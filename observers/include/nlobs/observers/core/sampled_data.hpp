@@ -1,7 +1,8 @@
 #pragma once
 // The sampled-data skeleton shared by the observers that integrate continuous dynamics between
-// samples (MVT, high-gain, PI bank), written once: sample k is taken at t_k = t_0 + k·T (the
-// time given with it must lie on that grid, UniformGrid below); its size is checked and the
+// samples (MVT, high-gain, PI bank), written once: each sample is placed by its time on the
+// grid t_0 + m·T (UniformGrid below: off the grid is refused, skipped points are a gap); its
+// size is checked and the
 // samples must come in order (both errors thrown, naming the observer); a u_k that is not
 // finite is a failure ("non_finite", the state kept: u is known by assumption); a y_k that is
 // not finite is a missing measurement (the state held, the next good sample bridges the gap at
@@ -43,43 +44,62 @@ inline double grid_tolerance(double t, double step) {
   return 1e-6 + 4.0 * std::numeric_limits<double>::epsilon() * std::abs(t) / step;
 }
 
-// The uniform grid t_k = t_0 + k·T of an observer that assumes uniform sampling: t_0 is taken
-// from the first sample placed (t_0 = t − k·T), and every later sample must lie on the grid.
-// Observers integrate (or divide) with the grid time, so that the rounding of recorded times
-// does not enter the estimate.
+// A sample's place on a uniform grid: its index m and time t_0 + m·T.
+struct GridPoint {
+  long index = 0;
+  double time = 0.0;
+};
+
+// The uniform grid t_0 + m·T of an observer that assumes uniform sampling, samples placed by
+// their time: t_0 is the first sample's time, a later sample must lie on a grid point after the
+// last one placed, and the grid points it skips are samples that did not come (a dropped row
+// of recorded data is a gap, as a missing y is). Observers integrate (or divide) with the grid
+// time, so that the rounding of recorded times does not enter the estimate.
 class UniformGrid {
  public:
   explicit UniformGrid(double sample_time) : sample_time_(sample_time) {}
-  void reset() { origin_.reset(); }
+  void reset() {
+    origin_.reset();
+    last_ = -1;
+  }
   double sample_time() const { return sample_time_; }
 
-  // The grid time of sample k taken at t; nullopt when t is not finite (failure "non_finite")
-  // or off the grid (failure "non_uniform"), with what and where in the step's message.
-  std::optional<double> place(const std::string& who, long k, double t, ObserverStep& step) {
-    const double kT = static_cast<double>(k) * sample_time_;
+  // Sample k taken at t; nullopt when t is not finite (failure "non_finite"), off the grid, not
+  // after the last sample placed, or too large for T to be resolved (failure "non_uniform"),
+  // with what and where in the step's message.
+  std::optional<GridPoint> place(const std::string& who, long k, double t, ObserverStep& step) {
     if (!std::isfinite(t)) {
       return refuse(step, "non_finite", who, k, t, "the sample time is not finite");
     }
     const double tolerance = grid_tolerance(t, sample_time_);
-    if (!(tolerance < 0.25)) {
+    if (!(tolerance < 0.25)) {  // |t| / T < 1.4e13: the indices below fit a long
       return refuse(step, "non_uniform", who, k, t,
                     "the time is too large for a grid step of T (its rounding exceeds a "
                     "quarter step)");
     }
-    if (!origin_) origin_ = t - kT;
-    const double grid = *origin_ + kT;
-    if (!(std::abs(t - grid) <= tolerance * sample_time_)) {
+    if (!origin_) origin_ = t;
+    const double position = (t - *origin_) / sample_time_;
+    const double m = std::round(position);
+    if (!(std::abs(position - m) <= tolerance)) {
       std::ostringstream os;
-      os << "the time is off the uniform grid t_0 + k·T (t_0 = " << *origin_
-         << ", so t_k = " << grid << "); this observer needs uniform samples";
+      os << "the time is off the uniform grid t_0 + m·T (t_0 = " << *origin_
+         << "; nearest grid time " << *origin_ + m * sample_time_
+         << "); this observer needs uniform samples";
       return refuse(step, "non_uniform", who, k, t, os.str());
     }
-    return grid;
+    if (!(m > static_cast<double>(last_))) {
+      std::ostringstream os;
+      os << "the time does not come after the last sample's (t = "
+         << *origin_ + static_cast<double>(last_) * sample_time_ << ")";
+      return refuse(step, "non_uniform", who, k, t, os.str());
+    }
+    last_ = static_cast<long>(m);
+    return GridPoint{last_, *origin_ + m * sample_time_};
   }
 
  private:
-  std::optional<double> refuse(ObserverStep& step, const char* failure, const std::string& who,
-                               long k, double t, const std::string& what) const {
+  std::nullopt_t refuse(ObserverStep& step, const char* failure, const std::string& who, long k,
+                        double t, const std::string& what) const {
     std::ostringstream os;
     os << who << ": sample k = " << k << " at t = " << t << " (T = " << sample_time_
        << "): " << what;
@@ -90,6 +110,7 @@ class UniformGrid {
 
   double sample_time_;
   std::optional<double> origin_;
+  long last_ = -1;  // the index of the last sample placed
 };
 
 template <int P, int M>
@@ -136,10 +157,11 @@ class SampledData {
     }
     step.failure.clear();
     step.failure_message.clear();
+    step.measurement_missing = false;
+    const std::optional<GridPoint> point = grid_.place(who, k, t, step);
+    if (!point) return kHold;
     step.measurement_missing = !y.allFinite();
-    const std::optional<double> on_grid = grid_.place(who, k, t, step);
-    if (!on_grid) return kHold;
-    t_ = *on_grid;
+    t_ = point->time;
     k_ = k;
     if (!u.allFinite()) {
       step.failure = "non_finite";

@@ -173,7 +173,7 @@ class ModulatingFunctionObserver final : public Observer {
     if (y.size() != 1) {
       return refuse(k, "input", "y must have one entry (SISO), got " + std::to_string(y.size()));
     }
-    if (!std::isfinite(t)) return refuse(k, "input", "the sample time is not finite");
+    if (!std::isfinite(t)) return refuse(k, "non_finite", "the sample time is not finite");
     if (!started_) {
       started_ = true;
       t0_ = t;  // the grid t0 + m δ starts at the first sample

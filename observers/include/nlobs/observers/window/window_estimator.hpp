@@ -136,9 +136,10 @@ class WindowEstimator final : public Observer {
   std::unique_ptr<Engine<N>> first_engine_;
   bool solved_once_ = false;
   WindowGain active_gain_ = WindowGain::kAuto;
-  bool gain_stale_ = true;    // newton: refresh Ψ before the next solve
-  bool gain_valid_ = false;   // newton: Ψ was formed at least once
-  bool gain_chosen_ = false;  // the first window decided Ψ (kAuto) and checked it
+  bool gain_stale_ = true;          // newton: refresh Ψ before the next solve
+  bool gain_valid_ = false;         // newton: Ψ was formed at least once
+  bool gain_chosen_ = false;        // the first window decided Ψ (kAuto) and checked it
+  std::size_t setup_warnings_ = 0;  // info_.warnings from the constructor
   bool warned_singular_ = false;
   // Relative offset of a guess at a singular point of the window map; an LU pivot below this
   // fraction of the largest |∂H/∂w| entry counts as zero (as in NewtonEngine).
@@ -200,6 +201,7 @@ WindowEstimator<Model>::WindowEstimator(Model model, WindowEstimatorOptions opti
     info_.name = "window:" + spec_;
     if (!square_) info_.name += ",N=" + std::to_string(state_->window.length());
   }
+  setup_warnings_ = info_.warnings.size();
   reset();
 }
 
@@ -216,7 +218,7 @@ void WindowEstimator<Model>::reset() {
   gain_valid_ = false;
   gain_chosen_ = false;
   warned_singular_ = false;
-  info_.warnings.clear();  // what the last run found
+  info_.warnings.resize(setup_warnings_);  // what the last run found goes, the set-up's stays
   if (square_) {
     const Eigen::Index n = state_->window.states();
     state_->gain = options_.gain == WindowGain::kScalar
