@@ -261,8 +261,6 @@ TEST(Allocations, HighGainStepWithTaylorMapAndProjectionAllocatesNothing) {
   EXPECT_GT((observer.zhat() - z5).norm(), 1e-3);
 }
 
-// A modulating-function step (FIR mode and sampled-data mode with the predictor): ring buffers
-// and weights are allocated at construction.
 // The backward differences place each sample on their grid (UniformGrid) and difference it:
 // nothing allocated on the way, the restart after a skipped grid point included.
 TEST(Allocations, BackwardDifferenceStepAllocatesNothing) {
@@ -280,6 +278,8 @@ TEST(Allocations, BackwardDifferenceStepAllocatesNothing) {
   EXPECT_TRUE(ready);
 }
 
+// A modulating-function step (FIR mode and sampled-data mode with the predictor): ring buffers
+// and weights are allocated at construction.
 TEST(Allocations, ModulatingFunctionStepAllocatesNothing) {
   for (double period : {0.0, 0.1}) {
     ModulatingOptions o;

@@ -385,6 +385,15 @@ TEST(ModulatingFunctionObserver, RepeatedOrDecreasingTimesAreRefused) {
   EXPECT_EQ(observer.step(6, std::nan(""), y, u).failure, "non_finite");
 }
 
+// A first time too large for δ is refused before it can anchor the grid: the next sample starts.
+TEST(ModulatingFunctionObserver, AHugeFirstTimeDoesNotAnchorTheGrid) {
+  ModulatingFunctionObserver<LtiInjectionForm> observer(LtiInjectionForm{}, options(0.01, 1.0));
+  const Eigen::VectorXd y = Eigen::VectorXd::Ones(1), u(0);
+  EXPECT_EQ(observer.step(0, 1e300, y, u).failure, "non_uniform");
+  EXPECT_TRUE(observer.step(1, 0.0, y, u).failure.empty());
+  EXPECT_TRUE(observer.step(2, 0.01, y, u).failure.empty());
+}
+
 // Absolute (epoch) times carry their decimal rounding: still on the grid.
 TEST(ModulatingFunctionObserver, AbsoluteTimesStayOnTheGrid) {
   ModulatingFunctionObserver<LtiInjectionForm> observer(LtiInjectionForm{}, options(0.01, 0.1));

@@ -195,6 +195,21 @@ TEST(UniformGrid, PlacesSamplesByTheirTime) {
   EXPECT_EQ(grid.place("obs", 0, -5.0, step)->time, -5.0);
 }
 
+// A held sample has come (its k again is out of order, before any start too); one refused for
+// its time has not, and may come again with the right time.
+TEST(SampledData, AHeldSampleHasComeARefusedTimeMayComeAgain) {
+  Clock clock(1, 1, 0.5);
+  ObserverStep step;
+  const Eigen::VectorXd one = Eigen::VectorXd::Constant(1, 1.0),
+                        missing = Eigen::VectorXd::Constant(1, NAN);
+  EXPECT_EQ(clock.receive("obs", 0, 0.0, missing, one, step), Clock::kHold);
+  EXPECT_THROW(clock.receive("obs", 0, 0.0, one, one, step), InvalidInput);
+  EXPECT_EQ(clock.receive("obs", 1, 0.6, one, one, step), Clock::kHold);
+  EXPECT_EQ(step.failure, "non_uniform");
+  EXPECT_EQ(clock.receive("obs", 1, 0.5, one, one, step), Clock::kStart);
+  EXPECT_EQ(clock.time(), 0.5);
+}
+
 TEST(SampledData, AnOffGridTimeIsHeldAndTheNextOneGoesOn) {
   Clock clock(1, 1, 0.5);
   ObserverStep step;

@@ -68,6 +68,17 @@ RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Ob
     settle_index = static_cast<long>(longest) - 1;
   }
   result.settle_index = settle_index;
+  // Before any observer runs: a report would read such a signal in place of the harness's row.
+  for (const auto& o : observers) {
+    for (const SignalInfo& signal : o->info().signals) {
+      if (signal.kind == SignalKind::kEmbeddedError || signal.kind == SignalKind::kCanonicalError ||
+          signal.kind == SignalKind::kCanonicalNorm) {
+        throw InvalidInput("run_observers: " + o->name() + " publishes the signal '" + signal.name +
+                           "' of a kind only the harness adds (the error and norm in the "
+                           "observer's coordinates, from the truth)");
+      }
+    }
+  }
   const long total = steps * static_cast<long>(observers.size());
   long done = 0;
   // Every observer's x̂ has the truth's size, or (without truth) the first observer's: the
@@ -81,14 +92,6 @@ RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Ob
     m.first_window_iterations = -1;
     // Read once: the table below is sized from it, whatever the observer does later.
     std::vector<SignalInfo> published = observer->info().signals;
-    for (const SignalInfo& signal : published) {
-      if (signal.kind == SignalKind::kEmbeddedError || signal.kind == SignalKind::kCanonicalError ||
-          signal.kind == SignalKind::kCanonicalNorm) {
-        throw InvalidInput("run_observers: " + m.name + " publishes the signal '" + signal.name +
-                           "' of a kind only the harness adds (the error and norm in the "
-                           "observer's coordinates, from the truth)");
-      }
-    }
     Eigen::MatrixXd estimate(states, steps);
     Eigen::MatrixXd signals(static_cast<Eigen::Index>(published.size()), steps);
     long iterations_sum = 0, evaluations_sum = 0;

@@ -9,7 +9,7 @@
 //           first step T / substeps, absolute and relative tolerances;
 //   kCvode  SUNDIALS CVODE, BDF with a dense solver (stiff_integrator.hpp), the caller's
 //           Jacobian or CVODE's difference quotients when none is given.
-// Compiled once in the observers library (src/interval_integrator.cpp), so no observer
+// Compiled once in the observers library (src/core/interval_integrator.cpp), so no observer
 // instantiates Odeint in the files that include it. Nothing allocates after construction
 // (RK4, Dormand–Prince; CVODE's own workspace is allocated when it is set up).
 #include <functional>

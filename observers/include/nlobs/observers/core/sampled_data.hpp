@@ -25,6 +25,7 @@
 //       clock_.accept();
 //   }
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -71,8 +72,11 @@ class UniformGrid {
     if (!std::isfinite(t)) {
       return refuse(step, "non_finite", who, k, t, "the sample time is not finite");
     }
-    const double tolerance = grid_tolerance(t, sample_time_);
-    if (!(tolerance < 0.25)) {  // |t| / T < 1.4e13: the indices below fit a long
+    // The position's rounding grows with the larger of t and t_0 (data from a large negative
+    // epoch crossing 0).
+    const double tolerance =
+        grid_tolerance(origin_ ? std::max(std::abs(t), std::abs(*origin_)) : t, sample_time_);
+    if (!(tolerance < 0.25)) {  // |t| / T < 2.8e14: the indices below fit a long
       return refuse(step, "non_uniform", who, k, t,
                     "the time is too large for a grid step of T (its rounding exceeds a "
                     "quarter step)");
@@ -130,6 +134,7 @@ class SampledData {
 
   void reset() {
     grid_.reset();
+    placed_ = false;
     samples_.clear();
     started_ = false;
     t_ = last_t_ = 0.0;
@@ -137,7 +142,8 @@ class SampledData {
   }
 
   // Sample k at time t: throws InvalidInput (`who`: the observer's name) for y or u of the wrong
-  // size and for a sample that does not come after the last one taken. Clears the step's failure
+  // size and for a k that does not come after the last one placed on the grid (taken, held or
+  // rejected: only a sample refused for its time may come again). Clears the step's failure
   // and sets measurement_missing; kHold for a t off the grid (UniformGrid::place's failures), a
   // missing y_k, and a u_k that is not finite (failure "non_finite", said in the step); otherwise
   // the sample is recorded and the answer is kStart (the observer has not started) or kIntegrate
@@ -151,7 +157,7 @@ class SampledData {
          << held_.size();
       throw InvalidInput(os.str());
     }
-    if (started_ && !(k > last_k_)) {
+    if (placed_ && !(k > last_k_)) {
       throw InvalidInput(who + ": sample k = " + std::to_string(k) +
                          " does not come after the last one: samples must arrive in order");
     }
@@ -160,9 +166,10 @@ class SampledData {
     step.measurement_missing = false;
     const std::optional<GridPoint> point = grid_.place(who, k, t, step);
     if (!point) return kHold;
+    placed_ = true;  // a held or rejected sample k has come too: k again is out of order
+    last_k_ = k;
     step.measurement_missing = !y.allFinite();
     t_ = point->time;
-    k_ = k;
     if (!u.allFinite()) {
       step.failure = "non_finite";
       std::ostringstream os;
@@ -188,7 +195,6 @@ class SampledData {
   void accept() {
     started_ = true;
     last_t_ = t_;
-    last_k_ = k_;
     held_ = current_u_;
   }
 
@@ -206,7 +212,8 @@ class SampledData {
   Input held_, current_u_ = Input::Zero(held_.size());
   bool started_ = false;
   double t_ = 0.0, last_t_ = 0.0;
-  long k_ = 0, last_k_ = 0;
+  bool placed_ = false;  // a sample was placed on the grid since the last reset()
+  long last_k_ = 0;      // the k of the last one
 };
 
 }  // namespace nlobs

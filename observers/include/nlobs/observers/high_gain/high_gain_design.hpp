@@ -1,6 +1,7 @@
 #pragma once
 // The high-gain observer's design arithmetic that does not depend on the model, compiled once
-// (src/high_gain_design.cpp): the gain polynomial from its roots and back, and σ_min(∂q_N/∂x).
+// (src/high_gain/high_gain_design.cpp): the gain polynomial from its roots and back, and
+// σ_min(∂q_N/∂x).
 #include <Eigen/Core>
 #include <vector>
 

@@ -18,6 +18,7 @@
 // hold the name, x̂(0) and the design; ModulatingOptions::validate() (called by the constructor)
 // checks what the options alone can tell, the constructor the sizes against the form.
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -45,7 +46,7 @@ struct ModulatingOptions {
   // Sampled-data mode: outputs every h = M δ (M ≥ 1 integer), the predictor between; 0: FIR
   // mode, every sample is a measurement.
   double sample_period = 0.0;
-  // FIR mode, times off the grid t_0 + k δ: interpolate linearly onto the grid (true) or refuse
+  // FIR mode, times off the grid t_0 + m δ: interpolate linearly onto the grid (true) or refuse
   // the sample (false: failure "non_uniform", state kept).
   bool resample = false;
   // With resample: spans between samples up to this are interpolated; longer ones are gaps
@@ -174,21 +175,24 @@ class ModulatingFunctionObserver final : public Observer {
       return refuse(k, "input", "y must have one entry (SISO), got " + std::to_string(y.size()));
     }
     if (!std::isfinite(t)) return refuse(k, "non_finite", "the sample time is not finite");
+    const double delta = options_.sample_time;
+    // Refused before it can anchor the grid: a first sample too large for δ would otherwise
+    // put every later one off the grid.
+    if (!(grid_tolerance(t, delta) < 0.25)) {  // t's rounding spans the grid step
+      return refuse(k, "non_uniform",
+                    "t = " + fmt(t) + " is too large for a grid step of " + fmt(delta) +
+                        " (its rounding exceeds a quarter step)");
+    }
     if (!started_) {
       started_ = true;
       t0_ = t;  // the grid t0 + m δ starts at the first sample
       t_raw_ = t;
       y_raw_ = y[0];
     }
-    const double delta = options_.sample_time;
     const double position = (t - t0_) / delta;
     const double grid = std::round(position);
-    const double tolerance = grid_tolerance(t, delta);  // sampled_data.hpp
-    if (!(tolerance < 0.25)) {  // t's rounding spans the grid step: no grid time to place it at
-      return refuse(k, "non_uniform",
-                    "t = " + fmt(t) + " is too large for a grid step of " + fmt(delta) +
-                        " (its rounding exceeds a quarter step)");
-    }
+    // sampled_data.hpp's: the rounding of the larger of t and t0
+    const double tolerance = grid_tolerance(std::max(std::abs(t), std::abs(t0_)), delta);
     const bool on_grid = std::abs(position - grid) <= tolerance;
     if (count_ > 0 && (!(t > t_raw_) || (on_grid && grid < static_cast<double>(count_)))) {
       return refuse(k, "non_uniform",

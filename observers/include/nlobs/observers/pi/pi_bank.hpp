@@ -136,18 +136,18 @@ struct PiBankOptions {
   void validate() const;
 };
 
-// Runs a bank on samples y_k, u_k at t_k = k·T, as every sampled-data observer does
-// (sampled_data.hpp): between samples y is interpolated linearly (the interval [t_{k−1}, t_k] is
-// integrated by RK4 when y_k arrives, so x̂_k uses data up to t_k) and u is held (the plant's
-// sampled input). A non-finite y_k is skipped with the state held, a non-finite u_k reported
-// with the state held; the next good sample integrates across the gap (y interpolated, u held,
-// the same step length). A step whose signals turn non-finite (a stage left its domain) keeps
-// the last good state and reports the signal and time, and the sample is dropped as if missing;
-// a first sample whose signals are not finite does not start the bank.
-// Built as PiBankObserver(bank, PiBankOptions) like every observer, the bank playing the
-// model's part: PiBankOptions::validate() (called by the constructor) checks the options alone,
-// the constructor that each estimate signal is one of the bank's and, by one evaluation on
-// zeros, that no stage reads a later one.
+// Runs a bank on samples y_k, u_k placed by their time on the grid t_0 + m·T, as every
+// sampled-data observer does (sampled_data.hpp): between samples y is interpolated linearly (the
+// interval [t_{k−1}, t_k] is integrated by RK4 when y_k arrives, so x̂_k uses data up to t_k) and u
+// is held (the plant's sampled input). A non-finite y_k is skipped with the state held, a
+// non-finite u_k reported with the state held; the next good sample integrates across the gap (y
+// interpolated, u held, the same step length). A step whose signals turn non-finite (a stage left
+// its domain) keeps the last good state and reports the signal and time, and the sample is dropped
+// as if missing; a first sample whose signals are not finite does not start the bank. Built as
+// PiBankObserver(bank, PiBankOptions) like every observer, the bank playing the model's part:
+// PiBankOptions::validate() (called by the constructor) checks the options alone, the constructor
+// that each estimate signal is one of the bank's and, by one evaluation on zeros, that no stage
+// reads a later one.
 class PiBankObserver final : public Observer {
  public:
   PiBankObserver(PiBank bank, PiBankOptions options);
