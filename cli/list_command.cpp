@@ -3,9 +3,9 @@
 #include <ostream>
 #include <stdexcept>
 
-#include "model_catalog.hpp"
+#include "nlobs/registry/model_registry.hpp"
+#include "nlobs/registry/observer_types.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
-#include "pi_banks.hpp"
 #include "reference/mgh_suite.hpp"
 #include "scenario.hpp"
 #include "solve_chua_window.hpp"
@@ -20,50 +20,34 @@ void print_list(const std::string& what, std::ostream& out) {
   }
   if (all || what == "models") {
     out << "models (JSON: {\"name\", \"parameters\", \"scheme\": euler|rk4, \"step\"}):\n";
-    for (const auto& m : model_catalog()) {
-      out << "  " << m.name << " — " << m.description << '\n';
-      if (!m.parameters.empty()) {
-        out << "      parameters:";
-        for (const auto& p : m.parameters) out << ' ' << p;
-        out << '\n';
+    for (const ModelEntry* m : model_registry().entries()) {
+      out << "  " << m->name << " — " << m->description << '\n';
+      out << "      " << m->states << " states, " << m->inputs << " inputs, " << m->outputs
+          << " outputs; T = " << m->default_step << ", "
+          << (m->default_scheme == Scheme::kEuler ? "euler" : "rk4") << "; observers:";
+      for (const auto& f : m->families) out << ' ' << f;
+      const std::string source = model_registry().source(m->name);
+      if (source != "built-in") out << "; from " << source;
+      out << '\n';
+      for (const KeyInfo& p : m->parameters) {
+        out << "      " << p.key << " = " << p.default_value << ": " << p.meaning << '\n';
       }
     }
   }
   if (all || what == "observers") {
-    out << "observers (scenario \"observers\" entries):\n"
-        << "  window — any engine x output window: engine, tol, window (N; 0 = square), "
-           "warm_start (propagated|previous), psi (auto|identity|newton|a number: the square "
-           "window's gain)\n"
-        << "  luenberger — constant gain: gain (n x p)\n"
-        << "  sliding_mode — Q, R (n x p), gamma (saturation boundary layer)\n"
-        << "  ekf — extended Kalman filter, AD Jacobians: process_covariance, "
-           "measurement_covariance, initial_covariance\n"
-        << "  (luenberger, sliding_mode, ekf also take 'model': their own design model)\n"
-        << "  pi_bank — model-free PI observers of [FFMG19]: bank, gains ([k_p, k_i] per "
-           "channel), omega_bounds ({channel: N}), start (paper|zero), substeps, parameters\n"
-        << "  mvt — mean-value-theorem observer of [BMH], models with y = [I_m 0] x: "
-           "error_guess (required), name, variant (injection|published), injection_gain, eta, "
-           "beta_solver (per-row|nlopt|ceres), integrator (rk4|dopri5), substeps, initial\n"
-        << "  high_gain — high-gain observer in embedded coordinates of [HG-EMB23], autonomous "
-           "one-output models: N, theta, poles | coefficients, map (ad|explicit), alpha "
-           "(auto|explicit|lie), inverse, saturation ({P | P_diagonal | box, R, rho}), "
-           "projection (engine spec), start (previous|predicted), integrator (auto|rk4|cvode), "
-           "substeps, jump_threshold, observability_floor, residual_scale, restart_residual, "
-           "restart_every, "
-           "initial_z | initial_z_from, initial, name\n"
-        << "  modulating — modulating-function algebraic observer of [MF-LTV], models with a "
-           "canonical form (lti-injection, pendulum): horizon, order, degree, noise_weights, "
-           "engine, quadrature (simpson|trapezoid), sample_period (0: every sample), resample, "
-           "disturbance_bound, initial, name\n"
-        << "  finite_difference — backward differences of y as (y, y', ...): name\n";
-    for (const auto& b : pi_bank_catalog()) {
-      out << "      bank " << b.name << ": " << b.description << "; channels";
-      for (const auto& c : b.channels) out << ' ' << c;
-      if (!b.parameters.empty()) {
-        out << "; parameters";
-        for (const auto& p : b.parameters) out << ' ' << p;
-      }
+    out << "observer types (scenario \"observers\" entries: {\"type\": NAME, key: value, ...}):\n";
+    const ObserverTypeRegistry& types = observer_type_registry();
+    for (const ObserverTypeEntry* t : types.entries()) {
+      out << "  " << t->name << " — " << t->description;
+      if (!t->condition.empty()) out << "; models: " << t->condition;
+      const std::string source = types.source(t->name);
+      if (source != "built-in") out << "; from " << source;
       out << '\n';
+      for (const KeyInfo& k : t->keys) {
+        out << "      " << k.key << ": " << k.meaning;
+        if (!k.default_value.empty()) out << " (default " << k.default_value << ")";
+        out << '\n';
+      }
     }
   }
   if (all || what == "scenarios") {

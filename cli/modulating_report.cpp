@@ -92,14 +92,17 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
                           std::ostream& err) {
   namespace fs = std::filesystem;
   const bool observer_key = key == "horizon" || key == "sample_period";
+  // The observers that take the key (the modulating ones); sample_period only where it is on.
+  const auto swept = [&](const ObserverSpec& o) {
+    return has_key(o, key) &&
+           (key != "sample_period" || observer_spec_json(o).value("sample_period", 0.0) > 0.0);
+  };
   if (observer_key && std::none_of(s.observers.begin(), s.observers.end(),
-                                   [](const ObserverSpec& o) { return o.type == "modulating"; })) {
+                                   [&](const ObserverSpec& o) { return has_key(o, key); })) {
     throw std::invalid_argument("--sweep " + key + " needs a modulating observer in the scenario");
   }
   if (observer_key && key == "sample_period" &&
-      std::none_of(s.observers.begin(), s.observers.end(), [](const ObserverSpec& o) {
-        return o.type == "modulating" && o.modulating.sample_period > 0.0;
-      })) {
+      std::none_of(s.observers.begin(), s.observers.end(), swept)) {
     throw std::invalid_argument(
         "--sweep sample_period needs a modulating observer in sampled-data mode (sample_period "
         "> 0) in the scenario");
@@ -135,17 +138,7 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
     Scenario run = s;
     Measurements local;
     const Measurements* d = &data;
-    if (observer_key) {
-      for (ObserverSpec& o : run.observers) {
-        if (o.type != "modulating") continue;
-        if (key == "horizon") o.modulating.horizon = value;
-        if (key == "sample_period" && o.modulating.sample_period > 0.0) {
-          o.modulating.sample_period = value;
-        }
-      }
-    } else {
-      run.model["parameters"][key] = value;
-    }
+    if (!observer_key) run.model["parameters"][key] = value;
     const std::string which = "--sweep " + key + " = " + fmt(value, "%g") + ": ";
     const auto named = [&](auto&& build) {
       try {
@@ -154,7 +147,7 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
         throw std::invalid_argument(which + e.what());
       }
     };
-    const AnyModel model = named([&] {
+    const ModelInstance instance = named([&] {
       try {
         return scenario_model(run);
       } catch (const std::invalid_argument& e) {
@@ -164,14 +157,23 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
                                     "parameter of the scenario's model)");
       }
     });
-    if (!observer_key) {
-      local = simulate_scenario(run, model);
+    if (observer_key) {
+      for (size_t i = 0; i < run.observers.size(); ++i) {
+        ObserverSpec& o = run.observers[i];
+        if (!swept(o)) continue;
+        o = named([&] {
+          return with_key(o, key, value, instance,
+                          s.name + ".observers[" + std::to_string(i) + "]");
+        });
+      }
+    } else {
+      local = simulate_scenario(run, instance.discrete);
       if (!local.stop_message.empty()) {
         throw std::runtime_error(which + "simulation " + local.stop_message);
       }
       d = &local;
     }
-    auto observers = named([&] { return make_observers(run, model, false); });
+    auto observers = named([&] { return make_observers(run, instance, false); });
     RunResult r = run_observers(*d, observers, settle_index);
     make_names_unique(r);
     add_coordinate_errors(*d, observers, r);

@@ -357,7 +357,7 @@ namespace {
 // --sweep theta=v1,v2,…: the high_gain observers once per θ on the same data ([HG-EMB23]'s
 // peaking/noise trade-off: peaking grows as θ shrinks, noise amplification too). Other keys
 // are the modulating-function sweeps (modulating_report.cpp).
-void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& data,
+void run_sweep(const Scenario& s, const ModelInstance& model, const Measurements& data,
                long settle_index, const RunOptions& options, std::ostream& out, std::ostream& err) {
   const std::string& spec = options.sweep;
   const auto eq = spec.find('=');
@@ -376,7 +376,7 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
   Scenario only = s;
   only.observers.clear();
   for (const ObserverSpec& o : s.observers) {
-    if (o.type == "high_gain") only.observers.push_back(o);
+    if (has_key(o, "theta")) only.observers.push_back(o);
   }
   if (only.observers.empty()) {
     throw std::invalid_argument("--sweep theta needs a high_gain observer in the scenario");
@@ -401,7 +401,10 @@ void run_sweep(const Scenario& s, const AnyModel& model, const Measurements& dat
   std::vector<Row> rows;
   for (double theta : values) {
     Scenario run = only;
-    for (ObserverSpec& o : run.observers) o.high_gain.theta = theta;
+    for (size_t i = 0; i < run.observers.size(); ++i) {
+      run.observers[i] = with_key(run.observers[i], "theta", theta, model,
+                                  s.name + ".observers[" + std::to_string(i) + "]");
+    }
     auto observers = make_observers(run, model, false);
     RunResult r = run_observers(data, observers, settle_index);
     make_names_unique(r);
@@ -491,7 +494,8 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
     os << "plot timeout " << options.plot_timeout << " s is out of range: must be in (0, 86400]";
     throw std::invalid_argument(os.str());
   }
-  const AnyModel model = scenario_model(s);
+  const ModelInstance instance = scenario_model(s);
+  const AnyModel& model = instance.discrete;
 
   Measurements data;
   std::string source = "simulation";
@@ -511,11 +515,11 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
       settle = static_cast<long>(
           std::min(std::ceil(s.settle_time / T - 1e-9), static_cast<double>(data.steps())));
     }
-    run_sweep(s, model, data, settle < 0 ? 0 : settle, options, out, err);
+    run_sweep(s, instance, data, settle < 0 ? 0 : settle, options, out, err);
     return;
   }
   Eigen::Index longest = 1;
-  auto observers = make_observers(s, model, !options.out_dir.empty());
+  auto observers = make_observers(s, instance, !options.out_dir.empty());
   for (const auto& o : observers) longest = std::max(longest, o->info().window);
   if (longest > data.steps()) {
     std::ostringstream os;
@@ -531,7 +535,7 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
         std::min(std::ceil(s.settle_time / T - 1e-9), static_cast<double>(data.steps())));
   }
   std::vector<std::string> warnings;
-  const nlohmann::json bounds = pi_bounds_json(s, &warnings);
+  const nlohmann::json bounds = observer_reports(s, &warnings);
   for (const auto& o : observers) {
     for (const auto& w : o->info().warnings) warnings.push_back(w);
   }

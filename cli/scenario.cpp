@@ -7,26 +7,10 @@
 #include <sstream>
 
 #include "input_file.hpp"
-#include "json_reader.hpp"
-#include "model_catalog.hpp"
-#include "nlobs/observers/baselines/baselines.hpp"
-#include "nlobs/observers/baselines/finite_difference_observer.hpp"
-#include "nlobs/observers/pi/pi_bound.hpp"
-#include "nlobs/observers/window/window_estimator.hpp"
-#include "nlobs/solvers/engine_registry.hpp"
+#include "nlobs/registry/json_reader.hpp"
 
 namespace nlobs::cli {
 namespace {
-
-nlohmann::json matrix_json(const Eigen::MatrixXd& m) {
-  nlohmann::json rows = nlohmann::json::array();
-  for (Eigen::Index i = 0; i < m.rows(); ++i) {
-    nlohmann::json row = nlohmann::json::array();
-    for (Eigen::Index j = 0; j < m.cols(); ++j) row.push_back(m(i, j));
-    rows.push_back(row);
-  }
-  return rows;
-}
 
 nlohmann::json vector_json(const Eigen::VectorXd& v) {
   return std::vector<double>(v.data(), v.data() + v.size());
@@ -331,7 +315,8 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
   if (!r.has("model")) r.fail("missing field 'model'");
   auto model_spec = r.object("model");
   s.model = model_spec->json();
-  const AnyModel model = make_model(*model_spec);  // validates now, naming the key
+  const ModelInstance instance = make_model_instance(*model_spec);  // validates now, naming keys
+  const AnyModel& model = instance.discrete;
   s.x0 = r.required_vector("x0");
   s.initial_guess = r.required_vector("initial_guess");
   if (auto v = r.integer("steps", 1, kMaxSteps)) s.steps = *v;
@@ -357,151 +342,7 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
     in->finish({"kind", "value", "amplitude", "frequency"});
   }
   for (JsonReader& o : r.objects("observers")) {
-    ObserverSpec spec;
-    // An observer's own model: built now (errors name its keys), sizes checked against ours.
-    const auto read_design_model = [&](JsonReader& reader) {
-      auto design = reader.object("model");
-      if (!design) return;
-      const AnyModel own = make_model(*design);
-      if (own.states() != model.states() || own.outputs() != model.outputs() ||
-          own.inputs() != model.inputs() || own.sample_time() != model.sample_time()) {
-        reader.fail("'model' must have the scenario model's sizes and sample time");
-      }
-      spec.model = design->json();
-    };
-    spec.type = o.required_text("type");
-    if (spec.type == "window") {
-      spec.engine = o.text("engine").value_or("newton");
-      spec.tol = o.number("tol");
-      spec.window = o.integer("window", 0, kMaxWindow).value_or(0);
-      spec.warm_start = o.text("warm_start").value_or("propagated");
-      if (spec.warm_start != "propagated" && spec.warm_start != "previous") {
-        o.fail("'warm_start' must be propagated or previous");
-      }
-      if (o.has("psi") && o.json()["psi"].is_number()) {
-        spec.psi = "scalar";
-        spec.psi_scale = *o.number("psi");
-        if (!std::isfinite(spec.psi_scale) || spec.psi_scale == 0.0) {
-          o.fail("'psi' as a number (Psi = psi I) must be finite and nonzero");
-        }
-      } else {
-        spec.psi = o.text("psi").value_or("auto");
-        if (spec.psi != "auto" && spec.psi != "identity" && spec.psi != "newton") {
-          o.fail("'psi' must be auto, identity, newton or a number (got '" + spec.psi + "')");
-        }
-      }
-      spec.initial = o.vector("initial");
-      o.finish({"type", "engine", "tol", "window", "warm_start", "psi", "initial"});
-    } else if (spec.type == "pi_bank") {
-      spec.pi.bank = o.required_text("bank");
-      PiBankInfo info;
-      try {
-        info = pi_bank_info(spec.pi.bank);
-      } catch (const std::invalid_argument& e) {
-        o.fail(e.what());
-      }
-      const Eigen::MatrixXd gains = o.matrix("gains").value_or(Eigen::MatrixXd());
-      if (gains.cols() != 2 || gains.rows() != static_cast<Eigen::Index>(info.channels.size())) {
-        o.fail("'gains' must list [k_p, k_i] for each of the bank's " +
-               std::to_string(info.channels.size()) + " channel(s)");
-      }
-      for (Eigen::Index i = 0; i < gains.rows(); ++i) {
-        const PiGains g{gains(i, 0), gains(i, 1)};
-        try {
-          validate(g, "channel '" + info.channels[static_cast<size_t>(i)] + "'");
-        } catch (const InvalidInput& e) {
-          o.fail(std::string("gains: ") + e.what());
-        }
-        spec.pi.gains.push_back(g);
-      }
-      spec.pi.omega_bounds.assign(info.channels.size(), std::nullopt);
-      if (auto bounds = o.object("omega_bounds")) {
-        for (size_t i = 0; i < info.channels.size(); ++i) {
-          spec.pi.omega_bounds[i] = bounds->number(info.channels[i]);
-          if (spec.pi.omega_bounds[i] && !(*spec.pi.omega_bounds[i] >= 0.0)) {
-            bounds->fail("'" + info.channels[i] + "' must be >= 0");
-          }
-        }
-        bounds->finish(info.channels);
-      }
-      spec.pi.start = o.text("start").value_or("paper");
-      if (spec.pi.start != "paper" && spec.pi.start != "zero") {
-        o.fail("'start' must be paper (gamma(0) = 0) or zero (estimates start at 0)");
-      }
-      spec.pi.substeps = static_cast<int>(o.integer("substeps", 1, 1000).value_or(1));
-      if (auto parameters = o.object("parameters")) spec.pi.parameters = parameters->json();
-      o.finish({"type", "bank", "gains", "omega_bounds", "start", "substeps", "parameters"});
-    } else if (spec.type == "mvt") {
-      spec.mvt = parse_mvt_spec(o);
-      if (spec.mvt.error_guess.size() != model.states()) {
-        o.fail("'error_guess' must have " + std::to_string(model.states()) +
-               " entries (the model's states)");
-      }
-      spec.initial = o.vector("initial");
-      o.finish({"type", "name", "error_guess", "eta", "variant", "injection_gain", "beta_solver",
-                "integrator", "substeps", "initial"});
-    } else if (spec.type == "high_gain") {
-      spec.high_gain = parse_high_gain_spec(o);
-      spec.initial = o.vector("initial");
-      o.finish({"type",
-                "name",
-                "N",
-                "theta",
-                "poles",
-                "coefficients",
-                "map",
-                "alpha",
-                "inverse",
-                "saturation",
-                "projection",
-                "start",
-                "integrator",
-                "substeps",
-                "jump_threshold",
-                "observability_floor",
-                "residual_scale",
-                "restart_residual",
-                "restart_every",
-                "initial_z",
-                "initial_z_from",
-                "initial"});
-    } else if (spec.type == "modulating") {
-      spec.modulating = parse_modulating_spec(o);
-      spec.initial = o.vector("initial");
-      o.finish({"type", "name", "horizon", "order", "degree", "noise_weights", "engine",
-                "quadrature", "sample_period", "resample", "resample_max_gap", "disturbance_bound",
-                "initial"});
-    } else if (spec.type == "finite_difference") {
-      spec.label = o.name().value_or("finite_difference");
-      o.finish({"type", "name"});
-    } else if (spec.type == "luenberger") {
-      spec.gain = o.matrix("gain").value_or(Eigen::MatrixXd());
-      if (spec.gain.size() == 0) o.fail("missing field 'gain'");
-      spec.initial = o.vector("initial");
-      read_design_model(o);
-      o.finish({"type", "gain", "initial", "model"});
-    } else if (spec.type == "sliding_mode") {
-      spec.q = o.matrix("Q").value_or(Eigen::MatrixXd());
-      spec.r = o.matrix("R").value_or(Eigen::MatrixXd());
-      if (spec.q.size() == 0 || spec.r.size() == 0) o.fail("missing field 'Q' or 'R'");
-      spec.gamma = o.required_number("gamma");
-      spec.initial = o.vector("initial");
-      read_design_model(o);
-      o.finish({"type", "Q", "R", "gamma", "initial", "model"});
-    } else if (spec.type == "ekf") {
-      spec.process_covariance = o.matrix("process_covariance").value_or(Eigen::MatrixXd());
-      spec.measurement_covariance = o.matrix("measurement_covariance").value_or(Eigen::MatrixXd());
-      spec.initial_covariance = o.matrix("initial_covariance").value_or(Eigen::MatrixXd());
-      spec.initial = o.vector("initial");
-      read_design_model(o);
-      o.finish({"type", "process_covariance", "measurement_covariance", "initial_covariance",
-                "initial", "model"});
-    } else {
-      o.fail("unknown observer type '" + spec.type +
-             "'; valid: window, luenberger, sliding_mode, ekf, pi_bank, mvt, high_gain, "
-             "modulating, finite_difference");
-    }
-    s.observers.push_back(std::move(spec));
+    s.observers.push_back(parse_observer_spec(o, instance));
   }
   if (s.observers.empty()) r.fail("'observers' must list at least one observer");
   if (auto rep = r.object("reported")) {
@@ -538,66 +379,16 @@ nlohmann::json to_json(const Scenario& s) {
                 {"amplitude", s.input.amplitude},
                 {"frequency", s.input.frequency}};
   nlohmann::json observers = nlohmann::json::array();
-  for (const ObserverSpec& o : s.observers) {
-    nlohmann::json jo{{"type", o.type}};
-    if (o.type == "window") {
-      jo["engine"] = o.engine;
-      if (o.tol) jo["tol"] = *o.tol;
-      jo["window"] = o.window;
-      jo["warm_start"] = o.warm_start;
-      if (o.psi == "scalar") {
-        jo["psi"] = o.psi_scale;
-      } else {
-        jo["psi"] = o.psi;
-      }
-    } else if (o.type == "luenberger") {
-      jo["gain"] = matrix_json(o.gain);
-    } else if (o.type == "sliding_mode") {
-      jo["Q"] = matrix_json(o.q);
-      jo["R"] = matrix_json(o.r);
-      jo["gamma"] = o.gamma;
-    } else if (o.type == "pi_bank") {
-      jo["bank"] = o.pi.bank;
-      nlohmann::json gains = nlohmann::json::array();
-      for (const PiGains& g : o.pi.gains) gains.push_back({g.kp, g.ki});
-      jo["gains"] = gains;
-      const auto& channels = pi_bank_info(o.pi.bank).channels;
-      nlohmann::json bounds = nlohmann::json::object();
-      for (size_t c = 0; c < channels.size(); ++c) {
-        if (o.pi.omega_bounds[c]) bounds[channels[c]] = *o.pi.omega_bounds[c];
-      }
-      jo["omega_bounds"] = bounds;
-      jo["start"] = o.pi.start;
-      jo["substeps"] = o.pi.substeps;
-      jo["parameters"] = o.pi.parameters;
-    } else if (o.type == "mvt") {
-      write_mvt_spec(o.mvt, jo);
-    } else if (o.type == "high_gain") {
-      write_high_gain_spec(o.high_gain, jo);
-    } else if (o.type == "modulating") {
-      write_modulating_spec(o.modulating, jo);
-    } else if (o.type == "finite_difference") {
-      jo["name"] = o.label;
-    } else if (o.type == "ekf") {
-      if (o.process_covariance.size()) jo["process_covariance"] = matrix_json(o.process_covariance);
-      if (o.measurement_covariance.size()) {
-        jo["measurement_covariance"] = matrix_json(o.measurement_covariance);
-      }
-      if (o.initial_covariance.size()) jo["initial_covariance"] = matrix_json(o.initial_covariance);
-    }
-    if (o.initial) jo["initial"] = vector_json(*o.initial);
-    if (o.model) jo["model"] = *o.model;
-    observers.push_back(jo);
-  }
+  for (const ObserverSpec& o : s.observers) observers.push_back(observer_spec_json(o));
   j["observers"] = observers;
   if (!s.reported.empty()) j["reported"] = s.reported;
   if (s.settle_time >= 0.0) j["settle_time"] = s.settle_time;
   return j;
 }
 
-AnyModel scenario_model(const Scenario& s) {
+ModelInstance scenario_model(const Scenario& s) {
   JsonReader m(s.model, s.name + ".model");
-  return make_model(m);
+  return make_model_instance(m);
 }
 
 Eigen::VectorXd scenario_input(const Scenario& s, const AnyModel& model, long k) {
@@ -610,111 +401,25 @@ Eigen::VectorXd scenario_input(const Scenario& s, const AnyModel& model, long k)
   return u;
 }
 
-std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& s, const AnyModel& model,
+std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& s,
+                                                      const ModelInstance& instance,
                                                       bool trace_first_window) {
   std::vector<std::unique_ptr<Observer>> out;
   for (size_t i = 0; i < s.observers.size(); ++i) {
     const ObserverSpec& o = s.observers[i];
-    const std::string where = s.name + ".observers[" + std::to_string(i) + "]";
-    const Eigen::VectorXd start = o.initial.value_or(s.initial_guess);
-    const AnyModel design = [&] {
-      if (!o.model) return model;
-      JsonReader reader(*o.model, where + ".model");
-      return make_model(reader);
-    }();
-    try {
-      if (o.type == "pi_bank") {
-        out.push_back(make_pi_bank(o.pi, model, where));
-      } else if (o.type == "mvt") {
-        out.push_back(make_mvt_observer(o.mvt, s.model, start, model.sample_time(), where));
-      } else if (o.type == "high_gain") {
-        out.push_back(
-            make_high_gain_observer(o.high_gain, s.model, start, model.sample_time(), where));
-      } else if (o.type == "modulating") {
-        out.push_back(
-            make_modulating_observer(o.modulating, s.model, start, model.sample_time(), where));
-      } else if (o.type == "finite_difference") {
-        if (model.outputs() != 1) {
-          throw std::invalid_argument(
-              "finite_difference needs a model with one output (its "
-              "state the output's phase variables y, y', ...)");
-        }
-        out.push_back(std::make_unique<FiniteDifferenceObserver>(FiniteDifferenceOptions{
-            .name = o.label, .states = model.states(), .sample_time = model.sample_time()}));
-      } else if (o.type == "window") {
-        SolverOptions options;
-        if (o.tol) {
-          options.stop.step_tolerance = *o.tol;
-          options.stop.residual_tolerance = *o.tol;
-        }
-        WindowEstimatorOptions window_options;
-        window_options.initial_estimate = start;
-        window_options.window = o.window;
-        window_options.warm_start =
-            o.warm_start == "previous" ? WarmStart::kPrevious : WarmStart::kPropagated;
-        window_options.gain = o.psi == "identity" ? WindowGain::kIdentity
-                              : o.psi == "newton" ? WindowGain::kNewton
-                              : o.psi == "scalar" ? WindowGain::kScalar
-                                                  : WindowGain::kAuto;
-        window_options.gain_scale = o.psi_scale;
-        auto estimator = make_window_estimator(model, o.engine, window_options, options);
-        if (trace_first_window) {
-          options.record_trace = true;
-          estimator->set_first_window_engine(
-              EngineRegistry<Dynamic>::global().create(o.engine, options));
-        }
-        out.push_back(std::move(estimator));
-      } else if (o.type == "luenberger") {
-        LuenbergerOptions options;
-        options.initial_estimate = start;
-        options.gain = o.gain;
-        out.push_back(std::make_unique<LuenbergerObserver<AnyModel>>(design, std::move(options)));
-      } else if (o.type == "sliding_mode") {
-        SlidingModeOptions options;
-        options.initial_estimate = start;
-        options.q = o.q;
-        options.r = o.r;
-        options.gamma = o.gamma;
-        out.push_back(std::make_unique<SlidingModeObserver<AnyModel>>(design, std::move(options)));
-      } else {
-        EkfOptions options;
-        options.initial_estimate = start;
-        options.process_covariance = o.process_covariance;
-        options.measurement_covariance = o.measurement_covariance;
-        options.initial_covariance = o.initial_covariance;
-        out.push_back(std::make_unique<ExtendedKalmanFilter<AnyModel>>(design, std::move(options)));
-      }
-    } catch (const InvalidInput& e) {
-      throw std::invalid_argument(where + ": " + e.what());
-    }
+    out.push_back(build_observer(o, instance, o.initial.value_or(s.initial_guess),
+                                 s.name + ".observers[" + std::to_string(i) + "]",
+                                 trace_first_window));
   }
   return out;
 }
 
-nlohmann::json pi_bounds_json(const Scenario& s, std::vector<std::string>* warnings) {
+nlohmann::json observer_reports(const Scenario& s, std::vector<std::string>* warnings) {
   nlohmann::json out = nlohmann::json::array();
   for (const ObserverSpec& o : s.observers) {
-    if (o.type != "pi_bank") continue;
-    const auto& channels = pi_bank_info(o.pi.bank).channels;
-    for (size_t c = 0; c < channels.size(); ++c) {
-      const std::optional<double> n = o.pi.omega_bounds[c];
-      const PiBound b = pi_ultimate_bound(o.pi.gains[c], n.value_or(0.0));
-      const std::string who = "pi:" + o.pi.bank + " channel '" + channels[c] + "'";
-      nlohmann::json j{{"observer", "pi:" + o.pi.bank},
-                       {"channel", channels[c]},
-                       {"kp", o.pi.gains[c].kp},
-                       {"ki", o.pi.gains[c].ki},
-                       {"warnings", b.warnings}};
-      if (n) {
-        j["omega_bound"] = *n;
-        j["paper_delta"] =
-            std::isfinite(b.paper_delta) ? nlohmann::json(b.paper_delta) : nlohmann::json(nullptr);
-        j["eta_error_bound"] = b.eta_error;
-        j["error_norm_bound"] = b.error_norm;
-      }
-      for (const auto& w : b.warnings) warnings->push_back(who + ": " + w);
-      out.push_back(j);
-    }
+    const ObserverTypeEntry& entry = observer_type_registry().get(o.type);
+    if (!entry.report) continue;
+    for (auto& item : entry.report(o.spec, warnings)) out.push_back(std::move(item));
   }
   return out;
 }

@@ -11,48 +11,16 @@
 #include <string>
 #include <vector>
 
-#include "high_gain_observers.hpp"
-#include "modulating_observers.hpp"
-#include "mvt_observers.hpp"
 #include "nlobs/observers/core/any_model.hpp"
 #include "nlobs/observers/core/observer.hpp"
-#include "pi_banks.hpp"
+#include "nlobs/registry/model_registry.hpp"
+#include "nlobs/registry/observer_types.hpp"
 
 namespace nlobs::cli {
 
-// Limits checked before anything is allocated: samples of a run (n × steps doubles per
-// observer are kept), samples of a window.
+// Samples of a run, checked before anything is allocated (n × steps doubles per observer are
+// kept).
 inline constexpr long kMaxSteps = 10'000'000;
-inline constexpr long kMaxWindow = 100'000;
-
-struct ObserverSpec {
-  // "window", "luenberger", "sliding_mode", "ekf", "pi_bank", "mvt", "high_gain", "modulating",
-  // "finite_difference"
-  std::string type;
-  // window
-  std::string engine = "newton";
-  std::optional<double> tol{};  // step and residual tolerance of the engine
-  long window = 0;              // 0 = square
-  std::string warm_start = "propagated";
-  // Ψ of a square window: "auto", "identity", "newton", or "scalar" with psi_scale (the JSON
-  // key "psi" holds the word or the number)
-  std::string psi = "auto";
-  double psi_scale = 1.0;
-  // luenberger: gain (n×p); sliding_mode: Q, R (n×p), gamma
-  Eigen::MatrixXd gain, q, r;
-  double gamma = 1.0;
-  // ekf
-  Eigen::MatrixXd process_covariance, measurement_covariance, initial_covariance;
-  std::optional<Eigen::VectorXd> initial{};  // start estimate; default: the scenario's guess
-  // luenberger, sliding_mode, ekf: the observer's own design model (same sizes and sample
-  // time as the scenario's), e.g. one that assumes an unknown input constant
-  std::optional<nlohmann::json> model{};
-  PiBankSpec pi{};              // pi_bank
-  MvtSpec mvt{};                // mvt
-  HighGainSpec high_gain{};     // high_gain
-  ModulatingSpec modulating{};  // modulating
-  std::string label;            // finite_difference: its name
-};
 
 struct InputSpec {
   std::string kind = "zero";                // zero | constant | sin
@@ -87,14 +55,14 @@ nlohmann::json to_json(const Scenario& scenario);
 
 // Builds the model and the observers a scenario describes. `trace_first_window`: window
 // estimators record the engine's trace of their first window (for the convergence plot).
-AnyModel scenario_model(const Scenario& scenario);
+ModelInstance scenario_model(const Scenario& scenario);
 std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& scenario,
-                                                      const AnyModel& model,
+                                                      const ModelInstance& model,
                                                       bool trace_first_window);
 Eigen::VectorXd scenario_input(const Scenario& scenario, const AnyModel& model, long k);
 
-// Per PI channel of the scenario's pi_bank observers: the gains, N, the paper's δ (eq. 15) and
-// our ultimate bounds (pi_bound.hpp); warnings (complex eigenvalues of K) are appended.
-nlohmann::json pi_bounds_json(const Scenario& scenario, std::vector<std::string>* warnings);
+// What the scenario's observer types report before a run (their entries' `report`: per PI
+// channel the gains, N, the paper's δ and our ultimate bounds); warnings are appended.
+nlohmann::json observer_reports(const Scenario& scenario, std::vector<std::string>* warnings);
 
 }  // namespace nlobs::cli

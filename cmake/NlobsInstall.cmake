@@ -1,13 +1,13 @@
 # `cmake --install` produces a CMake package: find_package(nlobs) gives nlobs::solvers,
-# nlobs::models and nlobs::observers (and nlobs::common, which they share).
+# nlobs::models, nlobs::observers and nlobs::registry (and nlobs::common, which they share).
 include(CMakePackageConfigHelpers)
 
-install(TARGETS nlobs_common nlobs_solvers nlobs_models nlobs_observers
+install(TARGETS nlobs_common nlobs_solvers nlobs_models nlobs_observers nlobs_registry
         EXPORT nlobsTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-foreach(layer common solvers models observers)
+foreach(layer common solvers models observers registry)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${layer}/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 endforeach()
 

@@ -13,7 +13,7 @@
 
 #include "data_file.hpp"
 #include "input_file.hpp"
-#include "json_reader.hpp"
+#include "nlobs/registry/json_reader.hpp"
 #include "scenario.hpp"
 
 namespace nlobs::cli {

@@ -9,14 +9,14 @@
 #include <stdexcept>
 #include <string>
 
-#include "json_reader.hpp"
+#include "nlobs/registry/json_reader.hpp"
 #include "scenario.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t size) {
   std::istringstream in(std::string(reinterpret_cast<const char*>(bytes), size));
   nlobs::cli::Scenario scenario;
   try {
-    scenario = nlobs::cli::parse_scenario(nlobs::cli::parse_json(in, "fuzz.json"), "fuzz.json");
+    scenario = nlobs::cli::parse_scenario(nlobs::parse_json(in, "fuzz.json"), "fuzz.json");
   } catch (const std::invalid_argument&) {
     return 0;  // refused with a message: fine
   }

@@ -6,6 +6,9 @@
 // oscillator's explicit inverse. Each map has the ExplicitObservabilityMap form; α and the
 // inverse are generic in the scalar too (∂α by AD for implicit integration).
 #include <Eigen/Core>
+#include <optional>
+
+#include "nlobs/models/systems.hpp"
 
 namespace nlobs {
 
@@ -92,5 +95,26 @@ struct VanDerPolEmbedding {
     return z;
   }
 };
+
+// The customisation point the model registry looks for (nlobs/registry/register_model.hpp):
+// hand_embedding(const Model&), found by argument-dependent lookup, gives the model's hand q_N
+// where it holds (empty elsewhere: Lorenz and Van der Pol at their documented parameters only),
+// for the high-gain observer's "map": "explicit", "alpha": "explicit", "inverse" and
+// "saturation.box".
+inline std::optional<DuffingEmbedding> hand_embedding(const Duffing&) {
+  return DuffingEmbedding{};
+}
+inline std::optional<OscillatorEmbedding> hand_embedding(const OscillatorNonlinearOutput&) {
+  return OscillatorEmbedding{};
+}
+inline std::optional<LorenzEmbedding> hand_embedding(const Lorenz& m) {
+  const LorenzParameters d;
+  if (m.p.sigma != d.sigma || m.p.rho != d.rho || m.p.beta != d.beta) return std::nullopt;
+  return LorenzEmbedding{};
+}
+inline std::optional<VanDerPolEmbedding> hand_embedding(const VanDerPol& m) {
+  if (m.mu != 1.0) return std::nullopt;
+  return VanDerPolEmbedding{};
+}
 
 }  // namespace nlobs

@@ -11,6 +11,8 @@
 //   Vector<p> inputs(double t, double y, const Eigen::VectorXd& u) const;  // v
 //   Vector<n> canonical(double t, const Vector<state_size>& x) const;      // η(t, x)
 //   Vector<state_size> state(double t, const Vector<n>& eta) const;        // x(t, η)
+// and, when an unknown disturbance d enters the canonical equations, its gains and bound:
+//   Vector<n> disturbance_gains() const;  double disturbance_level() const;   // |d| ≤ level
 #include <Eigen/Core>
 #include <cmath>
 
@@ -62,8 +64,19 @@ struct PendulumForm {
   Eigen::Matrix<double, 2, 1> state(double t, const Eigen::Matrix<double, 2, 1>& eta) const {
     return Eigen::Matrix<double, 2, 1>(eta[1], eta[0] - friction(t) * eta[1]);
   }
-  // |d| ≤ a_max / l.
+  // |d| ≤ a_max / l, entering η_0' with gain 1 (disturbance_gains).
   double disturbance_level() const { return std::abs(params.a_max) / params.length; }
+  Eigen::Matrix<double, 2, 1> disturbance_gains() const { return {1.0, 0.0}; }
 };
+
+// The customisation point the model registry looks for (nlobs/registry/register_model.hpp):
+// a model that has a function modulating_form(const Model&), found by argument-dependent
+// lookup, can run the modulating-function observer from scenario files.
+inline LtiInjectionForm modulating_form(const LtiOutputInjection& model) {
+  return {model.p};
+}
+inline PendulumForm modulating_form(const PendulumTimeVaryingFriction& model) {
+  return {model.p};
+}
 
 }  // namespace nlobs

@@ -1,4 +1,4 @@
-#include "json_reader.hpp"
+#include "nlobs/registry/json_reader.hpp"
 
 #include <cmath>
 #include <cstdint>
@@ -6,7 +6,7 @@
 
 #include "nlobs/solvers/status.hpp"
 
-namespace nlobs::cli {
+namespace nlobs {
 
 std::string json_excerpt(const nlohmann::json& value) {
   std::string text = value.dump();  // bounded: parse_json refuses deeper nesting
@@ -189,4 +189,4 @@ void JsonReader::finish(const std::vector<std::string>& valid) const {
   }
 }
 
-}  // namespace nlobs::cli
+}  // namespace nlobs

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-namespace nlobs::cli {
+namespace nlobs {
 
 // Scenario files are nested a few levels; a hostile one 70 000 levels deep must be refused at
 // parse time, not crash the printer of an error message.
@@ -59,4 +59,4 @@ class JsonReader {
   std::set<std::string> read_;
 };
 
-}  // namespace nlobs::cli
+}  // namespace nlobs

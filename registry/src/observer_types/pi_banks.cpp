@@ -2,9 +2,9 @@
 
 #include <stdexcept>
 
-#include "json_reader.hpp"
+#include "nlobs/registry/json_reader.hpp"
 
-namespace nlobs::cli {
+namespace nlobs::detail {
 namespace {
 
 using Values = PiBank::Values;
@@ -133,4 +133,4 @@ std::unique_ptr<PiBankObserver> make_pi_bank(const PiBankSpec& spec, const AnyMo
                                                         .substeps = spec.substeps});
 }
 
-}  // namespace nlobs::cli
+}  // namespace nlobs::detail

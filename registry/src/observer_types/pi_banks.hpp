@@ -11,7 +11,7 @@
 #include "nlobs/observers/core/any_model.hpp"
 #include "nlobs/observers/pi/pi_bank.hpp"
 
-namespace nlobs::cli {
+namespace nlobs::detail {
 
 struct PiBankSpec {
   std::string bank;
@@ -35,4 +35,4 @@ const PiBankInfo& pi_bank_info(const std::string& name);  // throws std::invalid
 std::unique_ptr<PiBankObserver> make_pi_bank(const PiBankSpec& spec, const AnyModel& model,
                                              const std::string& where);
 
-}  // namespace nlobs::cli
+}  // namespace nlobs::detail

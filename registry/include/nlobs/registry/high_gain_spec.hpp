@@ -1,18 +1,14 @@
 #pragma once
-// High-gain observers in embedded coordinates ([HG-EMB23]) in scenarios:
-//   {"type": "high_gain", "N": 6, "theta": 0.1, "map": "ad", "alpha": "explicit", ...}
-// built from the scenario's continuous model by name (model_visit.hpp). Keys: docs/cli.md.
+// What a scenario's high_gain observer asks for ([HG-EMB23]; keys: docs/cli.md): the
+// observer's options and the choices of its design (which observability map, which α), read
+// from the observer's JSON object and handed to the model's high-gain hook (register_model.hpp),
+// which knows the model's own type.
 #include <Eigen/Core>
-#include <memory>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "json_reader.hpp"
-#include "nlobs/observers/core/observer.hpp"
-
-namespace nlobs::cli {
+namespace nlobs {
 
 struct HighGainSpec {
   std::string name;  // default "high_gain"
@@ -40,14 +36,4 @@ struct HighGainSpec {
   std::optional<Eigen::VectorXd> initial_z_from{};  // ẑ(0) = q_N(this x)
 };
 
-// The observer object's keys other than "type" and "initial", strictly.
-HighGainSpec parse_high_gain_spec(JsonReader& o);
-void write_high_gain_spec(const HighGainSpec& spec, nlohmann::json& out);
-
-// Throws InvalidInput (options) or std::invalid_argument (a model the observer cannot take).
-std::unique_ptr<Observer> make_high_gain_observer(const HighGainSpec& spec,
-                                                  const nlohmann::json& model,
-                                                  const Eigen::VectorXd& start, double sample_time,
-                                                  const std::string& where);
-
-}  // namespace nlobs::cli
+}  // namespace nlobs

@@ -1,0 +1,168 @@
+#pragma once
+// A continuous model as a registry entry. One definition gives the scenario files, `nlobs list`
+// and every observer type the model's conditions allow:
+//
+//   struct Rossler : nlobs::ModelSizes<3, 0, 1> { double a = 0.2, b = 0.2, c = 5.7; ... };
+//   nlobs::model_registry().add(nlobs::model_entry(nlobs::ModelDefinition<Rossler>{
+//       .name = "rossler",
+//       .description = "Rössler attractor, y = x2",
+//       .parameters = {{"a", "x2' = x1 + a x2", [](Rossler& m) -> double& { return m.a; }},
+//                      {"c", "x3' = b + x3 (x1 - c)", [](Rossler& m) -> double& { return m.c; }}},
+//   }));
+//
+// What the entry offers, by the model's type (one registration serves every size):
+//   window estimators (any engine), EKF, Luenberger, sliding mode: every model (AnyModel, AD
+//     Jacobians through ceres::Jet);
+//   mvt: outputs <= states; the constructor checks y = [I_m 0] x;
+//   high_gain: one output, no input;
+//   modulating: a function modulating_form(const Model&) found by argument-dependent lookup
+//     (nlobs/models/modulating_forms.hpp shows the form);
+//   high_gain's "map": "explicit" and friends: hand_embedding(const Model&) likewise
+//     (nlobs/models/embedded_forms.hpp).
+//
+// This header compiles the MVT and high-gain observers for the model (about 20 s for a
+// three-state model at -O3); include it only where a model is registered.
+#include <functional>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "nlobs/models/discretization.hpp"
+#include "nlobs/observers/mvt/mvt_observer.hpp"
+#include "nlobs/registry/hooks/high_gain_hook.hpp"
+#include "nlobs/registry/hooks/modulating_hook.hpp"
+#include "nlobs/registry/model_registry.hpp"
+
+namespace nlobs {
+
+// One number of a model's "parameters" object: `value` gives the field it sets.
+template <typename Parameters>
+struct ModelParameter {
+  std::string key{};
+  std::string meaning{};
+  std::function<double&(Parameters&)> value{};
+};
+
+// `Parameters` is what the JSON keys set (the model itself by default, or its parameter struct
+// when the model is built from one); `build` turns it into the model and may throw
+// std::invalid_argument (InvalidInput) to refuse values, e.g. a length <= 0.
+template <typename Model, typename Parameters = Model>
+struct ModelDefinition {
+  std::string name{};
+  std::string description{};
+  std::vector<ModelParameter<Parameters>> parameters{};
+  double default_step = 0.01;
+  Scheme default_scheme = Scheme::kRk4;
+  Parameters defaults{};
+  std::function<Model(const Parameters&)> build{};  // empty: the parameters are the model
+};
+
+namespace detail {
+
+inline std::string number_text(double v) {
+  std::ostringstream os;
+  os.precision(6);
+  os << v;
+  return os.str();
+}
+
+template <typename Model>
+ModelInstance model_instance(const std::string& name, Model model, double step, Scheme scheme) {
+  ModelInstance out{
+      name, AnyModel(name, Discretized<Model>(model, step, scheme), step), {}, {}, {}};
+  constexpr bool kFixed = Model::kStates != Eigen::Dynamic && Model::kOutputs != Eigen::Dynamic &&
+                          Model::kInputs != Eigen::Dynamic;
+  if constexpr (kFixed && Model::kOutputs <= Model::kStates) {
+    out.mvt.make = [model](const MvtOptions& options) -> std::unique_ptr<Observer> {
+      return std::make_unique<MvtObserver<Model>>(model, options);
+    };
+  } else {
+    out.mvt.unmet = "the MVT observer needs fixed sizes and y = [I_m 0] x (m <= n outputs)";
+  }
+  if constexpr (kFixed && Model::kOutputs == 1 && Model::kInputs == 0) {
+    out.high_gain.make = [model, name](const HighGainSpec& spec, const Eigen::VectorXd& start,
+                                       double sample_time) {
+      return build_high_gain(model, spec, start, sample_time, name);
+    };
+  } else {
+    out.high_gain.unmet =
+        "the observer needs an autonomous model with one output (x' = f(x), y = h(x)); this one "
+        "has " +
+        std::to_string(out.discrete.outputs()) + " output(s) and " +
+        std::to_string(out.discrete.inputs()) + " input(s)";
+  }
+  if constexpr (HasModulatingForm<Model>) {
+    out.modulating.make = [model](const ModulatingSpec& spec, const Eigen::VectorXd& start,
+                                  double sample_time) {
+      return build_modulating(modulating_form(model), spec, start, sample_time);
+    };
+  } else {
+    out.modulating.unmet =
+        "no canonical form for it (the model supplies one with a function "
+        "modulating_form(const Model&), docs/extending.md)";
+  }
+  return out;
+}
+
+}  // namespace detail
+
+template <typename Model, typename Parameters>
+ModelEntry model_entry(ModelDefinition<Model, Parameters> definition) {
+  static_assert(ContinuousModel<Model>, "model_entry needs a continuous model (vector_field, h)");
+  if constexpr (!std::is_same_v<Model, Parameters>) {
+    if (!definition.build) {
+      throw InvalidInput("model '" + definition.name +
+                         "': ModelDefinition::build is required when the parameters are not the "
+                         "model");
+    }
+  }
+  ModelEntry entry;
+  entry.name = definition.name;
+  entry.description = definition.description;
+  entry.default_step = definition.default_step;
+  entry.default_scheme = definition.default_scheme;
+  for (auto& p : definition.parameters) {
+    if (!p.value)
+      throw InvalidInput("model '" + entry.name + "': parameter '" + p.key +
+                         "' has no field (ModelParameter::value)");
+    entry.parameters.push_back(
+        {p.key, p.meaning, detail::number_text(p.value(definition.defaults))});
+  }
+  const auto build = [definition](const Parameters& p) -> Model {
+    if (definition.build) return definition.build(p);
+    if constexpr (std::is_same_v<Model, Parameters>) return p;
+    throw InvalidInput("unreachable");  // refused above
+  };
+  const Model probe = build(definition.defaults);
+  entry.states = probe.states();
+  entry.inputs = probe.inputs();
+  entry.outputs = probe.outputs();
+  entry.families = {"window", "ekf", "luenberger", "sliding_mode"};
+  if (probe.outputs() <= probe.states()) entry.families.push_back("mvt");
+  if (probe.outputs() == 1 && probe.inputs() == 0) entry.families.push_back("high_gain");
+  if constexpr (detail::HasModulatingForm<Model>) entry.families.push_back("modulating");
+  if (probe.outputs() == 1) entry.families.push_back("finite_difference");
+  entry.make = [definition, build](JsonReader& reader, double step, Scheme scheme) {
+    Parameters p = definition.defaults;
+    std::vector<std::string> keys;
+    for (const auto& parameter : definition.parameters) {
+      keys.push_back(parameter.key);
+      if (auto v = reader.number(parameter.key)) parameter.value(p) = *v;
+    }
+    reader.finish(keys);
+    std::optional<Model> model;
+    try {  // the model's refusal names the parameters object
+      model.emplace(build(p));
+    } catch (const std::invalid_argument& e) {
+      reader.fail(e.what());
+    }
+    return detail::model_instance(definition.name, std::move(*model), step, scheme);
+  };
+  return entry;
+}
+
+}  // namespace nlobs

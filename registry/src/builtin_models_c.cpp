@@ -1,0 +1,73 @@
+// The built-in models, registered as a user's are (register_model.hpp): the PI paper's lander
+// and unknown-input integrator, the modulating-function paper's two systems (their canonical
+// forms: nlobs/models/modulating_forms.hpp).
+#include <stdexcept>
+
+#include "builtin_models.hpp"
+#include "nlobs/models/modulating_forms.hpp"
+#include "nlobs/models/systems.hpp"
+#include "nlobs/registry/register_model.hpp"
+
+namespace nlobs::detail {
+
+void add_builtin_models_c(ModelRegistry& r) {
+  using Lander = LunarLander;
+  r.add(model_entry(ModelDefinition<Lander>{
+      .name = "lander",
+      .description = "lunar lander, 1 input, y = x1, domain x3 > 0 ([FFMG19])",
+      .parameters = {{"g", "gravity", [](Lander& m) -> double& { return m.p.g; }},
+                     {"sigma", "x3' = -sigma u - f",
+                      [](Lander& m) -> double& { return m.p.sigma; }},
+                     {"alpha", "x2' = g - sigma alpha u / x3",
+                      [](Lander& m) -> double& { return m.p.alpha; }}},
+      .default_step = 0.001}));
+  using Immersed = LunarLanderImmersed;
+  r.add(model_entry(ModelDefinition<Immersed>{
+      .name = "lander-f",
+      .description =
+          "lunar lander with f = exp(c sin t) as state x4, y = x1, domain x3 > 0 ([FFMG19])",
+      .parameters =
+          {{"g", "gravity", [](Immersed& m) -> double& { return m.p.g; }},
+           {"sigma", "x3' = -sigma u - x4", [](Immersed& m) -> double& { return m.p.sigma; }},
+           {"alpha", "x2' = g - sigma alpha u / x3",
+            [](Immersed& m) -> double& { return m.p.alpha; }},
+           {"c", "f = exp(c sin t); 0: f constant", [](Immersed& m) -> double& { return m.c; }}},
+      .default_step = 0.001}));
+  using Integrator = UnknownInputIntegrator;
+  r.add(model_entry(ModelDefinition<Integrator>{
+      .name = "unknown-input",
+      .description = "x' = u + f, f = A sin(omega t) as state x2, y = x1 ([FFMG19], example 3)",
+      .parameters = {{"amplitude", "A; 0: f constant",
+                      [](Integrator& m) -> double& { return m.amplitude; }},
+                     {"omega", "omega (rad/s)", [](Integrator& m) -> double& { return m.omega; }}},
+      .default_step = 0.001}));
+  using Lti = LtiOutputInjection;
+  r.add(model_entry(ModelDefinition<Lti>{
+      .name = "lti-injection",
+      .description = "x1'=x2, x2'=-a0 x1-a1 x2+gain sin(y), y = x1 ([MF-LTV])",
+      .parameters = {
+          {"a0", "stiffness", [](Lti& m) -> double& { return m.p.a0; }},
+          {"a1", "damping", [](Lti& m) -> double& { return m.p.a1; }},
+          {"gain", "output injection gain", [](Lti& m) -> double& { return m.p.gain; }}}}));
+  using Pendulum = PendulumTimeVaryingFriction;
+  r.add(model_entry(ModelDefinition<Pendulum>{
+      .name = "pendulum",
+      .description = "pendulum with time-varying friction, y = angle ([MF-LTV])",
+      .parameters =
+          {{"g", "gravity", [](Pendulum& m) -> double& { return m.p.g; }},
+           {"length", "l > 0", [](Pendulum& m) -> double& { return m.p.length; }},
+           {"c0", "friction c(t) = c0 + c1 sin(omega_c t)",
+            [](Pendulum& m) -> double& { return m.p.c0; }},
+           {"c1", "friction's oscillation", [](Pendulum& m) -> double& { return m.p.c1; }},
+           {"omega_c", "friction's frequency", [](Pendulum& m) -> double& { return m.p.omega_c; }},
+           {"a_max", "unknown acceleration a(t) = a_max sin(omega_a t)",
+            [](Pendulum& m) -> double& { return m.p.a_max; }},
+           {"omega_a", "acceleration's frequency",
+            [](Pendulum& m) -> double& { return m.p.omega_a; }}},
+      .build = [](const Pendulum& m) {
+        if (!(m.p.length > 0.0)) throw std::invalid_argument("'length' must be > 0");
+        return m;
+      }}));
+}
+
+}  // namespace nlobs::detail

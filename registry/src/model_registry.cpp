@@ -1,0 +1,46 @@
+#include "nlobs/registry/model_registry.hpp"
+
+#include "builtin_models.hpp"
+
+namespace nlobs {
+
+ModelRegistry& model_registry() {
+  static ModelRegistry registry = [] {
+    ModelRegistry r("model");
+    detail::add_builtin_models_a(r);
+    detail::add_builtin_models_b(r);
+    detail::add_builtin_models_c(r);
+    return r;
+  }();
+  return registry;
+}
+
+ModelInstance make_model_instance(JsonReader& spec, const ModelRegistry& registry) {
+  const std::string name = spec.required_text("name");
+  const ModelEntry* entry = registry.find(name);
+  if (!entry) {
+    spec.fail("unknown model '" + name + "'; valid models: " + registry.valid_list());
+  }
+  Scheme scheme = entry->default_scheme;
+  if (auto s = spec.text("scheme")) {
+    if (*s == "euler") {
+      scheme = Scheme::kEuler;
+    } else if (*s == "rk4") {
+      scheme = Scheme::kRk4;
+    } else {
+      spec.fail("scheme '" + *s + "' is not euler or rk4");
+    }
+  }
+  const double step = spec.number("step").value_or(entry->default_step);
+  static const nlohmann::json empty = nlohmann::json::object();
+  std::optional<JsonReader> parameters = spec.object("parameters");
+  JsonReader p = parameters ? *parameters : JsonReader(empty, spec.where() + ".parameters");
+  spec.finish({"name", "parameters", "scheme", "step"});
+  try {
+    return entry->make(p, step, scheme);
+  } catch (const InvalidInput& e) {  // the discretisation's refusal of the step
+    spec.fail(e.what());
+  }
+}
+
+}  // namespace nlobs

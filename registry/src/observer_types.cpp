@@ -1,0 +1,99 @@
+#include "nlobs/registry/observer_types.hpp"
+
+#include <algorithm>
+
+#include "observer_types/builtin_observer_types.hpp"
+
+namespace nlobs {
+namespace {
+
+bool lists(const ObserverTypeEntry& e, const std::string& key) {
+  return std::any_of(e.keys.begin(), e.keys.end(), [&](const KeyInfo& k) { return k.key == key; });
+}
+
+}  // namespace
+
+ObserverTypeRegistry& observer_type_registry() {
+  static ObserverTypeRegistry registry = [] {
+    ObserverTypeRegistry r("observer type");
+    detail::add_builtin_observer_types(r);
+    return r;
+  }();
+  return registry;
+}
+
+ObserverSpec parse_observer_spec(JsonReader& o, const ModelInstance& model,
+                                 const ObserverTypeRegistry& types) {
+  ObserverSpec spec;
+  spec.type = o.required_text("type");
+  const ObserverTypeEntry* entry = types.find(spec.type);
+  if (!entry) {
+    o.fail("unknown observer type '" + spec.type + "'; valid: " + types.valid_list());
+  }
+  spec.spec = entry->parse(o, model);
+  if (lists(*entry, "initial")) spec.initial = o.vector("initial");
+  if (lists(*entry, "model")) {
+    // The observer's own model: built now (errors name its keys), sizes checked against ours.
+    if (auto design = o.object("model")) {
+      const AnyModel own = make_model_instance(*design).discrete;
+      const AnyModel& m = model.discrete;
+      if (own.states() != m.states() || own.outputs() != m.outputs() ||
+          own.inputs() != m.inputs() || own.sample_time() != m.sample_time()) {
+        o.fail("'model' must have the scenario model's sizes and sample time");
+      }
+      spec.model = design->json();
+    }
+  }
+  std::vector<std::string> keys{"type"};
+  for (const KeyInfo& k : entry->keys) keys.push_back(k.key);
+  o.finish(keys);
+  return spec;
+}
+
+nlohmann::json observer_spec_json(const ObserverSpec& spec, const ObserverTypeRegistry& types) {
+  nlohmann::json out{{"type", spec.type}};
+  types.get(spec.type).write(spec.spec, out);
+  if (spec.initial) {
+    out["initial"] =
+        std::vector<double>(spec.initial->data(), spec.initial->data() + spec.initial->size());
+  }
+  if (spec.model) out["model"] = *spec.model;
+  return out;
+}
+
+ObserverSpec with_key(const ObserverSpec& spec, const std::string& key, const nlohmann::json& value,
+                      const ModelInstance& model, const std::string& where,
+                      const ObserverTypeRegistry& types) {
+  nlohmann::json j = observer_spec_json(spec, types);
+  j[key] = value;
+  JsonReader reader(j, where);
+  return parse_observer_spec(reader, model, types);
+}
+
+bool has_key(const ObserverSpec& spec, const std::string& key, const ObserverTypeRegistry& types) {
+  const ObserverTypeEntry* e = types.find(spec.type);
+  return e && lists(*e, key);
+}
+
+std::unique_ptr<Observer> build_observer(const ObserverSpec& spec, const ModelInstance& model,
+                                         const Eigen::VectorXd& start, const std::string& where,
+                                         bool trace_first_window,
+                                         const ObserverTypeRegistry& types) {
+  const ObserverTypeEntry& entry = types.get(spec.type);
+  std::optional<ModelInstance> design;
+  if (spec.model) {
+    JsonReader reader(*spec.model, where + ".model");
+    design = make_model_instance(reader);
+  }
+  const ObserverBuild build{model, design ? design->discrete : model.discrete, start, where,
+                            trace_first_window};
+  try {
+    std::unique_ptr<Observer> observer = entry.build(spec.spec, build);
+    if (!observer) throw InvalidInput("observer type '" + spec.type + "' built no observer");
+    return observer;
+  } catch (const InvalidInput& e) {
+    throw std::invalid_argument(where + ": " + e.what());
+  }
+}
+
+}  // namespace nlobs
