@@ -5,8 +5,8 @@
 
 #include <memory>
 
+#include "nlobs/registry/problem_sets/chua_window_set.hpp"
 #include "nlobs/solvers/solvers.hpp"
-#include "reference/chua_window.hpp"
 #include "reference/kinsol_adapter.hpp"
 
 namespace {

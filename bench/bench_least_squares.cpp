@@ -2,9 +2,9 @@
 // built per solve; NLopt on small bounded problems: one nlopt::opt kept vs rebuilt per solve.
 #include <benchmark/benchmark.h>
 
+#include "nlobs/registry/problem_sets/chua_window_set.hpp"
 #include "nlobs/solvers/ceres_engine.hpp"
 #include "nlobs/solvers/nlopt_engine.hpp"
-#include "reference/chua_window.hpp"
 
 namespace {
 

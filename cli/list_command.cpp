@@ -5,8 +5,9 @@
 
 #include "nlobs/registry/model_registry.hpp"
 #include "nlobs/registry/observer_types.hpp"
+#include "nlobs/registry/problem_sets.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
-#include "reference/mgh_suite.hpp"
+#include "reference/problem_suite.hpp"
 #include "scenario.hpp"
 #include "solve_chua_window.hpp"
 
@@ -14,9 +15,10 @@ namespace nlobs::cli {
 
 void print_list(const std::string& what, std::ostream& out) {
   const bool all = what.empty();
-  if (!all && what != "engines" && what != "models" && what != "observers" && what != "scenarios") {
+  if (!all && what != "engines" && what != "models" && what != "observers" && what != "scenarios" &&
+      what != "problems") {
     throw std::invalid_argument("nothing to list under '" + what +
-                                "'; valid: models, engines, observers, scenarios");
+                                "'; valid: models, engines, observers, scenarios, problems");
   }
   if (all || what == "models") {
     out << "models (JSON: {\"name\", \"parameters\", \"scheme\": euler|rk4, \"step\"}):\n";
@@ -54,6 +56,30 @@ void print_list(const std::string& what, std::ostream& out) {
     out << "scenarios (nlobs run NAME, or a JSON file):\n";
     for (const auto& s : builtin_scenarios()) out << "  " << s << '\n';
   }
+  if (all || what == "problems") {
+    out << "problem sets (nlobs suite SET; nlobs solve SET/NAME[:n=K]):\n";
+    const auto& sets = problem_set_registry();
+    for (const ProblemSetEntry* set : sets.entries()) {
+      out << "  " << set->name << " — " << set->description
+          << "; solved at |F|2 <= " << set->solved_threshold;
+      const std::string source = sets.source(set->name);
+      if (source != "built-in") out << "; from " << source;
+      out << '\n';
+      try {
+        for (const TestProblem& p : build_problem_set(*set)) {
+          out << "      " << p.name << ":n=" << p.size() << (p.fixed_point ? " (x = G(x))" : "")
+              << "; starts";
+          for (const ProblemStart& st : p.starts) out << ' ' << st.label;
+          if (p.lower.size() || p.upper.size()) out << "; bounded";
+          if (!p.solutions.empty()) out << "; " << p.solutions.size() << " known solution(s)";
+          if (!p.description.empty()) out << "; " << p.description;
+          out << '\n';
+        }
+      } catch (const std::exception& e) {  // a user's set that cannot be built: say so, go on
+        out << "      (cannot be built: " << e.what() << ")\n";
+      }
+    }
+  }
   if (!all && what != "engines") return;
   out << "engines (spec: name[:word][,key=value...]):\n";
   for (const auto& e : EngineRegistry<Dynamic>::global().entries()) {
@@ -69,8 +95,10 @@ void print_list(const std::string& what, std::ostream& out) {
   }
   out << "\nreference solvers (same run, for comparison):\n  solve chua-window:";
   for (const auto& r : reference_names()) out << ' ' << r;
-  out << "\n  suite mgh:";
+  out << "\n  suite SET and solve SET/NAME (default):";
   for (const auto& r : reference::reference_suite_solvers()) out << ' ' << r;
+  out << "\n  suite SET and solve SET/NAME (accepted):";
+  for (const auto& r : reference::all_reference_solvers()) out << ' ' << r;
   out << '\n';
 }
 

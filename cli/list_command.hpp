@@ -1,11 +1,12 @@
 #pragma once
-// `nlobs list [engines]`: what can be named on the command line.
+// `nlobs list [models|engines|observers|scenarios|problems]`: what can be named on the command
+// line, from the registries.
 #include <iosfwd>
 #include <string>
 
 namespace nlobs::cli {
 
-// `what`: "" (everything) or "engines". Throws std::invalid_argument otherwise.
+// `what`: "" (everything) or one section. Throws std::invalid_argument otherwise.
 void print_list(const std::string& what, std::ostream& out);
 
 }  // namespace nlobs::cli

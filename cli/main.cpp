@@ -15,11 +15,11 @@
 
 #include "list_command.hpp"
 #include "output_directory.hpp"
-#include "reference/mgh_suite.hpp"
+#include "reference/problem_suite.hpp"
 #include "run_command.hpp"
 #include "scenario.hpp"
 #include "solve_chua_window.hpp"
-#include "suite_mgh.hpp"
+#include "suite_command.hpp"
 
 namespace {
 
@@ -71,6 +71,23 @@ std::uint64_t parse_seed(const std::string& text) {
   return static_cast<std::uint64_t>(v);
 }
 
+// The options `nlobs suite` and `nlobs solve SET/NAME` share.
+void add_suite_options(CLI::App* app, nlobs::cli::SuiteArguments& a) {
+  app->add_option("--solvers,--engines", a.solvers,
+                  "Comma-separated engine specs and references (default: the suite's list; "
+                  "nlobs list engines)");
+  app->add_option("--starts", a.starts, "Comma-separated start labels (default: all)");
+  app->add_option("--threshold", a.threshold,
+                  "Solved when |F|2 <= this at the returned point (default: the set's, 1e-8)")
+      ->check(finite_in(std::numeric_limits<double>::min(), std::numeric_limits<double>::max(),
+                        "X > 0"));
+  app->add_option("--budget", a.evaluations_per_dimension,
+                  "F evaluations per unknown and one (budget = this * (n + 1)); default 1000")
+      ->check(CLI::Range(1L, 1000000L));
+  app->add_flag("--json", a.json, "Print a JSON array instead of the tables");
+  app->add_option("--csv", a.csv, "Also write the rows as CSV to FILE ('-': stdout, no table)");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -78,9 +95,12 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "nlobs 0.1.0");
 
-  // nlobs solve chua-window
-  CLI::App* solve = app.add_subcommand("solve", "Solve a built-in problem with several engines");
-  solve->require_subcommand(1);
+  // nlobs solve chua-window | nlobs solve PROBLEM...
+  CLI::App* solve = app.add_subcommand(
+      "solve",
+      "Solve problems of a problem set (SET/NAME) with several engines beside KINSOL, "
+      "MINPACK and GSL; or the chua-window table");
+  solve->require_subcommand(0, 1);
   CLI::App* chua = solve->add_subcommand(
       "chua-window", "Modified-Chua window problem ([MGFF23]) with each engine and KINSOL");
   std::string engines_arg;
@@ -96,17 +116,23 @@ int main(int argc, char** argv) {
       ->default_val(1e-8);
   chua->add_flag("--json", chua_json, "Print a JSON array instead of the table");
   chua->add_flag("--no-reference", no_reference, "Leave out the KINSOL rows");
+  std::vector<std::string> solve_selectors;
+  nlobs::cli::SuiteArguments solve_args;
+  solve->add_option("problems", solve_selectors,
+                    "SET/NAME, SET/NAME:n=K or SET (nlobs list problems), one or more");
+  add_suite_options(solve, solve_args);
 
-  // nlobs suite mgh
-  CLI::App* suite = app.add_subcommand("suite", "Run a standard test suite");
-  suite->require_subcommand(1);
-  CLI::App* mgh = suite->add_subcommand(
-      "mgh", "Moré-Garbow-Hillstrom systems of MINPACK's driver, starts x1, x10, x100");
-  std::string solvers_arg;
-  bool mgh_json = false;
-  mgh->add_option("--solvers", solvers_arg,
-                  "Comma-separated engine specs and references (default: all)");
-  mgh->add_flag("--json", mgh_json, "Print a JSON array instead of the tables");
+  // nlobs suite SET
+  CLI::App* suite = app.add_subcommand(
+      "suite", "Run every listed solver on every (problem, start) of a problem set");
+  std::string suite_set;
+  nlobs::cli::SuiteArguments suite_args;
+  suite
+      ->add_option("set", suite_set,
+                   "Problem set: mgh, chua-window or a registered one (nlobs "
+                   "list problems)")
+      ->required();
+  add_suite_options(suite, suite_args);
 
   // nlobs run
   CLI::App* run = app.add_subcommand("run", "Run a scenario: simulate, observe, measure");
@@ -159,20 +185,17 @@ int main(int argc, char** argv) {
       } else {
         nlobs::cli::print_table(rows, tolerance, std::cout);
       }
-    } else if (*mgh) {
-      nlobs::reference::SuiteOptions options;
-      if (isatty(STDERR_FILENO))
-        options.progress = [](int done, int total) {
-          std::cerr << "\rnlobs suite mgh: " << done << "/" << total << " (problem, start) pairs"
-                    << (done == total ? "\n" : "") << std::flush;
-        };
-      const auto rows = nlobs::reference::run_mgh_suite(
-          specs_or(solvers_arg, nlobs::reference::default_suite_solvers()), options);
-      if (mgh_json) {
-        std::cout << nlobs::cli::suite_to_json(rows).dump(2) << '\n';
-      } else {
-        nlobs::cli::print_suite_tables(rows, std::cout);
+    } else if (*solve) {
+      if (solve_selectors.empty()) {
+        std::cerr << "nlobs: error: nlobs solve needs chua-window or a problem: SET/NAME, "
+                     "SET/NAME:n=K or SET (nlobs list problems)\n";
+        return kCommandLineError;
       }
+      solve_args.progress = isatty(STDERR_FILENO);
+      nlobs::cli::run_problem_suite(solve_selectors, solve_args, "solve", std::cout, std::cerr);
+    } else if (*suite) {
+      suite_args.progress = isatty(STDERR_FILENO);
+      nlobs::cli::run_problem_suite({suite_set}, suite_args, "suite", std::cout, std::cerr);
     } else if (*run) {
       if (*steps_opt) run_options.steps = steps;
       if (*noise_opt) run_options.noise = noise;

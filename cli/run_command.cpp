@@ -375,8 +375,11 @@ void run_sweep(const Scenario& s, const ModelInstance& model, const Measurements
   const std::vector<double> values = parse_sweep_values(key, spec.substr(eq + 1), true);
   Scenario only = s;
   only.observers.clear();
-  for (const ObserverSpec& o : s.observers) {
-    if (has_key(o, "theta")) only.observers.push_back(o);
+  std::vector<size_t> index;  // of each swept observer in the scenario, for messages
+  for (size_t i = 0; i < s.observers.size(); ++i) {
+    if (!has_key(s.observers[i], "theta")) continue;
+    only.observers.push_back(s.observers[i]);
+    index.push_back(i);
   }
   if (only.observers.empty()) {
     throw std::invalid_argument("--sweep theta needs a high_gain observer in the scenario");
@@ -403,7 +406,7 @@ void run_sweep(const Scenario& s, const ModelInstance& model, const Measurements
     Scenario run = only;
     for (size_t i = 0; i < run.observers.size(); ++i) {
       run.observers[i] = with_key(run.observers[i], "theta", theta, model,
-                                  s.name + ".observers[" + std::to_string(i) + "]");
+                                  s.name + ".observers[" + std::to_string(index[i]) + "]");
     }
     auto observers = make_observers(run, model, false);
     RunResult r = run_observers(data, observers, settle_index);

@@ -7,8 +7,8 @@
 #include <ostream>
 #include <stdexcept>
 
+#include "nlobs/registry/problem_sets/chua_window_set.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
-#include "reference/chua_window.hpp"
 #include "reference/kinsol_adapter.hpp"
 #include "reference/timing.hpp"
 

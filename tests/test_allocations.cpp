@@ -19,10 +19,10 @@
 #include "nlobs/observers/mvt/mvt_observer.hpp"
 #include "nlobs/observers/pi/pi_bank.hpp"
 #include "nlobs/observers/window/window_estimator.hpp"
+#include "nlobs/registry/problem_sets/chua_window_set.hpp"
 #include "nlobs/solvers/ceres_engine.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 #include "nlobs/solvers/solvers.hpp"
-#include "reference/chua_window.hpp"
 
 namespace {
 std::atomic<long> g_allocations{0};

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <limits>
 
+#include "nlobs/registry/problem_sets/mgh_problems.hpp"
 #include "nlobs/solvers/ceres_engine.hpp"
 #include "nlobs/solvers/root_adapter.hpp"
-#include "reference/mgh_problems.hpp"
 
 namespace nlobs {
 namespace {

@@ -7,8 +7,8 @@
 #include <numbers>
 
 #include "nlobs/models/modified_chua.hpp"
+#include "nlobs/registry/problem_sets/chua_window_set.hpp"
 #include "nlobs/solvers/solvers.hpp"
-#include "reference/chua_window.hpp"
 
 namespace nlobs {
 namespace {

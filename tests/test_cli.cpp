@@ -141,6 +141,47 @@ TEST(Cli, SuiteTableEndsWithCounts) {
   EXPECT_NE(bad.out.find("minpack:hybrj"), std::string::npos) << bad.out;
 }
 
+TEST(Cli, SolveRunsAnyProblemOfASetBesideTheReferences) {
+  const CliRun r = run("solve mgh/rosenbrock --engines newton,kinsol:newton --json");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto rows = nlohmann::json::parse(r.out);
+  ASSERT_EQ(rows.size(), 3U * 2U);  // starts x solvers
+  for (const auto& row : rows) {
+    EXPECT_EQ(row["set"], "mgh");
+    EXPECT_EQ(row["problem"], "rosenbrock");
+    EXPECT_TRUE(row["solved"].get<bool>()) << row.dump();
+    EXPECT_LT(row["error"].get<double>(), 1e-6) << row.dump();  // the known root (1, 1)
+  }
+  const CliRun table = run("solve chua-window/window --engines anderson --starts x1");
+  ASSERT_EQ(table.status, 0) << table.out;
+  EXPECT_NE(table.out.find("window n=3 (start x 1)"), std::string::npos) << table.out;
+  EXPECT_NE(table.out.find("anderson"), std::string::npos) << table.out;
+  // The chua-window table is still there under its own name.
+  EXPECT_EQ(run("solve chua-window --no-reference --engines newton").status, 0);
+  const CliRun none = run("solve");
+  EXPECT_EQ(none.status, 1) << none.out;
+  EXPECT_NE(none.out.find("nlobs list problems"), std::string::npos) << none.out;
+  const CliRun unknown = run("solve mgh/rosenbrok");
+  EXPECT_EQ(unknown.status, 2) << unknown.out;
+  EXPECT_NE(unknown.out.find("rosenbrock:n=2"), std::string::npos) << unknown.out;
+  const CliRun no_set = run("suite mhg");
+  EXPECT_EQ(no_set.status, 2) << no_set.out;
+  EXPECT_NE(no_set.out.find("valid problem sets: chua-window, mgh"), std::string::npos)
+      << no_set.out;
+  EXPECT_NE(run("suite mgh/rosenbrock").out.find("nlobs solve mgh/rosenbrock"), std::string::npos);
+  EXPECT_EQ(run("suite mgh --threshold nan").status, 1);
+  EXPECT_EQ(run("suite mgh --threshold 0").status, 1);
+}
+
+TEST(Cli, ListProblems) {
+  const CliRun r = run("list problems");
+  ASSERT_EQ(r.status, 0) << r.out;
+  for (const char* e : {"chua-window", "window:n=3 (x = G(x)); starts x1 x10", "mgh",
+                        "chebyquad:n=9", "rosenbrock:n=2; starts x1 x10 x100; 1 known solution"}) {
+    EXPECT_NE(r.out.find(e), std::string::npos) << e << "\n" << r.out;
+  }
+}
+
 TEST(Cli, ListEngines) {
   const CliRun r = run("list engines");
   ASSERT_EQ(r.status, 0) << r.out;

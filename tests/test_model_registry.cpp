@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -50,6 +51,43 @@ struct TwoOutputs : ModelSizes<2, 1, 2> {
   }
 };
 
+// A spring x1' = x2, x2' = -w^2 x1, y = x1, with its hand embedding q = (x1, x2, -w^2 x1,
+// -w^2 x2), alpha = L_f^4 h = -w^2 z3 and q's inverse: a form that holds the model's parameter
+// (a default-constructed one is NaN, so an observer built from it is visibly wrong).
+struct SpringEmbedding {
+  static constexpr int kStates = 2, kDimension = 4;
+  double w2 = std::nan("");
+  template <typename T>
+  Eigen::Matrix<T, 4, 1> operator()(const Eigen::Matrix<T, 2, 1>& x) const {
+    Eigen::Matrix<T, 4, 1> z;
+    z << x[0], x[1], -w2 * x[0], -w2 * x[1];
+    return z;
+  }
+  template <typename T>
+  T alpha(const Eigen::Matrix<T, 4, 1>& z) const {
+    return -w2 * z[2];
+  }
+  Eigen::Vector2d inverse(const Eigen::Vector4d& z) const { return z.head<2>(); }
+};
+
+struct Spring : ModelSizes<2, 0, 1> {
+  double w = 2.0;
+  template <typename T>
+  State<T> vector_field(const State<T>& x, const Input&, double) const {
+    State<T> dx;
+    dx << x[1], -w * w * x[0];
+    return dx;
+  }
+  template <typename T>
+  Output<T> h(const State<T>& x) const {
+    return x.template head<1>();
+  }
+};
+
+std::optional<SpringEmbedding> hand_embedding(const Spring& m) {
+  return SpringEmbedding{m.w * m.w};
+}
+
 void register_once() {
   static const bool done = [] {
     model_registry().add(
@@ -92,6 +130,12 @@ void register_once() {
               o.gain = g;
               return std::make_unique<LuenbergerObserver<AnyModel>>(b.design, o);
             }}),
+        "test_model_registry");
+    model_registry().add(
+        model_entry(ModelDefinition<Spring>{
+            .name = "spring",
+            .description = "a test's spring with a hand embedding",
+            .parameters = {{"w", "x2' = -w^2 x1", [](Spring& m) -> double& { return m.w; }}}}),
         "test_model_registry");
     model_registry().add(model_entry(ModelDefinition<TwoOutputs>{
                              .name = "two-outputs", .description = "a test's two-output model"}),
@@ -156,6 +200,28 @@ TEST(ModelRegistry, UserModelRunsWithEveryObserverTypeItsConditionsAllow) {
   }
 }
 
+TEST(ModelRegistry, AUserHandEmbeddingIsUsedWithTheModelsOwnParameters) {
+  register_once();
+  const nlohmann::json observers = nlohmann::json::parse(R"([
+    {"type": "high_gain", "name": "explicit", "N": 4, "theta": 0.3, "map": "explicit",
+     "alpha": "explicit"},
+    {"type": "high_gain", "name": "inverse", "N": 4, "theta": 0.3, "map": "explicit",
+     "alpha": "explicit", "inverse": true},
+    {"type": "high_gain", "name": "taylor", "N": 4, "theta": 0.3}
+  ])");
+  const nlohmann::json scenario = {
+      {"name", "spring-test"}, {"model", {{"name", "spring"}, {"parameters", {{"w", 3.0}}}}},
+      {"x0", {1.0, 0.0}},      {"initial_guess", {0.5, 0.5}},
+      {"steps", 1500},         {"observers", observers}};
+  const RunResult r = run(scenario);
+  ASSERT_EQ(r.metrics.size(), 3u);
+  for (const ObserverMetrics& m : r.metrics) {
+    SCOPED_TRACE(m.name);
+    ASSERT_TRUE(m.mse_after_window.allFinite()) << m.mse_after_window.transpose();
+    EXPECT_LT(m.mse_after_window.maxCoeff(), 1e-4);
+  }
+}
+
 TEST(ModelRegistry, ObserverTypesRefuseAModelThatMissesTheirConditionNamingIt) {
   register_once();
   EXPECT_NE(error_of(rossler_scenario(nlohmann::json::parse(R"([{"type": "modulating"}])")))
@@ -186,9 +252,10 @@ TEST(ModelRegistry, ParametersAreReadStrictlyAndCheckedByTheModel) {
   s["model"]["parameters"] = {{"c", -1.0}};
   EXPECT_NE(error_of(s).find("'c' must be > 0"), std::string::npos) << error_of(s);
   s["model"]["parameters"] = {{"c", "five"}};
-  EXPECT_NE(error_of(s).find("c"), std::string::npos) << error_of(s);
+  EXPECT_NE(error_of(s).find("test scenario.model.parameters: 'c'"), std::string::npos)
+      << error_of(s);
   s["model"] = {{"name", "rossler"}, {"step", -0.01}};
-  EXPECT_NE(error_of(s).find("model"), std::string::npos) << error_of(s);
+  EXPECT_NE(error_of(s).find("test scenario.model: 'step'"), std::string::npos) << error_of(s);
   s["model"] = {{"name", "rosler"}};
   const std::string unknown = error_of(s);
   EXPECT_NE(unknown.find("unknown model 'rosler'"), std::string::npos) << unknown;

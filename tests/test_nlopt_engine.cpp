@@ -5,8 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "nlobs/registry/problem_sets/mgh_problems.hpp"
 #include "nlobs/solvers/nlopt_engine.hpp"
-#include "reference/mgh_problems.hpp"
 
 namespace nlobs {
 namespace {

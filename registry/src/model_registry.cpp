@@ -1,5 +1,7 @@
 #include "nlobs/registry/model_registry.hpp"
 
+#include <cmath>
+
 #include "builtin_models.hpp"
 
 namespace nlobs {
@@ -32,6 +34,7 @@ ModelInstance make_model_instance(JsonReader& spec, const ModelRegistry& registr
     }
   }
   const double step = spec.number("step").value_or(entry->default_step);
+  if (!(step > 0.0) || !std::isfinite(step)) spec.fail("'step' must be finite and > 0");
   static const nlohmann::json empty = nlohmann::json::object();
   std::optional<JsonReader> parameters = spec.object("parameters");
   JsonReader p = parameters ? *parameters : JsonReader(empty, spec.where() + ".parameters");

@@ -1,6 +1,7 @@
 #include "nlobs/registry/observer_types.hpp"
 
 #include <algorithm>
+#include <any>
 
 #include "observer_types/builtin_observer_types.hpp"
 
@@ -9,6 +10,12 @@ namespace {
 
 bool lists(const ObserverTypeEntry& e, const std::string& key) {
   return std::any_of(e.keys.begin(), e.keys.end(), [&](const KeyInfo& k) { return k.key == key; });
+}
+
+// A spec parsed by one registry's entry and written or built by another's of the same name.
+InvalidInput mismatched(const std::string& type) {
+  return InvalidInput("observer type '" + type +
+                      "': its spec was parsed by another registry's entry of that name");
 }
 
 }  // namespace
@@ -30,7 +37,11 @@ ObserverSpec parse_observer_spec(JsonReader& o, const ModelInstance& model,
   if (!entry) {
     o.fail("unknown observer type '" + spec.type + "'; valid: " + types.valid_list());
   }
-  spec.spec = entry->parse(o, model);
+  try {
+    spec.spec = entry->parse(o, model);
+  } catch (const InvalidInput& e) {  // thrown by the entry itself, not through o.fail: add where
+    o.fail(e.what());
+  }
   if (lists(*entry, "initial")) spec.initial = o.vector("initial");
   if (lists(*entry, "model")) {
     // The observer's own model: built now (errors name its keys), sizes checked against ours.
@@ -52,7 +63,11 @@ ObserverSpec parse_observer_spec(JsonReader& o, const ModelInstance& model,
 
 nlohmann::json observer_spec_json(const ObserverSpec& spec, const ObserverTypeRegistry& types) {
   nlohmann::json out{{"type", spec.type}};
-  types.get(spec.type).write(spec.spec, out);
+  try {
+    types.get(spec.type).write(spec.spec, out);
+  } catch (const std::bad_any_cast&) {
+    throw mismatched(spec.type);
+  }
   if (spec.initial) {
     out["initial"] =
         std::vector<double>(spec.initial->data(), spec.initial->data() + spec.initial->size());
@@ -91,8 +106,13 @@ std::unique_ptr<Observer> build_observer(const ObserverSpec& spec, const ModelIn
     std::unique_ptr<Observer> observer = entry.build(spec.spec, build);
     if (!observer) throw InvalidInput("observer type '" + spec.type + "' built no observer");
     return observer;
-  } catch (const InvalidInput& e) {
-    throw std::invalid_argument(where + ": " + e.what());
+  } catch (const std::bad_any_cast&) {
+    throw std::invalid_argument(where + ": " + mismatched(spec.type).what());
+  } catch (const std::invalid_argument& e) {
+    // InvalidInput from the library, or a user's std::invalid_argument: add where once.
+    const std::string what = e.what();
+    if (what.compare(0, where.size(), where) == 0) throw;
+    throw std::invalid_argument(where + ": " + what);
   }
 }
 

@@ -22,6 +22,9 @@
 //
 // This header compiles the MVT and high-gain observers for the model (about 20 s for a
 // three-state model at -O3); include it only where a model is registered.
+#include <algorithm>
+#include <charconv>
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <sstream>
@@ -63,27 +66,33 @@ struct ModelDefinition {
 
 namespace detail {
 
+// The shortest text that reads back as v (100/7 shows all its digits, 0.11 stays 0.11).
 inline std::string number_text(double v) {
-  std::ostringstream os;
-  os.precision(6);
-  os << v;
-  return os.str();
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, v);
+  return std::string(buffer, result.ptr);
 }
+
+template <typename Model>
+constexpr bool kFixedSizes = Model::kStates != Eigen::Dynamic&& Model::kOutputs !=
+                             Eigen::Dynamic&& Model::kInputs != Eigen::Dynamic;
+template <typename Model>
+constexpr bool kMvtFits = kFixedSizes<Model>&& Model::kOutputs <= Model::kStates;
+template <typename Model>
+constexpr bool kHighGainFits = kFixedSizes<Model>&& Model::kOutputs == 1 && Model::kInputs == 0;
 
 template <typename Model>
 ModelInstance model_instance(const std::string& name, Model model, double step, Scheme scheme) {
   ModelInstance out{
       name, AnyModel(name, Discretized<Model>(model, step, scheme), step), {}, {}, {}};
-  constexpr bool kFixed = Model::kStates != Eigen::Dynamic && Model::kOutputs != Eigen::Dynamic &&
-                          Model::kInputs != Eigen::Dynamic;
-  if constexpr (kFixed && Model::kOutputs <= Model::kStates) {
+  if constexpr (kMvtFits<Model>) {
     out.mvt.make = [model](const MvtOptions& options) -> std::unique_ptr<Observer> {
       return std::make_unique<MvtObserver<Model>>(model, options);
     };
   } else {
     out.mvt.unmet = "the MVT observer needs fixed sizes and y = [I_m 0] x (m <= n outputs)";
   }
-  if constexpr (kFixed && Model::kOutputs == 1 && Model::kInputs == 0) {
+  if constexpr (kHighGainFits<Model>) {
     out.high_gain.make = [model, name](const HighGainSpec& spec, const Eigen::VectorXd& start,
                                        double sample_time) {
       return build_high_gain(model, spec, start, sample_time, name);
@@ -120,12 +129,21 @@ ModelEntry model_entry(ModelDefinition<Model, Parameters> definition) {
                          "model");
     }
   }
+  if (!(definition.default_step > 0.0) || !std::isfinite(definition.default_step)) {
+    throw InvalidInput("model '" + definition.name + "': default_step must be finite and > 0");
+  }
   ModelEntry entry;
   entry.name = definition.name;
   entry.description = definition.description;
   entry.default_step = definition.default_step;
   entry.default_scheme = definition.default_scheme;
   for (auto& p : definition.parameters) {
+    const bool taken = std::any_of(entry.parameters.begin(), entry.parameters.end(),
+                                   [&](const KeyInfo& k) { return k.key == p.key; });
+    if (p.key.empty() || taken) {
+      throw InvalidInput("model '" + definition.name + "': parameter key '" + p.key +
+                         "' is empty or listed twice");
+    }
     if (!p.value)
       throw InvalidInput("model '" + entry.name + "': parameter '" + p.key +
                          "' has no field (ModelParameter::value)");
@@ -142,8 +160,8 @@ ModelEntry model_entry(ModelDefinition<Model, Parameters> definition) {
   entry.inputs = probe.inputs();
   entry.outputs = probe.outputs();
   entry.families = {"window", "ekf", "luenberger", "sliding_mode"};
-  if (probe.outputs() <= probe.states()) entry.families.push_back("mvt");
-  if (probe.outputs() == 1 && probe.inputs() == 0) entry.families.push_back("high_gain");
+  if constexpr (detail::kMvtFits<Model>) entry.families.push_back("mvt");
+  if constexpr (detail::kHighGainFits<Model>) entry.families.push_back("high_gain");
   if constexpr (detail::HasModulatingForm<Model>) entry.families.push_back("modulating");
   if (probe.outputs() == 1) entry.families.push_back("finite_difference");
   entry.make = [definition, build](JsonReader& reader, double step, Scheme scheme) {
@@ -157,7 +175,7 @@ ModelEntry model_entry(ModelDefinition<Model, Parameters> definition) {
     std::optional<Model> model;
     try {  // the model's refusal names the parameters object
       model.emplace(build(p));
-    } catch (const std::invalid_argument& e) {
+    } catch (const std::exception& e) {  // a user's model may throw any standard exception
       reader.fail(e.what());
     }
     return detail::model_instance(definition.name, std::move(*model), step, scheme);

@@ -53,10 +53,15 @@ std::unique_ptr<Observer> build_high_gain(Model model, const HighGainSpec& spec,
   const auto refuse = [&](const std::string& what) {
     throw InvalidInput("high_gain on model '" + model_name + "': " + what);
   };
-  const bool hand_ok = [&] {
-    if constexpr (kHand) return hand_embedding(model).has_value();
-    return false;
+  // The model's own form value: a form may hold the model's parameters.
+  const auto hand = [&] {
+    if constexpr (kHand) {
+      return hand_embedding(model);
+    } else {
+      return std::optional<int>();
+    }
   }();
+  const bool hand_ok = hand.has_value();
   int N = spec.N;
   if constexpr (kHand) {
     if (N == 0) N = Form::kDimension;
@@ -65,8 +70,8 @@ std::unique_ptr<Observer> build_high_gain(Model model, const HighGainSpec& spec,
   const auto need_hand = [&](const char* what) {
     if (!hand_ok) {
       refuse(std::string(what) +
-             " needs the model's hand-expanded embedding (duffing, oscillator, lorenz and "
-             "van-der-pol at their documented parameters)");
+             " needs the model's hand-expanded embedding (hand_embedding(model); built in: "
+             "duffing, oscillator, lorenz and van-der-pol at their documented parameters)");
     }
     if constexpr (kHand) {
       if (N != Form::kDimension) {
@@ -83,7 +88,7 @@ std::unique_ptr<Observer> build_high_gain(Model model, const HighGainSpec& spec,
   }
   if (spec.map == "explicit") {
     need_hand("'map': explicit");
-    if constexpr (kHand) design.map = std::make_shared<ExplicitObservabilityMap<Form>>();
+    if constexpr (kHand) design.map = std::make_shared<ExplicitObservabilityMap<Form>>(*hand);
   } else if (spec.map == "adolc" || (spec.map == "ad" && N > kMaxTaylorObservabilityOrder)) {
     design.map = std::make_shared<LieObservabilityMap>(model, N);
   } else {
@@ -101,18 +106,21 @@ std::unique_ptr<Observer> build_high_gain(Model model, const HighGainSpec& spec,
     refuse("α = L_f^N h needs a map built from the model ('map': ad, taylor or adolc)");
   }
   if (spec.alpha == "explicit" || (spec.alpha == "auto" && hand_alpha)) {
-    if (!hand_alpha) refuse("'alpha': explicit needs a hand α (duffing N = 6, oscillator N = 4)");
+    if (!hand_alpha)
+      refuse(
+          "'alpha': explicit needs a hand α (the embedding's alpha(z); built in: duffing N = 6, "
+          "oscillator N = 4)");
     if constexpr (kHand) {
-      if constexpr (has_alpha<Form>) design.alpha = explicit_alpha<Form>();
+      if constexpr (has_alpha<Form>) design.alpha = explicit_alpha<Form>(*hand);
     }
   }
   if (spec.inverse) {
     need_hand("'inverse'");
     if constexpr (kHand) {
       if constexpr (has_inverse<Form>) {
-        design.inverse = explicit_inverse<Form>();
+        design.inverse = explicit_inverse<Form>(*hand);
       } else {
-        refuse("'inverse': only the oscillator has an explicit inverse");
+        refuse("'inverse': the hand embedding has no inverse(z) (built in: the oscillator's)");
       }
     }
   }
@@ -130,7 +138,7 @@ std::unique_ptr<Observer> build_high_gain(Model model, const HighGainSpec& spec,
     } else {
       need_hand("'saturation.box'");
       if constexpr (kHand)
-        s.P = saturation_weight_from_box(embedded_box_bound(Form{}, spec.saturation_box));
+        s.P = saturation_weight_from_box(embedded_box_bound(*hand, spec.saturation_box));
     }
     o.saturation = s;
   }

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "nlobs/registry/problem_sets.hpp"
 #include "nlobs/solvers/problem.hpp"
 
 namespace nlobs::reference {
@@ -31,3 +32,12 @@ std::vector<MghCase> mgh_cases();
 MghCase mgh_case(int number, int n);
 
 }  // namespace nlobs::reference
+
+namespace nlobs {
+// The built-in set "mgh": the cases above in MINPACK's order, named as mgh_cases() names them
+// (Watson and Chebyquad once per size: mgh/chebyquad:n=5), each from MINPACK's standard start
+// scaled by 1, 10 and 100 (starts "x1", "x10", "x100"); known solutions where they are exact
+// (Rosenbrock, Powell singular, Wood, helical valley, Brown almost-linear, variably
+// dimensioned).
+ProblemSetEntry mgh_problem_set();
+}  // namespace nlobs

@@ -1,6 +1,7 @@
-#include "reference/mgh_problems.hpp"
+#include "nlobs/registry/problem_sets/mgh_problems.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <stdexcept>
 
@@ -278,3 +279,46 @@ MghCase mgh_case(int number, int n) {
 }
 
 }  // namespace nlobs::reference
+
+namespace nlobs {
+
+ProblemSetEntry mgh_problem_set() {
+  ProblemSetEntry set;
+  set.name = "mgh";
+  set.description =
+      "the square systems of MINPACK's test driver (More, Garbow & Hillstrom), standard starts "
+      "scaled by 1, 10 and 100";
+  set.problems = [] {
+    std::vector<TestProblem> problems;
+    for (reference::MghCase& c : reference::mgh_cases()) {
+      TestProblem p{.name = c.name, .residual = std::move(c.problem)};
+      for (double scale : {1.0, 10.0, 100.0}) {
+        char label[16];
+        std::snprintf(label, sizeof label, "x%g", scale);
+        p.starts.push_back({label, c.start(scale), scale});
+      }
+      switch (c.number) {
+        case 1:   // Rosenbrock
+        case 4:   // Wood
+        case 8:   // Brown almost-linear
+        case 12:  // variably dimensioned
+          p.solutions.push_back(Eigen::VectorXd::Ones(c.n));
+          break;
+        case 2:  // Powell singular
+          p.solutions.push_back(Eigen::VectorXd::Zero(c.n));
+          break;
+        case 5:  // helical valley
+          p.solutions.push_back(Eigen::Vector3d(1.0, 0.0, 0.0));
+          break;
+        default:
+          break;
+      }
+      p.description = "MINPACK problem " + std::to_string(c.number);
+      problems.push_back(std::move(p));
+    }
+    return problems;
+  };
+  return set;
+}
+
+}  // namespace nlobs

@@ -1,12 +1,14 @@
 #pragma once
 // The modified-Chua window problem of [MGFF23], shared by the CLI, tests and benchmarks:
 // true initial state [1.0, 2.1428, −0.1648], the window of its first three outputs, initial
-// guess [5, 10, −5]. Its fixed point is the true initial state.
+// guess [5, 10, −5]. Its fixed point is the true initial state. As a problem set
+// (`nlobs suite chua-window`): that problem from the paper's guess scaled by 1 and 10.
 #include <Eigen/Core>
 #include <memory>
 
 #include "nlobs/models/modified_chua.hpp"
 #include "nlobs/observers/window/window_problems.hpp"
+#include "nlobs/registry/problem_sets.hpp"
 
 namespace nlobs::reference {
 
@@ -34,3 +36,9 @@ struct ChuaWindowCase {
 };
 
 }  // namespace nlobs::reference
+
+namespace nlobs {
+// The built-in set "chua-window": one fixed-point problem "window" (n = 3), starts "x1" and
+// "x10" (the paper's guess times 1 and 10), the true initial state as its known solution.
+ProblemSetEntry chua_window_problem_set();
+}  // namespace nlobs

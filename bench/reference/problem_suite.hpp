@@ -1,0 +1,69 @@
+#pragma once
+// `nlobs suite SET` and `nlobs solve SET/NAME`: every listed solver — engines of the registry
+// (any spec, a user's engine too) and the reference solvers — on every (problem, start) of a
+// problem set, judged the same way for all: solved when the returned point is finite, inside
+// the problem's bounds and ‖F(x)‖₂ ≤ the threshold (1e-8 unless the set or the caller says
+// otherwise).
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "nlobs/registry/problem_sets.hpp"
+
+namespace nlobs::reference {
+
+struct SuiteRow {
+  std::string set;  // the problem set's name
+  std::string problem;
+  int n = 0;
+  std::string start;  // the start's label ("x1", "x10", ...)
+  double start_scale = 1.0;
+  std::string solver;
+  bool solved = false;
+  double residual = 0.0;  // ‖F(x)‖₂ at the returned x (inf if not finite)
+  // min over the known solutions x* of ‖x − x*‖∞ (NaN when the problem lists none).
+  double error = 0.0;
+  long f_evals = 0;
+  long j_evals = 0;
+  double ns = 0.0;     // wall time per solve
+  std::string status;  // the solver's own account; `outside_bounds` for a point outside the box
+};
+
+struct SuiteOptions {
+  // ‖F‖₂ at or below this at the returned point counts as solved; NaN: the set's own default
+  // (ProblemSetEntry::solved_threshold). Otherwise finite and > 0.
+  double solved_threshold = std::numeric_limits<double>::quiet_NaN();
+  // Every solver gets the same budget of F evaluations: evaluations_per_dimension (n + 1), at
+  // least 1.
+  long evaluations_per_dimension = 1000;
+  // Only the starts with these labels (empty: all); a label no problem has is an error.
+  std::vector<std::string> starts{};
+  // Called after each (problem, start) pair, e.g. for a progress line.
+  std::function<void(int done, int total)> progress{};
+};
+
+// Our engines (registry specs) in the default order, then the default references.
+std::vector<std::string> default_suite_solvers();
+// The references run by default: minpack:hybrj, kinsol:newton, gsl:hybridsj, gsl:gnewton.
+std::vector<std::string> reference_suite_solvers();
+// Every reference name accepted: the default ones and KINSOL's fixed-point strategies
+// kinsol:fp and kinsol:fp-aa2 (on G: the problem's own, or x + F(x)).
+std::vector<std::string> all_reference_solvers();
+
+// The threshold `options` give for `set` (its own when options leave it NaN); InvalidInput for
+// a value that is not finite and > 0.
+double suite_threshold(const ProblemSetEntry& set, const SuiteOptions& options);
+
+// Throws std::invalid_argument for an unknown solver (listing the valid names, references
+// included) or an unknown start label, before anything runs.
+std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
+                                const std::vector<TestProblem>& problems,
+                                const std::vector<std::string>& solvers,
+                                const SuiteOptions& options = {});
+
+// Splits a --solvers/--engines list on commas, keeping "key=value" items with the spec
+// before them: "anderson:m=3,damping=0.5,newton" -> {"anderson:m=3,damping=0.5", "newton"}.
+std::vector<std::string> split_spec_list(const std::string& list);
+
+}  // namespace nlobs::reference

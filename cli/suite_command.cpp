@@ -1,0 +1,70 @@
+#include "suite_command.hpp"
+
+#include <cmath>
+#include <ostream>
+#include <stdexcept>
+
+#include "nlobs/registry/problem_sets.hpp"
+#include "reference/problem_suite.hpp"
+#include "suite_report.hpp"
+
+namespace nlobs::cli {
+
+void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArguments& args,
+                       const std::string& command, std::ostream& out, std::ostream& err) {
+  if (selectors.empty()) {
+    throw std::invalid_argument("nlobs " + command +
+                                ": name a problem set or problem (nlobs list problems)");
+  }
+  if (args.json && args.csv == "-") {
+    throw std::invalid_argument("nlobs " + command +
+                                ": --json and --csv - both print to stdout; give --csv a file");
+  }
+  reference::SuiteOptions options;
+  options.solved_threshold = args.threshold;
+  options.evaluations_per_dimension = args.evaluations_per_dimension;
+  options.starts =
+      args.starts.empty() ? std::vector<std::string>() : reference::split_spec_list(args.starts);
+  const std::vector<std::string> solvers = args.solvers.empty()
+                                               ? reference::default_suite_solvers()
+                                               : reference::split_spec_list(args.solvers);
+  // Every selection is built and checked before the first solve.
+  std::vector<ProblemSelection> selections;
+  double threshold = std::numeric_limits<double>::quiet_NaN();
+  for (const std::string& selector : selectors) {
+    if (command == "suite" && selector.find('/') != std::string::npos) {
+      throw std::invalid_argument("nlobs suite takes a problem set ('" + selector.substr(0, 60) +
+                                  "' names a problem: nlobs solve " + selector.substr(0, 60) + ")");
+    }
+    selections.push_back(select_problems(selector, problem_set_registry()));
+    const double t = reference::suite_threshold(*selections.back().set, options);
+    threshold =
+        selections.size() == 1 || t == threshold ? t : std::numeric_limits<double>::quiet_NaN();
+  }
+  int total = 0, before = 0;
+  for (const ProblemSelection& s : selections) {
+    for (const TestProblem& p : s.problems) total += static_cast<int>(p.starts.size());
+  }
+  std::vector<reference::SuiteRow> rows;
+  for (const ProblemSelection& s : selections) {
+    reference::SuiteOptions o = options;
+    if (args.progress) {
+      o.progress = [&, before](int done, int) {
+        err << "\rnlobs " << command << ": " << before + done << "/" << total
+            << " (problem, start) pairs" << std::flush;
+      };
+    }
+    const auto part = reference::run_suite(*s.set, s.problems, solvers, o);
+    for (const TestProblem& p : s.problems) before += static_cast<int>(p.starts.size());
+    rows.insert(rows.end(), part.begin(), part.end());
+  }
+  if (args.progress) err << '\n';
+  if (!args.csv.empty()) write_text_file(args.csv, suite_to_csv(rows), out);
+  if (args.json) {
+    out << suite_to_json(rows).dump(2) << '\n';
+  } else if (args.csv != "-") {
+    print_suite_tables(rows, threshold, out);
+  }
+}
+
+}  // namespace nlobs::cli

@@ -1,0 +1,28 @@
+#pragma once
+// `nlobs suite SET` and `nlobs solve SET/NAME …`: problems of the problem-set registry with every
+// listed engine and reference solver, one table (or JSON, or CSV).
+#include <iosfwd>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace nlobs::cli {
+
+struct SuiteArguments {
+  std::string solvers{};  // comma list of engine specs and references; empty: the default list
+  std::string starts{};   // comma list of start labels; empty: every start
+  double threshold = std::numeric_limits<double>::quiet_NaN();  // NaN: each set's own
+  long evaluations_per_dimension = 1000;
+  bool json = false;
+  std::string csv{};      // a file to write the CSV to ("-": stdout); empty: none
+  bool progress = false;  // a progress line on `err`
+};
+
+// Runs every selector ("SET", "SET/NAME", "SET/NAME:n=K") in turn and prints the table (or
+// the JSON array) to `out`; `command` ("suite" or "solve") names the command in messages.
+// Throws std::invalid_argument (an unknown set, problem, solver or start, a bad threshold) before
+// anything runs.
+void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArguments& args,
+                       const std::string& command, std::ostream& out, std::ostream& err);
+
+}  // namespace nlobs::cli

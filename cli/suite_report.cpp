@@ -1,0 +1,154 @@
+#include "suite_report.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <ostream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "run_support.hpp"
+
+namespace nlobs::cli {
+namespace {
+
+// 1e-08 as "1e-8": the threshold as a user types it.
+std::string short_number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  std::string s = text;
+  for (const char* from : {"e-0", "e+0"}) {
+    const std::size_t at = s.find(from);
+    if (at != std::string::npos) s.erase(at + 2, 1);
+  }
+  return s;
+}
+
+std::string number_text(double v) {
+  if (!std::isfinite(v)) return "";
+  std::ostringstream os;
+  os.precision(17);
+  os << v;
+  return os.str();
+}
+
+}  // namespace
+
+void print_suite_tables(const std::vector<reference::SuiteRow>& rows, double threshold,
+                        std::ostream& out) {
+  char line[320];
+  std::string current;
+  std::vector<std::string> order;
+  std::map<std::string, int> solved, pairs;
+  const bool any_error = std::any_of(
+      rows.begin(), rows.end(), [](const reference::SuiteRow& r) { return !std::isnan(r.error); });
+  for (const auto& r : rows) {
+    const std::string key = r.set + "/" + r.problem + " n=" + std::to_string(r.n) + " " + r.start;
+    if (current != key) {
+      current = key;
+      // A scaled standard start ("x10") reads as before: "start x 10".
+      const std::string scale = short_number(r.start_scale);
+      std::string start = "start ";
+      if (r.start.size() == scale.size() + 1 && r.start[0] == 'x' &&
+          r.start.compare(1, std::string::npos, scale) == 0) {
+        start += "x " + scale;
+      } else {
+        start += r.start;
+      }
+      std::snprintf(line, sizeof line, "\n%s n=%d (%s)\n  %-22s %-7s %-28s %10s %8s %8s %12s%s\n",
+                    r.problem.c_str(), r.n, start.c_str(), "solver", "solved", "status", "|F|2",
+                    "F evals", "J evals", "time [us]", any_error ? "  |x-x*|inf" : "");
+      out << line;
+    }
+    std::snprintf(line, sizeof line, "  %-22s %-7s %-28s %10.2e %8ld %8ld %12.1f", r.solver.c_str(),
+                  r.solved ? "yes" : "no", r.status.substr(0, 28).c_str(), r.residual, r.f_evals,
+                  r.j_evals, r.ns / 1e3);
+    out << line;
+    if (any_error) {
+      std::snprintf(line, sizeof line, " %11s", fmt(r.error, "%.2e").c_str());
+      out << line;
+    }
+    out << '\n';
+    if (!pairs.count(r.solver)) order.push_back(r.solver);
+    ++pairs[r.solver];
+    solved[r.solver] += r.solved;
+  }
+  out << "\nsolved (|F|2 <= "
+      << (std::isnan(threshold) ? std::string("each set's threshold") : short_number(threshold))
+      << " at the returned point), per solver:\n";
+  for (const auto& s : order) {
+    std::snprintf(line, sizeof line, "  %-22s %3d / %d\n", s.c_str(), solved[s], pairs[s]);
+    out << line;
+  }
+}
+
+nlohmann::json suite_to_json(const std::vector<reference::SuiteRow>& rows) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const auto& r : rows) {
+    a.push_back({{"set", r.set},
+                 {"problem", r.problem},
+                 {"n", r.n},
+                 {"start", r.start},
+                 {"start_scale", r.start_scale},
+                 {"solver", r.solver},
+                 {"solved", r.solved},
+                 {"residual", number_or_null(r.residual)},
+                 {"error", number_or_null(r.error)},
+                 {"f_evals", r.f_evals},
+                 {"j_evals", r.j_evals},
+                 {"ns", r.ns},
+                 {"status", r.status}});
+  }
+  return a;
+}
+
+std::string suite_to_csv(const std::vector<reference::SuiteRow>& rows) {
+  std::string out =
+      "set,problem,n,start,start_scale,solver,solved,residual,error,f_evals,j_evals,ns,status\n";
+  for (const auto& r : rows) {
+    out += csv_field(r.set) + ',' + csv_field(r.problem) + ',' + std::to_string(r.n) + ',' +
+           csv_field(r.start) + ',' + number_text(r.start_scale) + ',' + csv_field(r.solver) + ',' +
+           (r.solved ? "true" : "false") + ',' + number_text(r.residual) + ',' +
+           number_text(r.error) + ',' + std::to_string(r.f_evals) + ',' +
+           std::to_string(r.j_evals) + ',' + number_text(r.ns) + ',' + csv_field(r.status) + '\n';
+  }
+  return out;
+}
+
+void write_text_file(const std::string& path, const std::string& text, std::ostream& stdout_) {
+  if (path == "-") {
+    stdout_ << text;
+    return;
+  }
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    throw std::runtime_error("cannot write '" + path + "': it is a directory");
+  }
+  const std::string temporary = path + ".tmp-nlobs";
+  {
+    std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
+    if (!file) {
+      throw std::runtime_error("cannot write '" + path + "': " + std::strerror(errno));
+    }
+    file << text;
+    file.close();
+    if (!file) {
+      fs::remove(temporary, ec);
+      throw std::runtime_error("cannot write '" + path + "': the write failed");
+    }
+  }
+  fs::rename(temporary, path, ec);
+  if (ec) {
+    fs::remove(temporary, ec);
+    throw std::runtime_error("cannot write '" + path + "': " + ec.message());
+  }
+}
+
+}  // namespace nlobs::cli

@@ -1,0 +1,97 @@
+#pragma once
+// Problem sets: named lists of square systems F(x) = 0, or fixed points x = G(x), each with one
+// or more starts, optional box bounds and optional known solutions. `nlobs suite SET` runs every
+// listed engine and reference solver on every (problem, start) and judges all alike;
+// `nlobs solve SET/NAME` runs one problem. The built-in sets (chua-window, mgh) are registered
+// exactly as a user's set is (docs/extending.md).
+#include <Eigen/Core>
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "nlobs/registry/named_registry.hpp"
+#include "nlobs/solvers/problem.hpp"
+
+namespace nlobs {
+
+struct ProblemStart {
+  std::string label{};  // a column of the tables: "x1", "x10", "guess"
+  Eigen::VectorXd x{};  // of the problem's size, finite, inside the bounds
+  double scale = 1.0;   // the factor of a standard start (MGH: 1, 10, 100), `start_scale` in JSON
+};
+
+struct TestProblem {
+  // Unique in its set together with n; letters, digits and _ . + - (it is typed on the command
+  // line as SET/NAME or SET/NAME:n=K).
+  std::string name;
+  // F: Rⁿ → Rⁿ with a Jacobian (AD or the user's): what every solver is judged on (‖F(x)‖₂), and
+  // what the references (MINPACK, KINSOL Newton, GSL) solve.
+  RootProblem<Dynamic> residual;
+  // G, when the problem is posed as x = G(x) (then F(x) = G(x) − x): what our engines and
+  // KINSOL's fixed-point strategies iterate. Empty: G(x) = x + F(x) (to_fixed_point, Ψ = I).
+  std::optional<FixedPointProblem<Dynamic>> fixed_point{};
+  std::vector<ProblemStart> starts{};
+  // lower ≤ x ≤ upper, each empty for no bound on that side (±inf entries allowed): a point
+  // outside is not a solution (status `outside_bounds`).
+  Eigen::VectorXd lower{}, upper{};
+  // Known solutions: the suite reports the ∞-norm distance of the answer to the nearest one.
+  std::vector<Eigen::VectorXd> solutions{};
+  std::string description{};
+
+  Index size() const { return residual.size(); }
+};
+
+// F(x) = 0 with F generic in its scalar type (f(x, out) or out = f(x)): ∂F by forward-mode AD.
+template <typename F>
+TestProblem root_test_problem(std::string name, Index n, F f, std::vector<ProblemStart> starts) {
+  return TestProblem{.name = std::move(name),
+                     .residual = RootProblem<Dynamic>::with_autodiff(std::move(f), n, n),
+                     .starts = std::move(starts)};
+}
+
+// x = G(x) with G generic in its scalar type: G and F(x) = G(x) − x, both with AD Jacobians.
+template <typename G>
+TestProblem fixed_point_test_problem(std::string name, Index n, G g,
+                                     std::vector<ProblemStart> starts) {
+  auto f = [g](const auto& x, auto& out) mutable {
+    detail::invoke_map(g, x, out);
+    out -= x;
+  };
+  return TestProblem{.name = std::move(name),
+                     .residual = RootProblem<Dynamic>::with_autodiff(std::move(f), n, n),
+                     .fixed_point = FixedPointProblem<Dynamic>::with_autodiff(std::move(g), n),
+                     .starts = std::move(starts)};
+}
+
+// Throws InvalidInput naming `where` and the problem: a bad name, a non-square F or one without
+// a Jacobian, a fixed-point map of another size, no start, a start, bound or solution of the
+// wrong size, a non-finite start or solution, lower > upper, a start outside the bounds.
+void validate_test_problem(const TestProblem& problem, std::string_view where);
+
+struct ProblemSetEntry {
+  std::string name{};
+  std::string description{};
+  // Builds the problems when a run asks for them (a set may be large or slow to set up).
+  std::function<std::vector<TestProblem>()> problems{};
+  // The default of --threshold: solved when ‖F(x)‖₂ ≤ this at the returned point.
+  double solved_threshold = 1e-8;
+};
+
+NamedRegistry<ProblemSetEntry>& problem_set_registry();
+
+// The set's problems, each validated, (name, n) unique: InvalidInput "problem set 'S': …".
+std::vector<TestProblem> build_problem_set(const ProblemSetEntry& set);
+
+// "SET" (all its problems), "SET/NAME" (every size of NAME) or "SET/NAME:n=K": the problems it
+// selects. InvalidInput for an unknown set (listing the sets) or problem (listing the set's).
+struct ProblemSelection {
+  const ProblemSetEntry* set = nullptr;
+  std::vector<TestProblem> problems{};
+};
+ProblemSelection select_problems(std::string_view selector,
+                                 const NamedRegistry<ProblemSetEntry>& registry);
+
+}  // namespace nlobs

@@ -1,0 +1,162 @@
+#include "nlobs/registry/problem_sets.hpp"
+
+#include <cmath>
+#include <set>
+#include <sstream>
+
+#include "problem_sets/builtin_problem_sets.hpp"
+
+namespace nlobs {
+namespace {
+
+std::string shape(Index n) {
+  return std::to_string(n);
+}
+
+[[noreturn]] void fail(std::string_view where, const TestProblem& p, const std::string& what) {
+  std::ostringstream os;
+  os << where << ": problem '" << p.name << "' (n = " << p.residual.size() << "): " << what;
+  throw InvalidInput(os.str());
+}
+
+bool valid_name(const std::string& name) {
+  return !name.empty() && name.find_first_not_of(
+                              "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                              "0123456789_.+-") == std::string::npos;
+}
+
+}  // namespace
+
+void validate_test_problem(const TestProblem& p, std::string_view where) {
+  const Index n = p.residual.size();
+  if (!valid_name(p.name)) {
+    throw InvalidInput(std::string(where) + ": problem name '" + p.name +
+                       "' is empty or has characters other than letters, digits and _ . + -");
+  }
+  if (p.residual.residual_size() != n) {
+    fail(where, p,
+         "F has " + shape(p.residual.residual_size()) + " components for " + shape(n) +
+             " unknowns; a problem set holds square systems");
+  }
+  if (!p.residual.has_jacobian()) {
+    fail(where, p,
+         "F has no Jacobian (build it with_autodiff or with_jacobian): Newton and the "
+         "reference solvers need one");
+  }
+  if (p.fixed_point && p.fixed_point->size() != n) {
+    fail(where, p, "the fixed-point map G has size " + shape(p.fixed_point->size()));
+  }
+  if (p.starts.empty()) fail(where, p, "no start");
+  auto check_bound = [&](const Eigen::VectorXd& b, const char* side) {
+    if (b.size() != 0 && b.size() != n) {
+      fail(where, p, std::string(side) + " has size " + shape(b.size()));
+    }
+    for (Index i = 0; i < b.size(); ++i) {
+      if (std::isnan(b[i])) fail(where, p, std::string(side) + "[" + shape(i) + "] is NaN");
+    }
+  };
+  check_bound(p.lower, "lower");
+  check_bound(p.upper, "upper");
+  if (p.lower.size() == n && p.upper.size() == n) {
+    for (Index i = 0; i < n; ++i) {
+      if (!(p.lower[i] <= p.upper[i])) {
+        std::ostringstream os;
+        os << "lower[" << i << "] = " << p.lower[i] << " > upper[" << i << "] = " << p.upper[i];
+        fail(where, p, os.str());
+      }
+    }
+  }
+  std::set<std::string> labels;
+  for (const ProblemStart& s : p.starts) {
+    const std::string which = "start '" + s.label + "'";
+    if (s.label.empty()) fail(where, p, "a start without a label");
+    if (!labels.insert(s.label).second) fail(where, p, which + " is listed twice");
+    if (s.x.size() != n) fail(where, p, which + " has size " + shape(s.x.size()));
+    if (!s.x.allFinite()) fail(where, p, which + " is not finite");
+    if (!std::isfinite(s.scale)) fail(where, p, which + ": its scale is not finite");
+    for (Index i = 0; i < n; ++i) {
+      const bool below = p.lower.size() == n && s.x[i] < p.lower[i];
+      const bool above = p.upper.size() == n && s.x[i] > p.upper[i];
+      if (below || above) {
+        fail(where, p, which + ": x[" + shape(i) + "] is outside the bounds");
+      }
+    }
+  }
+  for (std::size_t k = 0; k < p.solutions.size(); ++k) {
+    const std::string which = "known solution " + std::to_string(k);
+    if (p.solutions[k].size() != n) {
+      fail(where, p, which + " has size " + shape(p.solutions[k].size()));
+    }
+    if (!p.solutions[k].allFinite()) fail(where, p, which + " is not finite");
+  }
+}
+
+NamedRegistry<ProblemSetEntry>& problem_set_registry() {
+  static NamedRegistry<ProblemSetEntry> registry = [] {
+    NamedRegistry<ProblemSetEntry> r("problem set");
+    detail::add_builtin_problem_sets(r);
+    return r;
+  }();
+  return registry;
+}
+
+std::vector<TestProblem> build_problem_set(const ProblemSetEntry& set) {
+  const std::string where = "problem set '" + set.name + "'";
+  if (!set.problems) throw InvalidInput(where + ": no function builds its problems");
+  if (!(set.solved_threshold > 0.0) || !std::isfinite(set.solved_threshold)) {
+    throw InvalidInput(where + ": solved_threshold must be finite and > 0");
+  }
+  std::vector<TestProblem> problems = set.problems();
+  if (problems.empty()) throw InvalidInput(where + ": it has no problems");
+  std::set<std::pair<std::string, Index>> seen;
+  for (const TestProblem& p : problems) {
+    validate_test_problem(p, where);
+    if (!seen.insert({p.name, p.size()}).second) {
+      fail(where, p, "listed twice (a name is unique per size)");
+    }
+  }
+  return problems;
+}
+
+ProblemSelection select_problems(std::string_view selector,
+                                 const NamedRegistry<ProblemSetEntry>& registry) {
+  const std::string text(selector);
+  const std::size_t slash = text.find('/');
+  const std::string set_name = text.substr(0, slash);
+  const ProblemSetEntry* set = registry.find(set_name);
+  if (!set) {
+    throw InvalidInput("unknown problem set '" + set_name.substr(0, 60) +
+                       "'; valid problem sets: " + registry.valid_list());
+  }
+  ProblemSelection out{set, build_problem_set(*set)};
+  if (slash == std::string::npos) return out;
+
+  std::string name = text.substr(slash + 1);
+  std::optional<Index> n;
+  if (const std::size_t colon = name.find(':'); colon != std::string::npos) {
+    const std::string size_text = name.substr(colon + 1);
+    name.resize(colon);
+    const bool digits = size_text.size() > 2 && size_text.size() <= 11 &&
+                        size_text.compare(0, 2, "n=") == 0 &&
+                        size_text.find_first_not_of("0123456789", 2) == std::string::npos;
+    if (!digits) {
+      throw InvalidInput("problem '" + text.substr(0, 60) +
+                         "': after the name, ':n=K' with K a positive integer selects a size");
+    }
+    n = std::stol(size_text.substr(2));
+  }
+  std::vector<TestProblem> chosen;
+  std::string names;
+  for (TestProblem& p : out.problems) {
+    names += (names.empty() ? "" : ", ") + p.name + ":n=" + std::to_string(p.size());
+    if (p.name == name && (!n || *n == p.size())) chosen.push_back(std::move(p));
+  }
+  if (chosen.empty()) {
+    throw InvalidInput("problem set '" + set->name + "' has no problem '" +
+                       text.substr(slash + 1, 60) + "'; its problems: " + names);
+  }
+  out.problems = std::move(chosen);
+  return out;
+}
+
+}  // namespace nlobs

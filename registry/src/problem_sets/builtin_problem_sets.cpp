@@ -1,0 +1,13 @@
+#include "builtin_problem_sets.hpp"
+
+#include "nlobs/registry/problem_sets/chua_window_set.hpp"
+#include "nlobs/registry/problem_sets/mgh_problems.hpp"
+
+namespace nlobs::detail {
+
+void add_builtin_problem_sets(NamedRegistry<ProblemSetEntry>& registry) {
+  registry.add(chua_window_problem_set());
+  registry.add(mgh_problem_set());
+}
+
+}  // namespace nlobs::detail

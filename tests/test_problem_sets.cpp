@@ -1,0 +1,374 @@
+// Problem sets nlobs does not ship: a user's two-problem set (a root problem with bounds and a
+// known solution, a fixed point) registered as the built-ins are, run by the suite with a user's
+// engine beside KINSOL and MINPACK, judged alike; every malformed problem refused naming it; the
+// CLI's table, JSON and CSV of such a set.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "nlobs/registry/problem_sets.hpp"
+#include "nlobs/solvers/engine_registry.hpp"
+#include "nlobs/solvers/fixed_point_engines.hpp"
+#include "reference/problem_suite.hpp"
+#include "suite_command.hpp"
+
+namespace nlobs {
+namespace {
+
+using reference::SuiteOptions;
+using reference::SuiteRow;
+
+// The circle x1² + x2² = 4 meets the line x1 = x2 at ±(√2, √2); the box [0, 3]² keeps one.
+TestProblem circle_and_line() {
+  TestProblem p =
+      root_test_problem("circle-line", 2,
+                        [](const auto& x, auto& f) {
+                          f[0] = x[0] * x[0] + x[1] * x[1] - 4.0;
+                          f[1] = x[0] - x[1];
+                        },
+                        {{"near", Eigen::Vector2d(1.0, 2.0)}, {"far", Eigen::Vector2d(3.0, 0.1)}});
+  p.lower = Eigen::Vector2d(0.0, 0.0);
+  p.upper = Eigen::Vector2d(3.0, 3.0);
+  p.solutions = {Eigen::Vector2d(std::sqrt(2.0), std::sqrt(2.0))};
+  return p;
+}
+
+// x = cos x (Dottie's number), three unknowns at once.
+TestProblem cosine_fixed_point() {
+  return fixed_point_test_problem("cosine", 3,
+                                  [](const auto& x, auto& g) {
+                                    using std::cos;
+                                    for (int i = 0; i < 3; ++i) g[i] = cos(x[i]);
+                                  },
+                                  {{"zero", Eigen::Vector3d::Zero()}});
+}
+
+// Throws from F at one point: the suite must turn it into a row, whichever solver meets it.
+TestProblem hostile() {
+  return root_test_problem("hostile", 1,
+                           [](const auto& x, auto& f) {
+                             if (x[0] > 0.5) throw std::runtime_error("the model left its domain");
+                             f[0] = x[0] - 1.0;
+                           },
+                           {{"x0", Eigen::VectorXd::Constant(1, 0.0)}});
+}
+
+// An engine a user registered: it throws while solving.
+class ThrowingEngine final : public Engine<Dynamic> {
+ public:
+  explicit ThrowingEngine(SolverOptions o) : Engine<Dynamic>(std::move(o)) {}
+  std::string_view name() const override { return "test-throws"; }
+  Summary solve(const FixedPointProblem<Dynamic>&, Vector<Dynamic>&) override {
+    throw std::runtime_error("a user's engine failed");
+  }
+};
+
+void register_once() {
+  static const bool done = [] {
+    problem_set_registry().add(
+        ProblemSetEntry{
+            .name = "test-set",
+            .description = "a test's two problems",
+            .problems =
+                [] {
+                  return std::vector<TestProblem>{circle_and_line(), cosine_fixed_point()};
+                }},
+        "test_problem_sets");
+    problem_set_registry().add(
+        ProblemSetEntry{.name = "test-hostile",
+                        .description = "F throws",
+                        .problems = [] { return std::vector<TestProblem>{hostile()}; }},
+        "test_problem_sets");
+    auto& engines = EngineRegistry<Dynamic>::global();
+    engines.add({"test-picard",
+                 "Picard under a user's name",
+                 {},
+                 {"test-picard"},
+                 [](EngineSpecReader&, SolverOptions o) -> std::unique_ptr<Engine<Dynamic>> {
+                   return std::make_unique<PicardEngine<Dynamic>>(o);
+                 }});
+    engines.add({"test-throws",
+                 "throws",
+                 {},
+                 {"test-throws"},
+                 [](EngineSpecReader&, SolverOptions o) -> std::unique_ptr<Engine<Dynamic>> {
+                   return std::make_unique<ThrowingEngine>(o);
+                 }});
+    return true;
+  }();
+  (void)done;
+}
+
+const SuiteRow& row(const std::vector<SuiteRow>& rows, const std::string& problem,
+                    const std::string& start, const std::string& solver) {
+  for (const SuiteRow& r : rows) {
+    if (r.problem == problem && r.start == start && r.solver == solver) return r;
+  }
+  throw std::logic_error("no row " + problem + " " + start + " " + solver);
+}
+
+TEST(ProblemSets, AUsersSetRunsEverySolverOnEveryStartJudgedAlike) {
+  register_once();
+  const ProblemSelection s = select_problems("test-set", problem_set_registry());
+  ASSERT_EQ(s.problems.size(), 2u);
+  const std::vector<std::string> solvers = {"newton", "test-picard", "kinsol:newton",
+                                            "minpack:hybrj", "kinsol:fp"};
+  const auto rows = reference::run_suite(*s.set, s.problems, solvers);
+  ASSERT_EQ(rows.size(), (2u + 1u) * solvers.size());
+  for (const SuiteRow& r : rows) {
+    SCOPED_TRACE(r.problem + " " + r.start + " " + r.solver);
+    EXPECT_EQ(r.set, "test-set");
+    EXPECT_EQ(r.solved, r.residual <= 1e-8 && r.status != "outside_bounds");
+  }
+  // Newton, KINSOL and MINPACK find (√2, √2) from the near start, inside the box.
+  for (const char* solver : {"newton", "kinsol:newton", "minpack:hybrj"}) {
+    const SuiteRow& r = row(rows, "circle-line", "near", solver);
+    EXPECT_TRUE(r.solved) << solver << " " << r.status;
+    EXPECT_LT(r.error, 1e-8) << solver;
+  }
+  // The fixed point: Picard iterates G = cos (a contraction), KINSOL's fixed point too.
+  for (const char* solver : {"test-picard", "kinsol:fp", "newton"}) {
+    const SuiteRow& r = row(rows, "cosine", "zero", solver);
+    EXPECT_TRUE(r.solved) << solver << " " << r.status;
+    EXPECT_TRUE(std::isnan(r.error));  // no known solution listed
+  }
+  // Picard on x + F (the circle problem has no contraction): not solved, said so.
+  EXPECT_FALSE(row(rows, "circle-line", "near", "test-picard").solved);
+}
+
+TEST(ProblemSets, APointOutsideTheBoundsIsNotASolution) {
+  register_once();
+  // x² = 1 in [-0.9, 2] from -0.5: Newton goes to -1, a root outside the box.
+  TestProblem p =
+      root_test_problem("square", 1, [](const auto& x, auto& f) { f[0] = x[0] * x[0] - 1.0; },
+                        {{"left", Eigen::VectorXd::Constant(1, -0.5)}});
+  p.lower = Eigen::VectorXd::Constant(1, -0.9);
+  p.upper = Eigen::VectorXd::Constant(1, 2.0);
+  const ProblemSetEntry set{.name = "one", .problems = [p] { return std::vector<TestProblem>{p}; }};
+  const auto rows = reference::run_suite(set, build_problem_set(set), {"newton"});
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].status, "outside_bounds");
+  EXPECT_FALSE(rows[0].solved);
+  EXPECT_LT(rows[0].residual, 1e-8);  // a root, but not in the box
+}
+
+TEST(ProblemSets, AThrowingProblemOrEngineIsARowNotTheEnd) {
+  register_once();
+  const ProblemSelection s = select_problems("test-hostile", problem_set_registry());
+  const std::vector<std::string> solvers = {"newton", "test-throws", "minpack:hybrj",
+                                            "kinsol:newton", "gsl:hybridsj"};
+  SuiteOptions options;
+  options.evaluations_per_dimension = 50;
+  const auto rows = reference::run_suite(*s.set, s.problems, solvers, options);
+  ASSERT_EQ(rows.size(), solvers.size());
+  EXPECT_EQ(row(rows, "hostile", "x0", "test-throws").status, "engine_threw");
+  for (const SuiteRow& r : rows) {
+    SCOPED_TRACE(r.solver);
+    EXPECT_FALSE(r.solved) << r.status;  // F throws beyond 0.5: the root 1 is out of reach
+  }
+}
+
+TEST(ProblemSets, MalformedProblemsAreRefusedNamingTheProblem) {
+  const auto refused = [](TestProblem p) -> std::string {
+    try {
+      validate_test_problem(p, "problem set 'x'");
+    } catch (const InvalidInput& e) {
+      return e.what();
+    }
+    return "<accepted>";
+  };
+  const auto expect = [&](TestProblem p, const std::string& part) {
+    const std::string m = refused(std::move(p));
+    EXPECT_NE(m.find("problem set 'x'"), std::string::npos) << m;
+    EXPECT_NE(m.find(part), std::string::npos) << m;
+  };
+  EXPECT_EQ(refused(circle_and_line()), "<accepted>");
+  TestProblem p = circle_and_line();
+  p.starts[0].x = Eigen::Vector3d::Zero();
+  expect(p, "start 'near' has size 3");
+  p = circle_and_line();
+  p.starts[1].x[0] = std::numeric_limits<double>::quiet_NaN();
+  expect(p, "start 'far' is not finite");
+  p = circle_and_line();
+  p.starts[1].x[0] = 5.0;
+  expect(p, "start 'far': x[0] is outside the bounds");
+  p = circle_and_line();
+  p.lower[1] = 4.0;
+  expect(p, "lower[1] = 4 > upper[1] = 3");
+  p = circle_and_line();
+  p.upper = Eigen::VectorXd::Zero(3);
+  expect(p, "upper has size 3");
+  p = circle_and_line();
+  p.starts.clear();
+  expect(p, "no start");
+  p = circle_and_line();
+  p.starts[1].label = "near";
+  expect(p, "start 'near' is listed twice");
+  p = circle_and_line();
+  p.solutions = {Eigen::VectorXd::Zero(1)};
+  expect(p, "known solution 0 has size 1");
+  p = circle_and_line();
+  p.name = "a b";
+  expect(p, "problem name 'a b'");
+  expect(TestProblem{.name = "no-jacobian",
+                     .residual = RootProblem<Dynamic>::from_map(
+                         [](const Eigen::VectorXd& x, Eigen::VectorXd& f) { f = x; }, 2, 2),
+                     .starts = {{"s", Eigen::Vector2d::Zero()}}},
+         "no Jacobian");
+  expect(TestProblem{.name = "not-square",
+                     .residual = RootProblem<Dynamic>::with_autodiff(
+                         [](const auto& x, auto& f) {
+                           f[0] = x[0];
+                           f[1] = x[1];
+                           f[2] = x[0] * x[1];
+                         },
+                         2, 3),
+                     .starts = {{"s", Eigen::Vector2d::Zero()}}},
+         "F has 3 components for 2 unknowns");
+  // A set listing one (name, n) twice, or nothing.
+  const ProblemSetEntry twice{
+      .name = "twice", .problems = [] {
+        return std::vector<TestProblem>{circle_and_line(), circle_and_line()};
+      }};
+  EXPECT_THROW(build_problem_set(twice), InvalidInput);
+  const ProblemSetEntry empty{.name = "empty",
+                              .problems = [] { return std::vector<TestProblem>{}; }};
+  EXPECT_THROW(build_problem_set(empty), InvalidInput);
+}
+
+TEST(ProblemSets, SelectorsNameSetsProblemsAndSizes) {
+  register_once();
+  const auto& sets = problem_set_registry();
+  EXPECT_EQ(select_problems("mgh/chebyquad", sets).problems.size(), 5u);
+  const auto seven = select_problems("mgh/chebyquad:n=7", sets);
+  ASSERT_EQ(seven.problems.size(), 1u);
+  EXPECT_EQ(seven.problems[0].size(), 7);
+  EXPECT_EQ(select_problems("chua-window", sets).problems.size(), 1u);
+  const auto message = [&](const std::string& selector) -> std::string {
+    try {
+      select_problems(selector, sets);
+    } catch (const InvalidInput& e) {
+      return e.what();
+    }
+    return "<accepted>";
+  };
+  const std::string no_problem = message("mgh/rosenbrok");
+  EXPECT_NE(no_problem.find("has no problem 'rosenbrok'"), std::string::npos) << no_problem;
+  EXPECT_NE(no_problem.find("rosenbrock:n=2"), std::string::npos) << no_problem;
+  const std::string no_set = message("mhg/rosenbrock");
+  EXPECT_NE(no_set.find("unknown problem set 'mhg'"), std::string::npos) << no_set;
+  EXPECT_NE(no_set.find("test-set"), std::string::npos) << no_set;
+  EXPECT_NE(message("mgh/chebyquad:n=x").find("':n=K'"), std::string::npos);
+  EXPECT_NE(message("mgh/chebyquad:n=4").find("has no problem"), std::string::npos);
+}
+
+TEST(ProblemSets, ADuplicateSetNameNamesBothSources) {
+  register_once();
+  try {
+    problem_set_registry().add(ProblemSetEntry{.name = "test-set"}, "another plugin");
+    FAIL() << "accepted";
+  } catch (const InvalidInput& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("another plugin"), std::string::npos) << m;
+    EXPECT_NE(m.find("test_problem_sets"), std::string::npos) << m;
+  }
+  EXPECT_EQ(problem_set_registry().source("test-set"), "test_problem_sets");
+}
+
+TEST(ProblemSets, TheChuaWindowSetIsTheFixedPointOfThePaper) {
+  const ProblemSelection s = select_problems("chua-window/window", problem_set_registry());
+  ASSERT_EQ(s.problems.size(), 1u);
+  const TestProblem& p = s.problems[0];
+  ASSERT_TRUE(p.fixed_point.has_value());
+  ASSERT_EQ(p.solutions.size(), 1u);
+  // G(x*) = x* and F(x*) = 0 at the true initial state; ∂F = ∂G − I.
+  Eigen::VectorXd g(3), f(3);
+  p.fixed_point->evaluate(p.solutions[0], g);
+  p.residual.evaluate(p.solutions[0], f);
+  EXPECT_LT((g - p.solutions[0]).norm(), 1e-12);
+  EXPECT_LT(f.norm(), 1e-12);
+  Eigen::MatrixXd jg, jf;
+  p.fixed_point->jacobian(p.starts[0].x, jg);
+  p.residual.jacobian(p.starts[0].x, jf);
+  EXPECT_LT((jf - (jg - Eigen::MatrixXd::Identity(3, 3))).norm(), 1e-12);
+  const auto rows = reference::run_suite(*s.set, s.problems, {"newton", "kinsol:fp-aa2"});
+  for (const SuiteRow& r : rows) {
+    if (r.start == "x1") {
+      EXPECT_TRUE(r.solved) << r.solver << " " << r.status;
+    }
+  }
+}
+
+TEST(ProblemSets, TheCliPrintsTheTableJsonAndCsvOfAUsersSet) {
+  register_once();
+  cli::SuiteArguments args;
+  args.solvers = "newton,kinsol:newton";
+  std::ostringstream out, err;
+  cli::run_problem_suite({"test-set"}, args, "suite", out, err);
+  EXPECT_NE(out.str().find("circle-line n=2 (start near)"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("|x-x*|inf"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("solved (|F|2 <= 1e-8 at the returned point)"), std::string::npos);
+
+  const auto csv = std::filesystem::temp_directory_path() / "nlobs_test_problem_sets.csv";
+  args.json = true;
+  args.csv = csv.string();
+  args.threshold = 1e-300;  // nothing but an exact root counts
+  std::ostringstream json_out;
+  cli::run_problem_suite({"test-set/cosine", "mgh/rosenbrock"}, args, "solve", json_out, err);
+  const auto rows = nlohmann::json::parse(json_out.str());
+  ASSERT_EQ(rows.size(), 2u * 1u + 2u * 3u);  // solvers x starts
+  for (const auto& r : rows) {
+    for (const char* key : {"set", "problem", "n", "start", "start_scale", "solver", "solved",
+                            "residual", "error", "f_evals", "j_evals", "ns", "status"}) {
+      ASSERT_TRUE(r.contains(key)) << key << " missing in " << r.dump();
+    }
+    // The threshold given is the one judged by.
+    EXPECT_EQ(r["solved"].get<bool>(),
+              r["residual"].is_number() && r["residual"].get<double>() <= 1e-300)
+        << r.dump();
+  }
+  std::ifstream file(csv);
+  std::string header, line;
+  std::getline(file, header);
+  EXPECT_EQ(header,
+            "set,problem,n,start,start_scale,solver,solved,residual,error,f_evals,j_evals,ns,"
+            "status");
+  int lines = 0;
+  while (std::getline(file, line)) ++lines;
+  EXPECT_EQ(lines, 8);
+  std::filesystem::remove(csv);
+
+  // Bad input, before anything runs.
+  args = {};
+  EXPECT_THROW(cli::run_problem_suite({"test-set/circle-line"}, args, "suite", out, err),
+               std::invalid_argument);
+  args.solvers = "newton,nonsense";
+  try {
+    cli::run_problem_suite({"test-set"}, args, "suite", out, err);
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown engine 'nonsense'"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("test-picard"), std::string::npos);  // a user's engine
+  }
+  args = {};
+  args.starts = "near,nowhere";
+  EXPECT_THROW(cli::run_problem_suite({"test-set"}, args, "suite", out, err),
+               std::invalid_argument);
+  args = {};
+  args.threshold = -1.0;
+  EXPECT_THROW(cli::run_problem_suite({"test-set"}, args, "suite", out, err), InvalidInput);
+  args = {};
+  args.csv = std::filesystem::temp_directory_path().string();  // a directory
+  EXPECT_THROW(cli::run_problem_suite({"test-set/cosine"}, args, "solve", out, err),
+               std::runtime_error);
+}
+
+}  // namespace
+}  // namespace nlobs
