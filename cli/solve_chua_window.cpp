@@ -17,12 +17,6 @@ namespace {
 
 using reference::KinsolStrategy;
 
-KinsolStrategy strategy_of(const std::string& name) {
-  if (name == "kinsol:fp") return KinsolStrategy::kFixedPoint;
-  if (name == "kinsol:fp-aa2") return KinsolStrategy::kFixedPointAnderson;
-  return KinsolStrategy::kNewtonLineSearch;
-}
-
 std::string kinsol_status(const reference::KinsolResult& r) {
   if (r.flag_name == "KIN_MAXITER_REACHED") return "max_iterations";
   std::string s = r.status();
@@ -56,7 +50,8 @@ SolveRow run_engine(const std::string& name, const reference::ChuaWindowCase& c,
 
 SolveRow run_kinsol(const std::string& name, const reference::ChuaWindowCase& c, double tol) {
   reference::KinsolOptions options;
-  options.strategy = strategy_of(name);
+  options.strategy =
+      reference::KinsolSolver::strategy(name).value_or(KinsolStrategy::kNewtonLineSearch);
   options.tolerance = tol;
   const auto solver = reference::make_kinsol_solver(c.problem, options);
   Eigen::VectorXd x = c.initial_guess;

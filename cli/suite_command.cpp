@@ -43,7 +43,7 @@ void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArg
   }
   int total = 0, before = 0;
   for (const ProblemSelection& s : selections) {
-    for (const TestProblem& p : s.problems) total += static_cast<int>(p.starts.size());
+    total += reference::count_suite_pairs(s.problems, options);
   }
   std::vector<reference::SuiteRow> rows;
   for (const ProblemSelection& s : selections) {
@@ -55,7 +55,7 @@ void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArg
       };
     }
     const auto part = reference::run_suite(*s.set, s.problems, solvers, o);
-    for (const TestProblem& p : s.problems) before += static_cast<int>(p.starts.size());
+    before += reference::count_suite_pairs(s.problems, options);
     rows.insert(rows.end(), part.begin(), part.end());
   }
   if (args.progress) err << '\n';

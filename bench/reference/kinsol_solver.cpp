@@ -143,6 +143,14 @@ std::string KinsolResult::status() const {
   return flag_name;
 }
 
+std::optional<KinsolStrategy> KinsolSolver::strategy(const std::string& name) {
+  for (KinsolStrategy s : {KinsolStrategy::kFixedPoint, KinsolStrategy::kFixedPointAnderson,
+                           KinsolStrategy::kNewtonLineSearch}) {
+    if (KinsolSolver::name(s) == name) return s;
+  }
+  return std::nullopt;
+}
+
 std::string KinsolSolver::name(KinsolStrategy strategy) {
   switch (strategy) {
     case KinsolStrategy::kFixedPoint:

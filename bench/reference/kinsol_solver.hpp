@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace nlobs::reference {
@@ -62,6 +63,8 @@ class KinsolSolver {
   KinsolResult solve(Eigen::VectorXd& x);
 
   static std::string name(KinsolStrategy strategy);
+  // The inverse of name(): "kinsol:fp", "kinsol:fp-aa2", "kinsol:newton"; none for another.
+  static std::optional<KinsolStrategy> strategy(const std::string& name);
 
  private:
   struct Impl;

@@ -30,12 +30,6 @@ bool is_reference(const std::string& s) {
   return std::find(refs.begin(), refs.end(), s) != refs.end();
 }
 
-KinsolStrategy kinsol_strategy(const std::string& solver) {
-  if (solver == "kinsol:fp") return KinsolStrategy::kFixedPoint;
-  if (solver == "kinsol:fp-aa2") return KinsolStrategy::kFixedPointAnderson;
-  return KinsolStrategy::kNewtonLineSearch;
-}
-
 // The C libraries (MINPACK, GSL, KINSOL) must never see an exception unwind through them: their
 // copies of a user's F, ∂F and G turn one into NaN, a non-finite evaluation they report.
 RootProblem<Dynamic> guarded(const RootProblem<Dynamic>& f) {
@@ -83,7 +77,7 @@ Outcome run_reference(const std::string& solver, const RootProblem<Dynamic>& res
     return {r.status, r.f_evals, r.j_evals};
   }
   KinsolOptions ko;
-  ko.strategy = kinsol_strategy(solver);
+  ko.strategy = KinsolSolver::strategy(solver).value_or(KinsolStrategy::kNewtonLineSearch);
   ko.tolerance = 1e-10;
   ko.max_iterations = budget;
   const int n = static_cast<int>(residual.size());
@@ -102,14 +96,6 @@ Outcome run_reference(const std::string& solver, const RootProblem<Dynamic>& res
   return {r.status(), r.evaluations, r.jacobian_evaluations};
 }
 
-bool inside(const TestProblem& p, const Eigen::VectorXd& x) {
-  for (Index i = 0; i < x.size(); ++i) {
-    if (p.lower.size() == x.size() && x[i] < p.lower[i]) return false;
-    if (p.upper.size() == x.size() && x[i] > p.upper[i]) return false;
-  }
-  return true;
-}
-
 double distance_to_solutions(const TestProblem& p, const Eigen::VectorXd& x) {
   if (p.solutions.empty()) return std::numeric_limits<double>::quiet_NaN();
   if (!x.allFinite()) return std::numeric_limits<double>::infinity();
@@ -120,7 +106,20 @@ double distance_to_solutions(const TestProblem& p, const Eigen::VectorXd& x) {
   return best;
 }
 
+bool selected(const ProblemStart& s, const SuiteOptions& options) {
+  return options.starts.empty() ||
+         std::find(options.starts.begin(), options.starts.end(), s.label) != options.starts.end();
+}
+
 }  // namespace
+
+int count_suite_pairs(const std::vector<TestProblem>& problems, const SuiteOptions& options) {
+  int total = 0;
+  for (const TestProblem& p : problems) {
+    for (const ProblemStart& s : p.starts) total += selected(s, options);
+  }
+  return total;
+}
 
 std::vector<std::string> default_suite_solvers() {
   std::vector<std::string> s = {
@@ -210,14 +209,7 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
                                   wanted.substr(0, 60) + "'; its starts: " + valid);
     }
   }
-  const auto selected = [&](const ProblemStart& s) {
-    return options.starts.empty() ||
-           std::find(options.starts.begin(), options.starts.end(), s.label) != options.starts.end();
-  };
-  int total = 0;
-  for (const TestProblem& p : problems) {
-    total += static_cast<int>(std::count_if(p.starts.begin(), p.starts.end(), selected));
-  }
+  const int total = count_suite_pairs(problems, options);
 
   int done = 0;
   std::vector<SuiteRow> rows;
@@ -229,7 +221,7 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
     const RootProblem<Dynamic> safe_f = guarded(p.residual);
     const FixedPointProblem<Dynamic> safe_g = guarded(g);
     for (const ProblemStart& start : p.starts) {
-      if (!selected(start)) continue;
+      if (!selected(start, options)) continue;
       for (const std::string& s : solvers) {
         SuiteRow row;
         row.set = set.name;
@@ -272,7 +264,7 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
           row.residual = std::numeric_limits<double>::infinity();
         }
         row.status = outcome.status;
-        const bool in_box = x.size() == n && inside(p, x);
+        const bool in_box = x.size() == n && !p.first_outside_bounds(x);
         if (!in_box) row.status = "outside_bounds";
         row.solved = in_box && row.residual <= threshold;
         row.error =

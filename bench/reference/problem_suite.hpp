@@ -55,6 +55,9 @@ std::vector<std::string> all_reference_solvers();
 // a value that is not finite and > 0.
 double suite_threshold(const ProblemSetEntry& set, const SuiteOptions& options);
 
+// The (problem, start) pairs run_suite runs: the starts options.starts selects.
+int count_suite_pairs(const std::vector<TestProblem>& problems, const SuiteOptions& options);
+
 // Throws std::invalid_argument for an unknown solver (listing the valid names, references
 // included) or an unknown start label, before anything runs.
 std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,

@@ -19,17 +19,11 @@ std::string shape(Index n) {
   throw InvalidInput(os.str());
 }
 
-bool valid_name(const std::string& name) {
-  return !name.empty() && name.find_first_not_of(
-                              "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
-                              "0123456789_.+-") == std::string::npos;
-}
-
 }  // namespace
 
 void validate_test_problem(const TestProblem& p, std::string_view where) {
   const Index n = p.residual.size();
-  if (!valid_name(p.name)) {
+  if (!is_registry_name(p.name)) {
     throw InvalidInput(std::string(where) + ": problem name '" + p.name +
                        "' is empty or has characters other than letters, digits and _ . + -");
   }
@@ -74,12 +68,8 @@ void validate_test_problem(const TestProblem& p, std::string_view where) {
     if (s.x.size() != n) fail(where, p, which + " has size " + shape(s.x.size()));
     if (!s.x.allFinite()) fail(where, p, which + " is not finite");
     if (!std::isfinite(s.scale)) fail(where, p, which + ": its scale is not finite");
-    for (Index i = 0; i < n; ++i) {
-      const bool below = p.lower.size() == n && s.x[i] < p.lower[i];
-      const bool above = p.upper.size() == n && s.x[i] > p.upper[i];
-      if (below || above) {
-        fail(where, p, which + ": x[" + shape(i) + "] is outside the bounds");
-      }
+    if (const auto i = p.first_outside_bounds(s.x)) {
+      fail(where, p, which + ": x[" + shape(*i) + "] is outside the bounds");
     }
   }
   for (std::size_t k = 0; k < p.solutions.size(); ++k) {

@@ -21,6 +21,14 @@ struct KeyInfo {
   std::string default_value;  // as text; empty: required (or no default)
 };
 
+// The name rule of every registry (and of a problem set's problems): non-empty, letters, digits
+// and _ . + - only, so that a name can be typed on a command line and in SET/NAME.
+inline bool is_registry_name(const std::string& name) {
+  return !name.empty() && name.find_first_not_of(
+                              "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                              "0123456789_.+-") == std::string::npos;
+}
+
 template <typename Entry>
 class NamedRegistry {
  public:
@@ -31,9 +39,7 @@ class NamedRegistry {
   // already registered (naming both sources). Entry must have a `name` member.
   void add(Entry entry, std::string source = "built-in") {
     const std::string& name = entry.name;
-    if (name.empty() ||
-        name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
-                               "0123456789_.+-") != std::string::npos) {
+    if (!is_registry_name(name)) {
       throw InvalidInput(kind_ + " name '" + name + "' from " + source +
                          " is empty or has characters other than letters, digits and _ . + -");
     }

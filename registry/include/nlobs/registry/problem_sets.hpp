@@ -42,6 +42,14 @@ struct TestProblem {
   std::string description{};
 
   Index size() const { return residual.size(); }
+  // The first component of x (of the problem's size) outside lower ≤ x ≤ upper; none inside.
+  std::optional<Index> first_outside_bounds(const Eigen::VectorXd& x) const {
+    for (Index i = 0; i < x.size(); ++i) {
+      if (lower.size() == x.size() && x[i] < lower[i]) return i;
+      if (upper.size() == x.size() && x[i] > upper[i]) return i;
+    }
+    return std::nullopt;
+  }
 };
 
 // F(x) = 0 with F generic in its scalar type (f(x, out) or out = f(x)): ∂F by forward-mode AD.
