@@ -5,9 +5,9 @@
 
 #include <memory>
 
+#include "nlobs/reference/kinsol_adapter.hpp"
 #include "nlobs/registry/problem_sets/chua_window_set.hpp"
 #include "nlobs/solvers/solvers.hpp"
-#include "reference/kinsol_adapter.hpp"
 
 namespace {
 

@@ -3,11 +3,11 @@
 #include <ostream>
 #include <stdexcept>
 
+#include "nlobs/reference/problem_suite.hpp"
 #include "nlobs/registry/model_registry.hpp"
 #include "nlobs/registry/observer_types.hpp"
 #include "nlobs/registry/problem_sets.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
-#include "reference/problem_suite.hpp"
 #include "scenario.hpp"
 #include "solve_chua_window.hpp"
 
@@ -83,7 +83,10 @@ void print_list(const std::string& what, std::ostream& out) {
   if (!all && what != "engines") return;
   out << "engines (spec: name[:word][,key=value...]):\n";
   for (const auto& e : EngineRegistry<Dynamic>::global().entries()) {
-    out << "  " << e.name << " — " << e.description << '\n';
+    out << "  " << e.name << " — " << e.description;
+    const std::string source = EngineRegistry<Dynamic>::global().source(e.name);
+    if (source != "built-in") out << "; from " << source;
+    out << '\n';
     for (const auto& o : e.options) out << "      " << o.key << ": " << o.description << '\n';
     out << "      e.g.";
     for (const auto& x : e.examples) out << ' ' << x;

@@ -14,8 +14,10 @@
 #include <vector>
 
 #include "list_command.hpp"
+#include "nlobs/common/version.hpp"
+#include "nlobs/reference/problem_suite.hpp"
+#include "nlobs/registry/plugin.hpp"
 #include "output_directory.hpp"
-#include "reference/problem_suite.hpp"
 #include "run_command.hpp"
 #include "scenario.hpp"
 #include "solve_chua_window.hpp"
@@ -93,7 +95,14 @@ void add_suite_options(CLI::App* app, nlobs::cli::SuiteArguments& a) {
 int main(int argc, char** argv) {
   CLI::App app{"nlobs: nonlinear state estimation — solvers and observers"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "nlobs 0.1.0");
+  app.set_version_flag("--version", "nlobs " NLOBS_VERSION_STRING);
+  // Before or after the subcommand: `nlobs --plugin p.so run x.json`, `nlobs run --plugin ...`.
+  app.fallthrough();
+  std::vector<std::string> plugins;
+  app.add_option("--plugin", plugins,
+                 "Load a plugin (a shared library built with nlobs_add_plugin); repeatable. "
+                 "NLOBS_PLUGIN_PATH (':'-separated files or directories) is loaded first")
+      ->type_name("PATH");
 
   // nlobs solve chua-window | nlobs solve PROBLEM...
   CLI::App* solve = app.add_subcommand(
@@ -177,6 +186,13 @@ int main(int argc, char** argv) {
   nlobs::cli::install_interrupt_cleanup();
 
   try {
+    // Plugins first: their models, engines, observer types and problem sets are then names like
+    // the built-ins' everywhere below. A refused plugin stops the run (kRunError).
+    if (const char* path = std::getenv("NLOBS_PLUGIN_PATH"); path != nullptr && *path != '\0') {
+      nlobs::load_plugin_path(path);
+    }
+    for (const std::string& plugin : plugins) nlobs::load_plugin(plugin);
+
     if (*chua) {
       const auto engines = specs_or(engines_arg, nlobs::cli::engine_names());
       const auto rows = nlobs::cli::solve_chua_window(engines, tolerance, !no_reference);

@@ -7,10 +7,10 @@
 #include <ostream>
 #include <stdexcept>
 
+#include "nlobs/reference/kinsol_adapter.hpp"
+#include "nlobs/reference/timing.hpp"
 #include "nlobs/registry/problem_sets/chua_window_set.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
-#include "reference/kinsol_adapter.hpp"
-#include "reference/timing.hpp"
 
 namespace nlobs::cli {
 namespace {

@@ -4,8 +4,8 @@
 #include <ostream>
 #include <stdexcept>
 
+#include "nlobs/reference/problem_suite.hpp"
 #include "nlobs/registry/problem_sets.hpp"
-#include "reference/problem_suite.hpp"
 #include "suite_report.hpp"
 
 namespace nlobs::cli {

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "reference/problem_suite.hpp"
+#include "nlobs/reference/problem_suite.hpp"
 
 namespace nlobs::cli {
 

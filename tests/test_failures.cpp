@@ -13,11 +13,11 @@
 #include "nlobs/observers/baselines/baselines.hpp"
 #include "nlobs/observers/core/simulation.hpp"
 #include "nlobs/observers/window/window_estimator.hpp"
+#include "nlobs/reference/kinsol_adapter.hpp"
+#include "nlobs/reference/root_reference.hpp"
 #include "nlobs/solvers/dynamic_size_engine.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 #include "nlobs/solvers/solvers.hpp"
-#include "reference/kinsol_adapter.hpp"
-#include "reference/root_reference.hpp"
 #include "test_support.hpp"
 
 namespace nlobs {

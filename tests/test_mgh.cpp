@@ -3,9 +3,9 @@
 
 #include <cmath>
 
+#include "nlobs/reference/problem_suite.hpp"
 #include "nlobs/registry/problem_sets/mgh_problems.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
-#include "reference/problem_suite.hpp"
 
 namespace nlobs::reference {
 namespace {

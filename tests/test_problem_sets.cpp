@@ -12,11 +12,12 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
+#include "nlobs/reference/problem_suite.hpp"
 #include "nlobs/registry/problem_sets.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 #include "nlobs/solvers/fixed_point_engines.hpp"
-#include "reference/problem_suite.hpp"
 #include "suite_command.hpp"
 
 namespace nlobs {
@@ -172,6 +173,35 @@ TEST(ProblemSets, AThrowingProblemOrEngineIsARowNotTheEnd) {
   for (const SuiteRow& r : rows) {
     SCOPED_TRACE(r.solver);
     EXPECT_FALSE(r.solved) << r.status;  // F throws beyond 0.5: the root 1 is out of reach
+  }
+}
+
+// F returns NaN beyond 0.5 without throwing (a model that leaves its domain quietly): every
+// solver gets a row, none claims the root, and a point where F is NaN is never "solved".
+TEST(ProblemSets, AProblemThatReturnsNanIsARowNeverASolution) {
+  const ProblemSetEntry set{
+      .name = "test-quiet-nan", .description = "F is NaN beyond 0.5", .problems = [] {
+        return std::vector<TestProblem>{root_test_problem(
+            "quiet-nan", 1,
+            [](const auto& x, auto& f) {
+              using T = std::decay_t<decltype(x[0])>;
+              f[0] = x[0] > 0.5 ? T(std::numeric_limits<double>::quiet_NaN()) : x[0] - 1.0;
+            },
+            {{"x0", Eigen::VectorXd::Constant(1, 0.0)}})};
+      }};
+  const std::vector<TestProblem> problems = build_problem_set(set);
+  const std::vector<std::string> solvers = {"newton",        "anderson",      "ceres",
+                                            "minpack:hybrj", "kinsol:newton", "gsl:hybridsj",
+                                            "gsl:gnewton"};
+  SuiteOptions options;
+  options.evaluations_per_dimension = 50;
+  const auto rows = reference::run_suite(set, problems, solvers, options);
+  ASSERT_EQ(rows.size(), solvers.size());
+  for (const SuiteRow& r : rows) {
+    SCOPED_TRACE(r.solver);
+    EXPECT_FALSE(r.solved) << r.status;
+    EXPECT_FALSE(r.status.empty());
+    EXPECT_FALSE(r.status == "converged" && !(r.residual <= 1e-8)) << r.residual;
   }
 }
 

@@ -8,7 +8,7 @@ if(rc)
   message(FATAL_ERROR "cmake --install failed (${rc})")
 endif()
 set(flags "")
-if(SANITIZE)  # the installed static libraries are instrumented: link the runtimes too
+if(SANITIZE)  # the installed libraries are instrumented: link the runtimes too
   set(flags "-fsanitize=address,undefined")
 endif()
 execute_process(COMMAND ${CMAKE_COMMAND} -S ${CONSUMER_SOURCE_DIR} -B ${WORK_DIR}/build
@@ -22,7 +22,7 @@ execute_process(COMMAND ${CMAKE_COMMAND} --build ${WORK_DIR}/build RESULT_VARIAB
 if(rc)
   message(FATAL_ERROR "building the consumer failed (${rc})")
 endif()
-foreach(program consumer consumer_engine_by_name consumer_window_estimator)
+foreach(program consumer consumer_engine_by_name consumer_window_estimator consumer_reference_suite)
   execute_process(COMMAND ${WORK_DIR}/build/${program} RESULT_VARIABLE rc)
   if(rc)
     message(FATAL_ERROR "the consumer's ${program} ran but failed (${rc})")

@@ -41,12 +41,13 @@ template <int N = Dynamic>
 class EngineRegistry {
  public:
   using Factory = std::function<std::unique_ptr<Engine<N>>(EngineSpecReader&, SolverOptions)>;
+  // Designated initialisers may leave out any field: {.name = ..., .make = ...}.
   struct Entry {
-    std::string name;
-    std::string description;
-    std::vector<EngineOptionInfo> options;  // engine-specific; the common ones are added
-    std::vector<std::string> examples;      // spec strings shown by `nlobs list engines`
-    Factory make;
+    std::string name{};
+    std::string description{};
+    std::vector<EngineOptionInfo> options{};  // engine-specific; the common ones are added
+    std::vector<std::string> examples{};      // spec strings shown by `nlobs list engines`
+    Factory make{};
   };
 
   // The process-wide registry, with every built-in engine.
@@ -68,8 +69,16 @@ class EngineRegistry {
     return common;
   }
 
-  // Throws InvalidInput if the name is empty, malformed or taken, or the factory is empty.
-  void add(Entry entry);
+  // Throws InvalidInput if the name is empty, malformed or taken (naming both sources), or the
+  // factory is empty. `source` says who registered it: "built-in", a plugin's path, a program.
+  void add(Entry entry, std::string source = "built-in");
+
+  // The source that registered `name` in this registry (empty when none did).
+  std::string source(const std::string& name) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = sources_.find(name);
+    return it == sources_.end() ? std::string() : it->second;
+  }
 
   // Whether create() knows the name (here or, for a fixed N, at Dynamic).
   bool contains(const std::string& name) const { return find(name).has_value(); }
@@ -117,24 +126,30 @@ class EngineRegistry {
   }
 
   EngineRegistry() = default;
-  EngineRegistry(EngineRegistry&& other) noexcept : entries_(std::move(other.entries_)) {}
+  EngineRegistry(EngineRegistry&& other) noexcept
+      : entries_(std::move(other.entries_)), sources_(std::move(other.sources_)) {}
 
   mutable std::mutex mutex_;
   std::map<std::string, Entry> entries_;
+  std::map<std::string, std::string> sources_;
 };
 
 template <int N>
-void EngineRegistry<N>::add(Entry entry) {
+void EngineRegistry<N>::add(Entry entry, std::string source) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (entry.name.empty() || entry.name.find_first_of(":,=") != std::string::npos) {
-    throw InvalidInput("engine name '" + entry.name + "' is empty or contains ':', ',' or '='");
+    throw InvalidInput("engine name '" + entry.name + "' from " + source +
+                       " is empty or contains ':', ',' or '='");
   }
-  if (entries_.count(entry.name)) {
-    throw InvalidInput("an engine named '" + entry.name + "' is already registered");
+  if (auto it = sources_.find(entry.name); it != sources_.end()) {
+    throw InvalidInput("engine '" + entry.name + "' from " + source + " is already registered by " +
+                       it->second);
   }
-  if (!entry.make) throw InvalidInput("engine '" + entry.name + "' has no factory");
+  if (!entry.make)
+    throw InvalidInput("engine '" + entry.name + "' from " + source + " has no factory");
   const std::string name = entry.name;
   entries_.emplace(name, std::move(entry));
+  sources_.emplace(name, std::move(source));
 }
 
 template <int N>

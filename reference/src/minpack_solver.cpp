@@ -2,7 +2,7 @@
 
 #include <vector>
 
-#include "reference/root_reference.hpp"
+#include "nlobs/reference/root_reference.hpp"
 
 namespace nlobs::reference {
 namespace {

@@ -1,4 +1,4 @@
-#include "reference/kinsol_solver.hpp"
+#include "nlobs/reference/kinsol_solver.hpp"
 
 #include <kinsol/kinsol.h>
 #include <kinsol/kinsol_ls.h>

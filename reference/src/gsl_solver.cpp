@@ -3,7 +3,7 @@
 
 #include <memory>
 
-#include "reference/root_reference.hpp"
+#include "nlobs/reference/root_reference.hpp"
 
 namespace nlobs::reference {
 namespace {

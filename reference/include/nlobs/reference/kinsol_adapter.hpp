@@ -3,8 +3,8 @@
 // the fixed-point strategies, F = G − x and ∂F = ∂G − I (the problem's own Jacobian) for Newton.
 #include <memory>
 
+#include "nlobs/reference/kinsol_solver.hpp"
 #include "nlobs/solvers/problem.hpp"
-#include "reference/kinsol_solver.hpp"
 
 namespace nlobs::reference {
 

@@ -1,4 +1,4 @@
-#include "reference/problem_suite.hpp"
+#include "nlobs/reference/problem_suite.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,11 +6,11 @@
 #include <set>
 #include <stdexcept>
 
+#include "nlobs/reference/kinsol_solver.hpp"
+#include "nlobs/reference/root_reference.hpp"
+#include "nlobs/reference/timing.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 #include "nlobs/solvers/root_adapter.hpp"
-#include "reference/kinsol_solver.hpp"
-#include "reference/root_reference.hpp"
-#include "reference/timing.hpp"
 
 namespace nlobs::reference {
 namespace {

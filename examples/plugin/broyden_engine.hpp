@@ -1,0 +1,175 @@
+#pragma once
+// Broyden's "good" method for F(x) = G(x) − x = 0, an engine nlobs does not ship (Broyden, Math.
+// Comp. 19, 1965; Dennis & Schnabel, Numerical Methods for Unconstrained Optimization, §8.1):
+//   H_0 = J_F(x_0)⁻¹,  s_k = −t_k H_k F(x_k)  (t_k: backtracking on ‖F‖₂²),
+//   H_{k+1} = H_k + (s_k − H_k y_k) s_kᵀ H_k / (s_kᵀ H_k y_k),  y_k = F(x_{k+1}) − F(x_k),
+// the Sherman–Morrison form of B_{k+1} = B_k + (y_k − B_k s_k) s_kᵀ / (s_kᵀ s_k): O(n²) per step.
+// The Jacobian is computed again (the problem's, or forward differences) when the line search
+// finds no decrease along the quasi-Newton direction or the update's denominator vanishes.
+// Fixed-size members: a solve at a fixed N allocates nothing.
+#include <Eigen/LU>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <string_view>
+
+#include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/finite_difference.hpp"
+#include "nlobs/solvers/stop_monitor.hpp"
+
+namespace example {
+
+struct BroydenOptions {
+  int max_backtracks = 10;            // halvings of the step before the Jacobian is renewed
+  double sufficient_decrease = 1e-4;  // c in ‖F(x + t s)‖² ≤ (1 − 2ct) ‖F(x)‖²
+};
+
+template <int N = nlobs::Dynamic>
+class BroydenEngine final : public nlobs::Engine<N> {
+ public:
+  using Vec = nlobs::Vector<N>;
+  using Mat = nlobs::Matrix<N, N>;
+
+  BroydenEngine(nlobs::SolverOptions options, BroydenOptions broyden)
+      : nlobs::Engine<N>(std::move(options)), broyden_(broyden) {
+    if (broyden_.max_backtracks < 0 || !(broyden_.sufficient_decrease > 0.0) ||
+        !(broyden_.sufficient_decrease < 0.5)) {
+      throw nlobs::InvalidInput(
+          "broyden: max_backtracks must be >= 0 and sufficient_decrease in (0, 0.5)");
+    }
+  }
+  std::string_view name() const override { return "broyden"; }
+
+  nlobs::Summary solve(const nlobs::FixedPointProblem<N>& problem, Vec& x) override {
+    nlobs::detail::check_initial_guess(name(), problem, x);
+    const nlobs::StopCriteria& stop = this->options().stop;
+    const nlobs::Index n = x.size();
+    if constexpr (N == nlobs::Dynamic) {
+      x_.resize(n), g_.resize(n), f_.resize(n), s_.resize(n), xt_.resize(n), ft_.resize(n);
+      hy_.resize(n), h_.resize(n, n), jac_.resize(n, n), fd_.resize(n);
+    }
+    nlobs::Summary summary;
+    summary.engine = name();
+    nlobs::StopMonitor monitor(stop, x.template lpNorm<Eigen::Infinity>(), false);
+    int evaluations = 0, jacobians = 0;
+    auto residual_at = [&](const Vec& at, Vec& f) {
+      problem.evaluate(at, g_);
+      ++evaluations;
+      nlobs::detail::check_output_size(problem, g_);
+      f = g_ - at;
+      return f.allFinite();
+    };
+    // H = J_F(x)⁻¹; false when J_F is not finite or (numerically) singular.
+    auto renew_inverse = [&]() {
+      if (problem.has_jacobian()) {
+        problem.jacobian(x_, jac_);
+      } else {
+        g_ = f_ + x_;
+        evaluations += nlobs::finite_difference_jacobian(problem, x_, g_, jac_,
+                                                         nlobs::FiniteDifference::kForward, fd_);
+      }
+      ++jacobians;
+      jac_.diagonal().array() -= 1.0;
+      if (!jac_.allFinite()) return false;
+      // A pivot below this fraction of the largest |J_ij|: singular, as NewtonEngine judges.
+      Eigen::PartialPivLU<Mat> lu(jac_);
+      const double smallest_pivot = lu.matrixLU().diagonal().cwiseAbs().minCoeff();
+      if (!(smallest_pivot > 1e-13 * jac_.cwiseAbs().maxCoeff())) return false;
+      h_ = lu.inverse();
+      return h_.allFinite();
+    };
+
+    x_ = x;
+    std::optional<nlobs::Status> status;
+    if (!residual_at(x_, f_)) status = nlobs::Status::kNonFinite;
+    double fnorm = f_.template lpNorm<Eigen::Infinity>();
+    if (!status && stop.residual_tolerance && fnorm <= *stop.residual_tolerance) {
+      status = nlobs::Status::kConverged;
+    }
+    bool fresh = false;  // H is the inverse of a Jacobian computed at x_
+    if (!status) {
+      fresh = renew_inverse();
+      if (!fresh) {
+        summary.message = "Jacobian of F is singular or not finite at the initial guess";
+        status = nlobs::Status::kSingularJacobian;
+      }
+    }
+    while (!status) {
+      if (evaluations >= stop.max_evaluations) {
+        status = nlobs::Status::kMaxEvaluations;
+        break;
+      }
+      s_ = -(h_ * f_);
+      double t = 1.0;
+      const double phi0 = f_.squaredNorm();
+      bool accepted = false;
+      for (int k = 0; k <= broyden_.max_backtracks && evaluations < stop.max_evaluations; ++k) {
+        xt_ = x_ + t * s_;
+        if (residual_at(xt_, ft_) &&
+            ft_.squaredNorm() <= (1.0 - 2.0 * broyden_.sufficient_decrease * t) * phi0) {
+          accepted = true;
+          break;
+        }
+        t *= 0.5;
+      }
+      if (!accepted) {
+        // At a root to rounding, no step decreases |F|: a full step below the step tolerance
+        // is the step criterion met (x stays where |F| is smallest).
+        const double full_step = s_.template lpNorm<Eigen::Infinity>();
+        if (stop.step_tolerance && full_step <= *stop.step_tolerance) {
+          status = monitor.update(full_step, fnorm, x_.template lpNorm<Eigen::Infinity>());
+          if (status) break;
+        }
+        if (evaluations >= stop.max_evaluations) {
+          status = nlobs::Status::kMaxEvaluations;
+        } else if (!fresh && renew_inverse()) {
+          fresh = true;  // a stale H: try again along the Newton direction
+          continue;
+        } else {
+          summary.message = "line search found no decrease of |F| along the Newton direction";
+          status = nlobs::Status::kStagnated;
+        }
+        break;
+      }
+      s_ *= t;
+      // y = F(x + s) − F(x), kept in f_ until f_ takes F(x + s).
+      f_ = ft_ - f_;
+      hy_ = h_ * f_;
+      const double denominator = s_.dot(hy_);
+      const double step = s_.template lpNorm<Eigen::Infinity>();
+      x_ = xt_;
+      f_ = ft_;
+      fnorm = f_.template lpNorm<Eigen::Infinity>();
+      status = monitor.update(step, fnorm, x_.template lpNorm<Eigen::Infinity>());
+      if (status) break;
+      if (std::abs(denominator) > 1e-14 * s_.norm() * hy_.norm() && std::isfinite(denominator)) {
+        h_ += ((s_ - hy_) / denominator) * (s_.transpose() * h_);
+        fresh = false;
+      } else {
+        fresh = renew_inverse();
+        if (!fresh) {
+          summary.message = "Jacobian of F is singular where the Broyden update broke down";
+          status = nlobs::Status::kSingularJacobian;
+        }
+      }
+    }
+    x = x_;
+    summary.status = *status;
+    summary.function_evaluations = evaluations;
+    summary.jacobian_evaluations = jacobians;
+    monitor.fill(summary, f_.allFinite() ? fnorm : std::numeric_limits<double>::infinity());
+    summary.record_answer(x, stop);
+    return summary;
+  }
+
+ private:
+  BroydenOptions broyden_;
+  Vec x_ = nlobs::zero_vector<N>(), g_ = nlobs::zero_vector<N>(), f_ = nlobs::zero_vector<N>(),
+      s_ = nlobs::zero_vector<N>(), xt_ = nlobs::zero_vector<N>(), ft_ = nlobs::zero_vector<N>(),
+      hy_ = nlobs::zero_vector<N>();
+  Mat h_, jac_;
+  nlobs::FiniteDifferenceWorkspace<N> fd_;
+};
+
+}  // namespace example

@@ -1,0 +1,25 @@
+// The engine's registry entry at Dynamic size: every fixed size falls back to it, so one
+// registration serves a window of any size and every problem of a set.
+#include <memory>
+
+#include "broyden_engine.hpp"
+#include "example_plugin.hpp"
+
+namespace example {
+
+void add_broyden(nlobs::PluginRegistrar& registrar) {
+  registrar.add_engine(
+      {.name = "broyden",
+       .description = "Broyden's good method with backtracking and Jacobian restarts "
+                      "(example plugin)",
+       .options = {{"backtracks", "step halvings before the Jacobian is renewed; default 10"}},
+       .examples = {"broyden", "broyden:backtracks=4"},
+       .make = [](nlobs::EngineSpecReader& spec,
+                  nlobs::SolverOptions options) -> std::unique_ptr<nlobs::Engine<>> {
+         BroydenOptions broyden;
+         if (auto k = spec.integer("backtracks", 0, 60)) broyden.max_backtracks = *k;
+         return std::make_unique<BroydenEngine<>>(std::move(options), broyden);
+       }});
+}
+
+}  // namespace example

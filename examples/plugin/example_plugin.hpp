@@ -1,0 +1,11 @@
+#pragma once
+// The example plugin's three registrations, one per file (they compile in parallel).
+#include "nlobs/registry/plugin.hpp"
+
+namespace example {
+
+void add_fitzhugh_nagumo(nlobs::PluginRegistrar& registrar);   // fitzhugh_nagumo_entry.cpp
+void add_broyden(nlobs::PluginRegistrar& registrar);           // broyden_entry.cpp
+void add_example_problems(nlobs::PluginRegistrar& registrar);  // example_problems.cpp
+
+}  // namespace example

@@ -1,0 +1,15 @@
+// The example plugin's entry point: `nlobs --plugin libnlobs_example_plugin.so list` shows a
+// model (fitzhugh-nagumo), an engine (broyden) and a problem set (example) beside the built-ins.
+#include "example_plugin.hpp"
+
+namespace {
+
+void register_example_plugin(nlobs::PluginRegistrar& registrar) {
+  example::add_fitzhugh_nagumo(registrar);
+  example::add_broyden(registrar);
+  example::add_example_problems(registrar);
+}
+
+}  // namespace
+
+NLOBS_PLUGIN(register_example_plugin)
