@@ -102,7 +102,8 @@ int main(int argc, char** argv) {
   app.add_option("--plugin", plugins,
                  "Load a plugin (a shared library built with nlobs_add_plugin); repeatable. "
                  "NLOBS_PLUGIN_PATH (':'-separated files or directories) is loaded first")
-      ->type_name("PATH");
+      ->type_name("PATH")
+      ->allow_extra_args(false);  // one path per --plugin: `run --plugin p.so x.json` keeps x.json
 
   // nlobs solve chua-window | nlobs solve PROBLEM...
   CLI::App* solve = app.add_subcommand(

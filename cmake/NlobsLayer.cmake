@@ -33,6 +33,7 @@ function(nlobs_shared_library_properties target)
   set_target_properties(${target} PROPERTIES
     VERSION ${PROJECT_VERSION}
     SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR}
-    INSTALL_RPATH "$ORIGIN")  # the other nlobs libraries lie beside it
+    INSTALL_RPATH "$ORIGIN"  # the other nlobs libraries lie beside it
+    INSTALL_RPATH_USE_LINK_PATH ON)  # and its dependencies where they were found (not /usr/lib)
   target_compile_options(${target} PRIVATE -fno-semantic-interposition)
 endfunction()

@@ -12,6 +12,7 @@
 #include <limits>
 #include <optional>
 #include <sstream>
+#include <string>
 #include <string_view>
 
 #include "nlobs/solvers/engine.hpp"
@@ -60,24 +61,34 @@ class BroydenEngine final : public nlobs::Engine<N> {
       f = g_ - at;
       return f.allFinite();
     };
-    // H = J_F(x)⁻¹; false when J_F is not finite or (numerically) singular.
-    auto renew_inverse = [&]() {
+    // H = J_F(x)⁻¹, or the status to stop with: kMaxEvaluations (differences would exceed the
+    // budget), kNonFinite, kSingularJacobian (with the message).
+    auto renew_inverse = [&](const char* where) -> std::optional<nlobs::Status> {
       if (problem.has_jacobian()) {
         problem.jacobian(x_, jac_);
       } else {
+        if (evaluations + static_cast<int>(n) > stop.max_evaluations) {
+          return nlobs::Status::kMaxEvaluations;
+        }
         g_ = f_ + x_;
         evaluations += nlobs::finite_difference_jacobian(problem, x_, g_, jac_,
                                                          nlobs::FiniteDifference::kForward, fd_);
       }
       ++jacobians;
       jac_.diagonal().array() -= 1.0;
-      if (!jac_.allFinite()) return false;
+      if (!jac_.allFinite()) {
+        summary.message = std::string("Jacobian of F is not finite ") + where;
+        return nlobs::Status::kNonFinite;
+      }
       // A pivot below this fraction of the largest |J_ij|: singular, as NewtonEngine judges.
       Eigen::PartialPivLU<Mat> lu(jac_);
       const double smallest_pivot = lu.matrixLU().diagonal().cwiseAbs().minCoeff();
-      if (!(smallest_pivot > 1e-13 * jac_.cwiseAbs().maxCoeff())) return false;
-      h_ = lu.inverse();
-      return h_.allFinite();
+      if (smallest_pivot > 1e-13 * jac_.cwiseAbs().maxCoeff()) {
+        h_ = lu.inverse();
+        if (h_.allFinite()) return std::nullopt;
+      }
+      summary.message = std::string("Jacobian of F is singular ") + where;
+      return nlobs::Status::kSingularJacobian;
     };
 
     x_ = x;
@@ -89,11 +100,8 @@ class BroydenEngine final : public nlobs::Engine<N> {
     }
     bool fresh = false;  // H is the inverse of a Jacobian computed at x_
     if (!status) {
-      fresh = renew_inverse();
-      if (!fresh) {
-        summary.message = "Jacobian of F is singular or not finite at the initial guess";
-        status = nlobs::Status::kSingularJacobian;
-      }
+      status = renew_inverse("at the initial guess");
+      fresh = !status;
     }
     while (!status) {
       if (evaluations >= stop.max_evaluations) {
@@ -114,18 +122,20 @@ class BroydenEngine final : public nlobs::Engine<N> {
         t *= 0.5;
       }
       if (!accepted) {
-        // At a root to rounding, no step decreases |F|: a full step below the step tolerance
-        // is the step criterion met (x stays where |F| is smallest).
+        // At a root to rounding, no step decreases |F|: a full Newton step (H fresh, not a
+        // stale Broyden update) below the step tolerance is the step criterion met; x stays
+        // where |F| is smallest.
         const double full_step = s_.template lpNorm<Eigen::Infinity>();
-        if (stop.step_tolerance && full_step <= *stop.step_tolerance) {
+        if (fresh && stop.step_tolerance && full_step <= *stop.step_tolerance) {
           status = monitor.update(full_step, fnorm, x_.template lpNorm<Eigen::Infinity>());
           if (status) break;
         }
         if (evaluations >= stop.max_evaluations) {
           status = nlobs::Status::kMaxEvaluations;
-        } else if (!fresh && renew_inverse()) {
-          fresh = true;  // a stale H: try again along the Newton direction
-          continue;
+        } else if (!fresh) {  // a stale H: try again along the Newton direction
+          status = renew_inverse("where the line search failed");
+          fresh = !status;
+          if (fresh) continue;
         } else {
           summary.message = "line search found no decrease of |F| along the Newton direction";
           status = nlobs::Status::kStagnated;
@@ -147,11 +157,8 @@ class BroydenEngine final : public nlobs::Engine<N> {
         h_ += ((s_ - hy_) / denominator) * (s_.transpose() * h_);
         fresh = false;
       } else {
-        fresh = renew_inverse();
-        if (!fresh) {
-          summary.message = "Jacobian of F is singular where the Broyden update broke down";
-          status = nlobs::Status::kSingularJacobian;
-        }
+        status = renew_inverse("where the Broyden update broke down");
+        fresh = !status;
       }
     }
     x = x_;

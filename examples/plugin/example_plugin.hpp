@@ -1,5 +1,5 @@
 #pragma once
-// The example plugin's three registrations, one per file (they compile in parallel).
+// The example plugin's registrations, one per file (they compile in parallel).
 #include "nlobs/registry/plugin.hpp"
 
 namespace example {
@@ -7,5 +7,6 @@ namespace example {
 void add_fitzhugh_nagumo(nlobs::PluginRegistrar& registrar);   // fitzhugh_nagumo_entry.cpp
 void add_broyden(nlobs::PluginRegistrar& registrar);           // broyden_entry.cpp
 void add_example_problems(nlobs::PluginRegistrar& registrar);  // example_problems.cpp
+void add_output_injection(nlobs::PluginRegistrar& registrar);  // output_injection_entry.cpp
 
 }  // namespace example

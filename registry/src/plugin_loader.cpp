@@ -1,8 +1,8 @@
 #include <dlfcn.h>
 
 #include <algorithm>
-#include <cstring>
 #include <filesystem>
+#include <optional>
 #include <set>
 #include <string>
 #include <system_error>
@@ -24,10 +24,9 @@ void check_names(const std::vector<Entry>& staged, const std::string& kind,
     if (!seen.insert(e.name).second) {
       throw InvalidInput(kind + " '" + e.name + "' is registered twice by " + source);
     }
-    const std::string other = taken_by(e.name);
-    if (!other.empty()) {
+    if (const std::optional<std::string> other = taken_by(e.name)) {
       throw InvalidInput(kind + " '" + e.name + "' from " + source + " is already registered by " +
-                         other);
+                         (other->empty() ? std::string("an unnamed source") : *other));
     }
   }
 }
@@ -42,16 +41,22 @@ void check_registry_names(const std::vector<Entry>& staged, const NamedRegistry<
     }
   }
   check_names(staged, registry.kind(), source,
-              [&registry](const std::string& name) { return registry.source(name); });
+              [&registry](const std::string& name) -> std::optional<std::string> {
+                if (!registry.contains(name)) return std::nullopt;
+                return registry.source(name);
+              });
 }
 
 // The source that has an engine of this name at any size the library serves (an entry at a
-// fixed size would shadow the plugin's Dynamic entry there).
-std::string engine_source(const std::string& name) {
-  std::string source = EngineRegistry<Dynamic>::global().source(name);
-#define NLOBS_ENGINE_SOURCE_AT(n)                                                        \
-  if (source.empty() && (n) != Dynamic && EngineRegistry<n>::global().has_entry(name)) { \
-    source = EngineRegistry<n>::global().source(name) + " (at size " #n ")";             \
+// fixed size would shadow the plugin's Dynamic entry there); none when the name is free.
+std::optional<std::string> engine_source(const std::string& name) {
+  if (EngineRegistry<Dynamic>::global().has_entry(name)) {
+    return EngineRegistry<Dynamic>::global().source(name);
+  }
+  std::optional<std::string> source;
+#define NLOBS_ENGINE_SOURCE_AT(n)                                                 \
+  if (!source && (n) != Dynamic && EngineRegistry<n>::global().has_entry(name)) { \
+    source = EngineRegistry<n>::global().source(name) + " (at size " #n ")";      \
   }
   NLOBS_FOR_EACH_LIBRARY_SIZE(NLOBS_ENGINE_SOURCE_AT)
 #undef NLOBS_ENGINE_SOURCE_AT
@@ -74,6 +79,9 @@ void check_staged(const PluginRegistrar& staged, const std::string& source) {
     if (!e.problems) {
       throw InvalidInput("problem set '" + e.name + "' from " + source + " has no problems()");
     }
+  }
+  for (const auto& e : staged.models()) {
+    if (!e.make) throw InvalidInput("model '" + e.name + "' from " + source + " has no make");
   }
   for (const auto& e : staged.observer_types()) {
     if (!e.parse || !e.write || !e.build) {
@@ -109,17 +117,10 @@ std::string quoted(const std::string& text) {
   return "'" + (text.size() > 200 ? text.substr(0, 200) + "…" : text) + "'";
 }
 
-// Unloads a refused library when it goes out of scope, after what it staged is gone.
-struct LibraryHandle {
-  void* handle = nullptr;
-  ~LibraryHandle() {
-    if (handle) dlclose(handle);
-  }
-};
-
 }  // namespace
 
 LoadedPlugin register_extensions(PluginRegistration registration, const std::string& source) {
+  if (source.empty()) throw InvalidInput("register_extensions: the source has no name");
   if (registration == nullptr) {
     throw InvalidInput(source + ": no registration function");
   }
@@ -146,8 +147,10 @@ LoadedPlugin load_plugin(const std::string& path) {
   const std::string named = "plugin " + quoted(path);
   std::error_code ec;
   if (path.empty()) throw InvalidInput("plugin path is empty");
-  if (!fs::exists(path, ec)) throw InvalidInput(named + ": no such file");
-  if (fs::is_directory(path, ec)) {
+  const fs::file_status status = fs::status(path, ec);
+  if (status.type() == fs::file_type::not_found) throw InvalidInput(named + ": no such file");
+  if (ec) throw InvalidInput(named + " cannot be read: " + ec.message());
+  if (fs::is_directory(status)) {
     throw InvalidInput(named + " is a directory (NLOBS_PLUGIN_PATH takes directories)");
   }
   // An absolute path: dlopen searches the library path for a name without '/', and the
@@ -156,19 +159,27 @@ LoadedPlugin load_plugin(const std::string& path) {
   const std::string file = ec ? path : absolute.lexically_normal().string();
   const std::string plugin = "plugin " + quoted(file);
 
+  // A library that loaded is never unloaded, refused or not: its static constructors have run,
+  // an exception or an entry may still refer to its code, and template statics (GNU unique
+  // symbols) would keep it mapped anyway. Nothing of a refused one is registered.
   dlerror();
-  LibraryHandle library{dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL)};
-  if (!library.handle) {
+  void* library = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (!library) {
     const char* why = dlerror();
     throw InvalidInput(plugin + " cannot be loaded: " + (why ? why : "dlopen failed"));
   }
   using InfoFunction = const PluginInfo* (*)();
-  void* symbol = dlsym(library.handle, kPluginSymbol);
+  void* symbol = dlsym(library, kPluginSymbol);
   if (!symbol) {
     throw InvalidInput(plugin + " is not an nlobs plugin: it exports no " + kPluginSymbol +
                        " (build it with nlobs_add_plugin and NLOBS_PLUGIN, docs/extending.md)");
   }
-  const PluginInfo* info = reinterpret_cast<InfoFunction>(symbol)();
+  const PluginInfo* info = nullptr;
+  try {
+    info = reinterpret_cast<InfoFunction>(symbol)();
+  } catch (...) {
+    throw InvalidInput(plugin + " is not an nlobs plugin: its " + kPluginSymbol + " threw");
+  }
   if (info == nullptr || info->magic != kPluginMagic) {
     throw InvalidInput(plugin + " is not an nlobs plugin: its " + kPluginSymbol +
                        " does not describe one");
@@ -188,14 +199,13 @@ LoadedPlugin load_plugin(const std::string& path) {
     throw InvalidInput(plugin + " was built with " + quoted(abi) + "; this nlobs with '" +
                        NLOBS_PLUGIN_ABI_TAG + "': rebuild it with the same compiler setup");
   }
-  LoadedPlugin loaded;
   try {
-    loaded = register_extensions(info->registration, file);
+    return register_extensions(info->registration, file);
   } catch (const InvalidInput& e) {
     throw InvalidInput(plugin + " refused: " + e.what());
+  } catch (const std::exception& e) {  // out of memory while its entries were added
+    throw InvalidInput(plugin + " could not be registered: " + e.what());
   }
-  library.handle = nullptr;  // its entries run its code: it stays loaded
-  return loaded;
 }
 
 std::vector<LoadedPlugin> load_plugin_path(const std::string& list) {
@@ -210,13 +220,17 @@ std::vector<LoadedPlugin> load_plugin_path(const std::string& list) {
     std::error_code ec;
     if (fs::is_directory(item, ec)) {
       std::vector<std::string> files;
-      for (const auto& entry : fs::directory_iterator(item, ec)) {
-        if (entry.path().extension() == ".so" && !entry.is_directory()) {
-          files.push_back(entry.path().string());
+      fs::directory_iterator it(item, ec), last;
+      for (; !ec && it != last; it.increment(ec)) {
+        std::error_code kind;
+        if (it->path().extension() == ".so" && !it->is_directory(kind)) {
+          files.push_back(it->path().string());
         }
       }
-      if (ec)
-        throw InvalidInput("NLOBS_PLUGIN_PATH directory " + quoted(item) + ": " + ec.message());
+      if (ec) {
+        throw InvalidInput("NLOBS_PLUGIN_PATH directory " + quoted(item) +
+                           " cannot be read: " + ec.message());
+      }
       std::sort(files.begin(), files.end());
       for (const auto& f : files) loaded.push_back(load_plugin(f));
     } else {

@@ -1,4 +1,4 @@
-// A plugin whose registration stages a model and an engine, then throws: nothing of it may be
+// A plugin whose registration stages an engine, then throws: nothing of it may be
 // registered, and the message names the plugin and the reason.
 #include <stdexcept>
 

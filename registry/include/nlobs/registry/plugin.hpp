@@ -97,16 +97,19 @@ struct LoadedPlugin {
 // Runs `registration` on a fresh registrar and commits what it staged under `source`: every
 // name is checked first (the registry's name rules; not taken, by a built-in, an earlier plugin
 // or another entry of the same registration), then everything is added. On any error nothing
-// is added. Throws InvalidInput naming `source` (a throwing registration included).
+// is added. Throws InvalidInput naming `source` (a throwing registration included, or an empty
+// `source`).
 LoadedPlugin register_extensions(PluginRegistration registration, const std::string& source);
 
 // Loads the shared library at `path` (RTLD_NOW: a missing symbol fails here, not mid-run),
 // checks its PluginInfo (magic, layout, nlobs version, ABI tag) and commits its registration
 // as register_extensions does. Throws InvalidInput naming the plugin: a path that does not
 // exist, a library that cannot be loaded, one that is not an nlobs plugin, one built against
-// another nlobs, a registration that throws or registers a taken name. A refused library is
-// unloaded; a loaded one stays for the life of the process. Loading the same file twice is an
-// error (its names are taken).
+// another nlobs, a registration that throws or registers a taken name. A library that dlopen
+// loaded stays mapped for the life of the process, refused or not (its code may still be
+// referred to); nothing of a refused one is registered. Loading the same file twice is an
+// error (its names are taken). A registration function must add through the registrar only:
+// what it adds to the global registries directly escapes the checks.
 LoadedPlugin load_plugin(const std::string& path);
 
 // The plugins a ':'-separated list names (NLOBS_PLUGIN_PATH): each item a plugin file, or a
