@@ -48,6 +48,10 @@ void print_suite_tables(const std::vector<reference::SuiteRow>& rows, double thr
   std::map<std::string, int> solved, pairs;
   const bool any_error = std::any_of(
       rows.begin(), rows.end(), [](const reference::SuiteRow& r) { return !std::isnan(r.error); });
+  // The solver column fits the longest spec ("levenberg-marquardt:geodesic=1"), within reason.
+  int width = 22;
+  for (const auto& r : rows)
+    width = std::max(width, static_cast<int>(std::min<std::size_t>(r.solver.size(), 48)));
   for (const auto& r : rows) {
     const std::string key = r.set + "/" + r.problem + " n=" + std::to_string(r.n) + " " + r.start;
     if (current != key) {
@@ -61,14 +65,14 @@ void print_suite_tables(const std::vector<reference::SuiteRow>& rows, double thr
       } else {
         start += r.start;
       }
-      std::snprintf(line, sizeof line, "\n%s n=%d (%s)\n  %-22s %-7s %-28s %10s %8s %8s %12s%s\n",
-                    r.problem.c_str(), r.n, start.c_str(), "solver", "solved", "status", "|F|2",
-                    "F evals", "J evals", "time [us]", any_error ? "  |x-x*|inf" : "");
+      std::snprintf(line, sizeof line, "\n%s n=%d (%s)\n  %-*s %-7s %-28s %10s %8s %8s %12s%s\n",
+                    r.problem.c_str(), r.n, start.c_str(), width, "solver", "solved", "status",
+                    "|F|2", "F evals", "J evals", "time [us]", any_error ? "  |x-x*|inf" : "");
       out << line;
     }
-    std::snprintf(line, sizeof line, "  %-22s %-7s %-28s %10.2e %8ld %8ld %12.1f", r.solver.c_str(),
-                  r.solved ? "yes" : "no", r.status.substr(0, 28).c_str(), r.residual, r.f_evals,
-                  r.j_evals, r.ns / 1e3);
+    std::snprintf(line, sizeof line, "  %-*s %-7s %-28s %10.2e %8ld %8ld %12.1f", width,
+                  r.solver.substr(0, 48).c_str(), r.solved ? "yes" : "no",
+                  r.status.substr(0, 28).c_str(), r.residual, r.f_evals, r.j_evals, r.ns / 1e3);
     out << line;
     if (any_error) {
       std::snprintf(line, sizeof line, " %11s", fmt(r.error, "%.2e").c_str());
@@ -83,7 +87,8 @@ void print_suite_tables(const std::vector<reference::SuiteRow>& rows, double thr
       << (std::isnan(threshold) ? std::string("each set's threshold") : short_number(threshold))
       << " at the returned point), per solver:\n";
   for (const auto& s : order) {
-    std::snprintf(line, sizeof line, "  %-22s %3d / %d\n", s.c_str(), solved[s], pairs[s]);
+    std::snprintf(line, sizeof line, "  %-*s %3d / %d\n", width, s.substr(0, 48).c_str(), solved[s],
+                  pairs[s]);
     out << line;
   }
 }

@@ -86,8 +86,11 @@ TEST(Allocations, FixedSizeSolvesAllocateNothing) {
   NewtonEngine<3> newton({}, o);
   NewtonEngine<3> newton_ls({.line_search = true}, o);
   CeresEngine<3> tiny({.backend = CeresOptions::Backend::kTinySolver}, o);
+  DoglegEngine<3> dogleg({}, o);
+  // Its residual and Jacobian workspaces have m rows: sized by the warm-up, reused after.
+  LevenbergMarquardtEngine<3> lm({}, o);
   for (Engine<3>* e : std::initializer_list<Engine<3>*>{&picard, &aitken, &steffensen, &anderson,
-                                                        &newton, &newton_ls, &tiny}) {
+                                                        &newton, &newton_ls, &tiny, &dogleg, &lm}) {
     EXPECT_EQ(allocations_during_solve(*e, cw.problem), 0) << e->name();
   }
 }

@@ -679,6 +679,27 @@ TEST(References, KinsolCountsDifferenceQuotientEvaluations) {
   EXPECT_GE(r.evaluations, r.iterations + 2 * r.jacobian_evaluations) << r.iterations;
 }
 
+TEST(References, KinsolsMaximumStepRuleFailsFromZeroAndTheSuitesDoesNot) {
+  // F(u) = u − 50 from u₀ = 0: KINSOL's default maximum step is 1000 ‖u₀‖₂ but at least 1, so
+  // the Newton step 50 is cut to 1 five times in a row: KIN_MXNEWT_5X_EXCEEDED.
+  const auto shifted = FixedPointProblem<>::with_jacobian(
+      [](const Eigen::VectorXd& u, Eigen::VectorXd& g) { g = 2.0 * u.array() - 50.0; },
+      [](const Eigen::VectorXd&, Eigen::MatrixXd& j) { j.setConstant(1, 1, 2.0); }, 1);
+  reference::KinsolOptions ko;
+  ko.strategy = reference::KinsolStrategy::kNewtonLineSearch;
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(1);
+  const reference::KinsolResult by_default = reference::make_kinsol_solver(shifted, ko)->solve(u);
+  EXPECT_FALSE(by_default.success);
+  EXPECT_EQ(by_default.flag_name, "KIN_MXNEWT_5X_EXCEEDED");
+  ko.max_newton_step = 1000.0;  // the suite's 1000 max(1, ‖u₀‖₂)
+  u.setZero();
+  const reference::KinsolResult wider = reference::make_kinsol_solver(shifted, ko)->solve(u);
+  EXPECT_TRUE(wider.success) << wider.flag_name;
+  EXPECT_NEAR(u[0], 50.0, 1e-10);
+  ko.max_newton_step = -1.0;
+  EXPECT_THROW(reference::make_kinsol_solver(shifted, ko), std::invalid_argument);
+}
+
 TEST(References, StepTestsAloneAreNotSuccess) {
   // F(x) = x³ − 2 from x = 10 with a loose step tolerance (xtol 0.1 for hybrj; GSL's step test
   // 1e-3): the solvers stop on the step with |F| far above residual_tolerance (1e-8).
@@ -690,6 +711,7 @@ TEST(References, StepTestsAloneAreNotSuccess) {
       1, 1);
   reference::ReferenceOptions loose;
   loose.tolerance = 0.1;
+  loose.minpack_xtol = 0.1;
   Eigen::VectorXd x = Eigen::VectorXd::Constant(1, 10.0);
   const reference::ReferenceResult minpack = reference::solve_minpack_hybrj(f, x, loose);
   EXPECT_EQ(minpack.status, "residual_above_tolerance") << "x = " << x[0];

@@ -55,6 +55,9 @@ struct KinsolSolver::Impl {
 
 KinsolSolver::KinsolSolver(int n, KinsolOptions options, Function function, Jacobian jacobian)
     : impl_(std::make_unique<Impl>()) {
+  if (!(options.max_newton_step >= 0.0 && std::isfinite(options.max_newton_step))) {
+    throw std::invalid_argument("KinsolOptions::max_newton_step must be finite and >= 0");
+  }
   Impl& s = *impl_;
   s.n = n;
   s.options = options;
@@ -104,6 +107,9 @@ KinsolResult KinsolSolver::solve(Eigen::VectorXd& x) {
   Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(s.u), s.n) = x;
   const int strategy =
       s.options.strategy == KinsolStrategy::kNewtonLineSearch ? KIN_LINESEARCH : KIN_FP;
+  if (s.options.strategy == KinsolStrategy::kNewtonLineSearch) {
+    s.check(KINSetMaxNewtonStep(s.kinsol, s.options.max_newton_step), "KINSetMaxNewtonStep");
+  }
   KinsolResult r;
   s.calls = 0;
   r.flag = KINSol(s.kinsol, s.u, strategy, s.scale, s.scale);

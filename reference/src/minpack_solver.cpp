@@ -38,11 +38,12 @@ ReferenceResult solve_minpack_hybrj(const RootProblem<Dynamic>& problem, Eigen::
   std::vector<double> fvec(n), fjac(n * n), diag(n, 1.0), r(n * (n + 1) / 2), qtf(n), wa1(n),
       wa2(n), wa3(n), wa4(n);
   int nfev = 0, njev = 0;
-  // mode 1: internal scaling; factor 100 and no printing, as MINPACK's hybrj1 driver.
-  const int info = hybrj(&callback, &c, n, x.data(), fvec.data(), fjac.data(), n, options.tolerance,
-                         static_cast<int>(options.max_evaluations), diag.data(), 1, 100.0, 0, &nfev,
-                         &njev, r.data(), static_cast<int>(r.size()), qtf.data(), wa1.data(),
-                         wa2.data(), wa3.data(), wa4.data());
+  // As hybrj1 calls it: mode 2 with diag = 1 (the variables as given: no rescaling by the
+  // Jacobian's column norms, which mode 1 would do), factor 100, no printing.
+  const int info = hybrj(
+      &callback, &c, n, x.data(), fvec.data(), fjac.data(), n, options.minpack_xtol,
+      static_cast<int>(options.max_evaluations), diag.data(), 2, 100.0, 0, &nfev, &njev, r.data(),
+      static_cast<int>(r.size()), qtf.data(), wa1.data(), wa2.data(), wa3.data(), wa4.data());
   ReferenceResult result;
   result.f_evals = nfev;
   result.j_evals = njev;

@@ -22,6 +22,10 @@ struct KinsolOptions {
   double tolerance = 1e-8;  // KINSOL's fnormtol (‖F‖∞, or ‖G(u)−u‖∞ for FP) and scsteptol
   int anderson_depth = 2;
   long max_iterations = 10000;
+  // KINSetMaxNewtonStep (Newton only): the largest scaled step ‖Δu‖₂. 0 keeps KINSOL's rule,
+  // 1000 ‖u₀‖₂ but at least 1 (kinsol.c, KINSolInit), which at u₀ = 0 allows steps of length 1
+  // only and ends runs with KIN_MXNEWT_5X_EXCEEDED; the suite passes 1000 max(1, ‖u₀‖₂).
+  double max_newton_step = 0.0;
 };
 
 struct KinsolResult {

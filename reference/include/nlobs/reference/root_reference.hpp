@@ -3,6 +3,7 @@
 // analytic (AD) Jacobian: MINPACK hybrj, GSL hybridsj and gnewton. (KINSOL: kinsol_solver.hpp.)
 #include <Eigen/Core>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <string>
 
@@ -17,7 +18,9 @@ struct ReferenceResult {
 };
 
 struct ReferenceOptions {
-  double tolerance = 1e-10;  // hybrj: xtol; GSL: residual test sum|F_i| < tol and step test
+  double tolerance = 1e-10;  // GSL: residual test sum|F_i| < tol and step test
+  // hybrj's xtol: √ε, what MINPACK's test driver gives hybrj1 (tests/data/minpack/README.md).
+  double minpack_xtol = std::sqrt(std::numeric_limits<double>::epsilon());
   long max_evaluations = 10000;
   // A solver's "converged" stands only for a finite point with ‖F‖∞ ≤ residual_tolerance
   // (checked by one more evaluation, counted): hybrj's xtol test and GSL's step test stop on
@@ -44,7 +47,11 @@ inline void check_answer(const RootProblem<Dynamic>& problem, const Eigen::Vecto
   }
 }
 
-// MINPACK hybrj (Powell hybrid method, user Jacobian), through cminpack.
+// MINPACK hybrj (Powell hybrid method, user Jacobian), through cminpack, configured as hybrj1
+// (MINPACK's easy-to-use driver, which its published test driver runs): mode 2 with diag = 1
+// (no internal rescaling), factor = 100, xtol = options.minpack_xtol (√ε); maxfev is
+// options.max_evaluations (hybrj1: 100 (n + 1); the suite's budget otherwise). f_evals counts
+// hybrj's own evaluations plus check_answer's one.
 ReferenceResult solve_minpack_hybrj(const RootProblem<Dynamic>& problem, Eigen::VectorXd& x,
                                     const ReferenceOptions& options);
 

@@ -9,17 +9,19 @@
 #include <utility>
 
 #include "nlobs/solvers/ceres_engine.hpp"
+#include "nlobs/solvers/dogleg_engine.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 #include "nlobs/solvers/fixed_point_engines.hpp"
+#include "nlobs/solvers/levenberg_marquardt_engine.hpp"
 #include "nlobs/solvers/newton_engine.hpp"
 #include "nlobs/solvers/nlopt_engine.hpp"
 
 namespace nlobs {
 namespace detail {
-inline FiniteDifference parse_finite_difference(const std::string& v) {
+inline FiniteDifference parse_finite_difference(const char* engine, const std::string& v) {
   if (v == "central") return FiniteDifference::kCentral;
   if (v == "forward") return FiniteDifference::kForward;
-  throw InvalidInput("newton: fd=" + v + " is not forward or central");
+  throw InvalidInput(std::string(engine) + ": fd=" + v + " is not forward or central");
 }
 }  // namespace detail
 
@@ -68,8 +70,64 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
        [](EngineSpecReader& s, SolverOptions o) {
          NewtonOptions n;
          if (auto v = s.boolean("linesearch")) n.line_search = *v;
-         if (auto v = s.text("fd")) n.finite_difference = detail::parse_finite_difference(*v);
+         if (auto v = s.text("fd"))
+           n.finite_difference = detail::parse_finite_difference("newton", *v);
          return std::make_unique<NewtonEngine<N>>(n, std::move(o));
+       }});
+  add({"dogleg",
+       "Powell's hybrid method (MINPACK hybrj): trust region, dogleg steps, Broyden updates",
+       {{"scale",
+         "none|jacobian: trust-region scaling D = I or Jacobian column norms "
+         "(MINPACK mode 2|1); default none"},
+        {"factor", "initial radius factor * |D x0|; default 100"},
+        {"broyden", "0/1 Broyden updates between Jacobians; default 1"},
+        {"fd", "forward|central differences when no Jacobian; default central"}},
+       {"dogleg", "dogleg:scale=jacobian"},
+       [](EngineSpecReader& s, SolverOptions o) {
+         DoglegOptions d;
+         if (auto v = s.text("scale")) {
+           if (*v == "none")
+             d.scaling = DoglegOptions::Scaling::kNone;
+           else if (*v == "jacobian")
+             d.scaling = DoglegOptions::Scaling::kJacobianColumns;
+           else
+             throw InvalidInput("dogleg: scale=" + *v + " is not none or jacobian");
+         }
+         if (auto v = s.number("factor")) d.initial_radius_factor = *v;
+         if (auto v = s.boolean("broyden")) d.broyden_updates = *v;
+         if (auto v = s.text("fd"))
+           d.finite_difference = detail::parse_finite_difference("dogleg", *v);
+         return std::make_unique<DoglegEngine<N>>(d, std::move(o));
+       }});
+  add({"levenberg-marquardt",
+       "Levenberg-Marquardt as MINPACK lmder (More's lambda and scaling), square or least "
+       "squares",
+       {{"scale", "none|jacobian: D = I or Jacobian column norms (More); default none"},
+        {"factor", "initial radius factor * |D x0|; default 100"},
+        {"geodesic", "0/1 geodesic acceleration (Transtrum-Sethna); default 0"},
+        {"ftol", "relative reduction of |F|^2 (least squares); default 1e-10"},
+        {"gtol", "cosine of F and the columns of J; default 1e-12"},
+        {"fd", "forward|central differences when no Jacobian; default central"}},
+       {"levenberg-marquardt", "levenberg-marquardt:geodesic=1",
+        "levenberg-marquardt:scale=jacobian"},
+       [](EngineSpecReader& s, SolverOptions o) {
+         LevenbergMarquardtOptions l;
+         if (auto v = s.text("scale")) {
+           if (*v == "jacobian")
+             l.scale_by_jacobian_columns = true;
+           else if (*v == "none")
+             l.scale_by_jacobian_columns = false;
+           else
+             throw InvalidInput("levenberg-marquardt: scale=" + *v + " is not none or jacobian");
+         }
+         if (auto v = s.number("factor")) l.initial_radius_factor = *v;
+         if (auto v = s.boolean("geodesic")) l.geodesic_acceleration = *v;
+         if (auto v = s.number("ftol")) l.function_tolerance = *v;
+         if (auto v = s.number("gtol")) l.gradient_tolerance = *v;
+         if (auto v = s.text("fd")) {
+           l.finite_difference = detail::parse_finite_difference("levenberg-marquardt", *v);
+         }
+         return std::make_unique<LevenbergMarquardtEngine<N>>(l, std::move(o));
        }});
   add({"ceres",
        "Ceres least squares, Levenberg-Marquardt or dogleg",

@@ -5,10 +5,12 @@
 //   nlobs/solvers/engine_registry.hpp
 #include "nlobs/solvers/accelerated_engine.hpp"
 #include "nlobs/solvers/contraction.hpp"
+#include "nlobs/solvers/dogleg_engine.hpp"
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/engine_spec.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
 #include "nlobs/solvers/fixed_point_engines.hpp"
+#include "nlobs/solvers/levenberg_marquardt_engine.hpp"
 #include "nlobs/solvers/newton_engine.hpp"
 #include "nlobs/solvers/objective_problem.hpp"
 #include "nlobs/solvers/problem.hpp"

@@ -24,7 +24,11 @@ class StopMonitor {
 
   // After each completed iteration: the step ‖x_l − x_{l−1}‖∞, the residual ‖G − x‖∞ at the
   // last evaluated point (NaN when unknown) and ‖x_l‖∞. Returns the final status or nullopt.
-  std::optional<Status> update(double step, double residual, double iterate_norm) {
+  // step_may_converge = false: the step was cut short by the engine (a trust region's radius),
+  // so its smallness says nothing about the distance to a root; the step criterion is not
+  // applied to it (the residual criterion still is).
+  std::optional<Status> update(double step, double residual, double iterate_norm,
+                               bool step_may_converge = true) {
     ++iterations_;
     last_step_ = step;
     if (prev_step_ > 0.0) {
@@ -32,7 +36,9 @@ class StopMonitor {
       ++ratio_count_;
     }
     if (iterate_norm > limit_) return Status::kDiverged;
-    if (converged(step, residual)) return Status::kConverged;
+    if (converged(step_may_converge ? step : std::numeric_limits<double>::infinity(), residual)) {
+      return Status::kConverged;
+    }
 
     zero_steps_ = (step == 0.0) ? zero_steps_ + 1 : 0;
     if (c_.stop_on_repeated_iterates && zero_steps_ >= 2) {

@@ -1,0 +1,514 @@
+#pragma once
+// Levenberg–Marquardt for F(x) = 0, square (F = G − x) or least squares (F: Rⁿ → Rᵐ, m ≥ n), as
+// Moré implements it ([Mor78]; MINPACK's lmder, [MINPACK80]): the step solves
+//   min ‖F + J p‖₂² + λ ‖D p‖₂²,
+// with λ ≥ 0 found by Moré's safeguarded Newton iteration on the secular equation ‖D p(λ)‖₂ = Δ
+// (λ = 0 when the Gauss–Newton step fits in the trust region), on the QR factors of J with
+// column pivoting, so the normal equations are never formed. D is I or Moré's scaling: the
+// column norms of J, kept as a running maximum (invariant to a scaling of x).
+// Optional geodesic acceleration ([TS12]): the velocity v = p(λ) is corrected by the
+// acceleration a = argmin ‖J a + r_vv‖² + λ‖D a‖², r_vv ≈ (2/h)((F(x + h v) − F(x))/h − J v), and
+// the step p = v + a/2 is taken only when 2‖D a‖ ≤ α ‖D v‖ (one more evaluation per step).
+//
+// Stop rules. Converged: StopCriteria's residual criterion, its step criterion on a step with
+// λ = 0 (a Gauss–Newton step inside the region), or — least squares only, where ‖F‖ need not
+// reach 0 — MINPACK's ftol (actual and predicted relative reductions of ‖F‖₂² both below it)
+// and gtol (the cosine between F and every column of J below it). On a square system those two
+// mean a local minimum of ‖F‖ that is not a root: stagnated, with the reason. Stagnated also:
+// the radius below ε‖D x‖₂. A non-finite F at a trial point is a failed step.
+#include <Eigen/Householder>
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <string_view>
+
+#include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/finite_difference.hpp"
+#include "nlobs/solvers/library_sizes.hpp"
+#include "nlobs/solvers/stop_monitor.hpp"
+
+namespace nlobs {
+
+struct LevenbergMarquardtOptions {
+  // D: Moré's scaling (column norms of J, running maximum; MINPACK's mode 1, what lmder1
+  // uses), or D = I (the default: on the MGH systems it solves 49 of 57 runs, Moré's scaling
+  // 42; docs/solvers.md).
+  bool scale_by_jacobian_columns = false;
+  // Δ₀ = factor · ‖D x₀‖₂ (factor when x₀ = 0); MINPACK's recommended 100. Must be > 0.
+  double initial_radius_factor = 100.0;
+  // MINPACK's ftol: relative reductions of ‖F‖₂² below which a least-squares run has converged.
+  double function_tolerance = 1e-10;
+  // MINPACK's gtol: max_j |cos(F, J e_j)| below which the gradient vanishes (0 = off).
+  double gradient_tolerance = 1e-12;
+  // Geodesic acceleration ([TS12]): off by default (one more evaluation per step).
+  bool geodesic_acceleration = false;
+  double acceleration_ratio = 0.75;     // α: take v + a/2 only when 2‖Da‖ ≤ α‖Dv‖; > 0
+  double second_derivative_step = 0.1;  // h of the directional second difference; > 0
+  // Used only when the problem carries no Jacobian.
+  FiniteDifference finite_difference = FiniteDifference::kCentral;
+};
+
+template <int N = Dynamic>
+class LevenbergMarquardtEngine : public Engine<N> {
+ public:
+  explicit LevenbergMarquardtEngine(LevenbergMarquardtOptions lm = {}, SolverOptions options = {});
+
+  std::string_view name() const override { return "levenberg-marquardt"; }
+  const LevenbergMarquardtOptions& lm_options() const { return lm_; }
+  bool least_squares() const override { return true; }
+
+  // Square: F = G − x, J = ∂G − I.
+  Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
+  // Any m ≥ n.
+  Summary solve_least_squares(const RootProblem<N, Dynamic>& problem, Vector<N>& x) override;
+
+ private:
+  using ResidualVector = Vector<Dynamic>;
+  using JacobianMatrix = Matrix<Dynamic, N>;
+
+  // The iteration on F given as residual(x, f) → finite? and jacobian(x, J) (evaluations it
+  // spent); m = rows of F.
+  template <typename Residual, typename Jacobian>
+  Summary run(Residual&& residual, Jacobian&& jacobian, Index m, Vector<N>& x);
+  // min ‖[R; √λ D_P] z − [b; 0]‖ (MINPACK's qrsolv) into z; leaves S (the triangular factor of
+  // the augmented matrix) in s_ and its diagonal in sdiag_.
+  void solve_damped(double lambda, const Vector<N>& b, Vector<N>& z);
+  // Moré's λ for radius delta (MINPACK's lmpar); leaves the permuted step in z_ and returns λ.
+  double find_lambda(double delta, double lambda);
+
+  void resize(Index n, Index m);
+
+  LevenbergMarquardtOptions lm_;
+  Vector<N> x_ = zero_vector<N>(), xt_ = zero_vector<N>(), p_ = zero_vector<N>(),
+            diag_ = zero_vector<N>(), diag_p_ = zero_vector<N>(), qtf_ = zero_vector<N>(),
+            z_ = zero_vector<N>(), w_ = zero_vector<N>(), sdiag_ = zero_vector<N>(),
+            b_ = zero_vector<N>(), v_ = zero_vector<N>(), a_ = zero_vector<N>(),
+            qtr_ = zero_vector<N>(), g_ = zero_vector<N>(), column_norms_ = zero_vector<N>();
+  ResidualVector f_, ft_, fh_, fp_, fm_, work_m_;
+  JacobianMatrix jac_;
+  Matrix<N, N> r_, s_;
+  Eigen::ColPivHouseholderQR<JacobianMatrix> qr_;
+  Eigen::Matrix<Index, N, 1> perm_;
+  FiniteDifferenceWorkspace<N> fd_;
+};
+
+template <int N>
+LevenbergMarquardtEngine<N>::LevenbergMarquardtEngine(LevenbergMarquardtOptions lm,
+                                                      SolverOptions options)
+    : Engine<N>(std::move(options)), lm_(lm) {
+  auto require = [](bool ok, const char* option, double value, const char* requirement) {
+    if (ok) return;
+    std::ostringstream os;
+    os << "LevenbergMarquardtOptions::" << option << " = " << value
+       << " is invalid: " << requirement;
+    throw InvalidInput(os.str());
+  };
+  require(lm_.initial_radius_factor > 0.0 && std::isfinite(lm_.initial_radius_factor),
+          "initial_radius_factor", lm_.initial_radius_factor, "must be finite and > 0");
+  require(lm_.function_tolerance >= 0.0 && std::isfinite(lm_.function_tolerance),
+          "function_tolerance", lm_.function_tolerance, "must be finite and >= 0");
+  require(lm_.gradient_tolerance >= 0.0 && std::isfinite(lm_.gradient_tolerance),
+          "gradient_tolerance", lm_.gradient_tolerance, "must be finite and >= 0");
+  require(lm_.acceleration_ratio > 0.0 && std::isfinite(lm_.acceleration_ratio),
+          "acceleration_ratio", lm_.acceleration_ratio, "must be finite and > 0");
+  require(lm_.second_derivative_step > 0.0 && std::isfinite(lm_.second_derivative_step),
+          "second_derivative_step", lm_.second_derivative_step, "must be finite and > 0");
+  detail::require_lipschitz_for_error_bound(name(), this->options_.stop);
+}
+
+template <int N>
+void LevenbergMarquardtEngine<N>::resize(Index n, Index m) {
+  if constexpr (N == Dynamic) {
+    for (Vector<N>* v : {&x_, &xt_, &p_, &diag_, &diag_p_, &qtf_, &z_, &w_, &sdiag_, &b_, &v_, &a_,
+                         &qtr_, &g_, &column_norms_}) {
+      v->resize(n);
+    }
+    perm_.resize(n), r_.resize(n, n), s_.resize(n, n), fd_.resize(n);
+  }
+  for (ResidualVector* v : {&f_, &ft_, &fh_, &fp_, &fm_, &work_m_}) {
+    if (v->size() != m) v->resize(m);
+  }
+  if (jac_.rows() != m || jac_.cols() != n) jac_.resize(m, n);
+  // qr_ sizes itself in compute(): allocates when m changes, never after.
+}
+
+template <int N>
+void LevenbergMarquardtEngine<N>::solve_damped(double lambda, const Vector<N>& b, Vector<N>& z) {
+  const Index n = r_.rows();
+  s_ = r_.template triangularView<Eigen::Upper>();
+  b_ = b;
+  const double root = std::sqrt(lambda);
+  for (Index j = 0; j < n; ++j) {
+    const double dj = root * diag_p_[j];
+    if (dj == 0.0) continue;
+    // The row [0 … √λ D_j … 0 | 0] of the augmented system, eliminated against S by rotations.
+    w_.setZero();
+    w_[j] = dj;
+    double extra = 0.0;  // its right-hand side
+    for (Index k = j; k < n; ++k) {
+      if (w_[k] == 0.0) continue;
+      const double radius = std::hypot(s_(k, k), w_[k]);
+      const double c = s_(k, k) / radius, s = w_[k] / radius;  // [c s; −s c] zeroes w_k
+      for (Index i = k; i < n; ++i) {
+        const double top = s_(k, i), bottom = w_[i];
+        s_(k, i) = c * top + s * bottom;
+        w_[i] = -s * top + c * bottom;
+      }
+      const double top = b_[k];
+      b_[k] = c * top + s * extra;
+      extra = -s * top + c * extra;
+    }
+  }
+  sdiag_ = s_.diagonal();
+  // Back substitution; a zero diagonal ends the non-singular part (the rest of z is 0).
+  Index rank = n;
+  for (Index j = 0; j < n; ++j) {
+    if (s_(j, j) == 0.0) {
+      rank = j;
+      break;
+    }
+  }
+  z.setZero();
+  for (Index j = rank - 1; j >= 0; --j) {
+    double sum = b_[j];
+    for (Index i = j + 1; i < rank; ++i) sum -= s_(j, i) * z[i];
+    z[j] = sum / s_(j, j);
+  }
+}
+
+template <int N>
+double LevenbergMarquardtEngine<N>::find_lambda(double delta, double lambda) {
+  const Index n = r_.rows();
+  const double dwarf = std::numeric_limits<double>::min();
+  // Gauss–Newton direction R z = Qᵀ F; rank-deficient R: components past the first zero
+  // diagonal are 0.
+  Index rank = n;
+  for (Index j = 0; j < n; ++j) {
+    if (r_(j, j) == 0.0) {
+      rank = j;
+      break;
+    }
+  }
+  z_.setZero();
+  for (Index j = rank - 1; j >= 0; --j) {
+    double sum = qtf_[j];
+    for (Index i = j + 1; i < rank; ++i) sum -= r_(j, i) * z_[i];
+    z_[j] = sum / r_(j, j);
+  }
+  double dxnorm = diag_p_.cwiseProduct(z_).norm();
+  double fp = dxnorm - delta;
+  if (fp <= 0.1 * delta) return 0.0;
+
+  // Bounds on λ: parl from the Newton step of the secular equation at λ = 0 (full rank only),
+  // paru = ‖D⁻¹ Jᵀ F‖ / Δ.
+  double parl = 0.0;
+  if (rank == n) {
+    w_ = diag_p_.cwiseProduct(diag_p_.cwiseProduct(z_)) / dxnorm;
+    for (Index j = 0; j < n; ++j) {
+      double sum = w_[j];
+      for (Index i = 0; i < j; ++i) sum -= r_(i, j) * w_[i];
+      w_[j] = sum / r_(j, j);
+    }
+    const double t = w_.norm();
+    parl = ((fp / delta) / t) / t;
+  }
+  for (Index j = 0; j < n; ++j) {
+    w_[j] = r_.col(j).head(j + 1).dot(qtf_.head(j + 1)) / diag_p_[j];
+  }
+  const double gnorm = w_.norm();
+  double paru = gnorm / delta;
+  if (paru == 0.0) paru = dwarf / std::min(delta, 0.1);
+
+  lambda = std::clamp(lambda, parl, paru);
+  if (lambda == 0.0) lambda = gnorm / dxnorm;
+  for (int iteration = 1;; ++iteration) {
+    if (lambda == 0.0) lambda = std::max(dwarf, 0.001 * paru);
+    solve_damped(lambda, qtf_, z_);
+    dxnorm = diag_p_.cwiseProduct(z_).norm();
+    const double previous = fp;
+    fp = dxnorm - delta;
+    // |‖Dp‖ − Δ| ≤ 0.1 Δ, or λ at its lower bound 0 with ‖Dp‖ < Δ still, or ten iterations.
+    if (std::abs(fp) <= 0.1 * delta || (parl == 0.0 && fp <= previous && previous < 0.0) ||
+        iteration == 10) {
+      return lambda;
+    }
+    // Newton correction of λ on φ(λ) = ‖D p(λ)‖ − Δ, through S from solve_damped.
+    w_ = diag_p_.cwiseProduct(diag_p_.cwiseProduct(z_)) / dxnorm;
+    for (Index j = 0; j < n; ++j) {
+      w_[j] /= sdiag_[j];
+      for (Index i = j + 1; i < n; ++i) w_[i] -= s_(j, i) * w_[j];
+    }
+    const double t = w_.norm();
+    const double correction = ((fp / delta) / t) / t;
+    if (fp > 0.0) parl = std::max(parl, lambda);
+    if (fp < 0.0) paru = std::min(paru, lambda);
+    lambda = std::max(parl, lambda + correction);
+  }
+}
+
+template <int N>
+template <typename Residual, typename Jacobian>
+Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobian, Index m,
+                                         Vector<N>& x) {
+  const Index n = x.size();
+  const bool least_squares = m > n;
+  StopCriteria stop = this->options_.stop;
+  stop.stagnation_patience = 0;  // a trust region grows and shrinks its steps by design
+  resize(n, m);
+  Summary summary;
+  summary.engine = name();
+  StopMonitor monitor(stop, x.template lpNorm<Eigen::Infinity>(), /*estimate_lipschitz=*/false);
+  int evaluations = 0, jacobians = 0;
+  const double eps = std::numeric_limits<double>::epsilon();
+  auto evaluate = [&](const Vector<N>& at, ResidualVector& out) {
+    ++evaluations;
+    return residual(at, out);
+  };
+
+  x_ = x;
+  std::optional<Status> status;
+  if (!evaluate(x_, f_)) status = Status::kNonFinite;
+  double fnorm = f_.norm();
+  if (!status &&
+      (fnorm == 0.0 || (stop.residual_tolerance &&
+                        f_.template lpNorm<Eigen::Infinity>() <= *stop.residual_tolerance))) {
+    status = Status::kConverged;
+  }
+  double delta = 0.0, xnorm = 0.0, lambda = 0.0, last_step = 0.0;
+  bool first_trial = true;
+  auto stagnate = [&](const char* why) {
+    summary.message = why;
+    status = Status::kStagnated;
+  };
+
+  while (!status) {
+    if (evaluations >= stop.max_evaluations) {
+      status = Status::kMaxEvaluations;
+      break;
+    }
+    evaluations += jacobian(x_, f_, jac_);
+    ++jacobians;
+    if (!jac_.allFinite()) {
+      summary.message = "the Jacobian of F is not finite";
+      status = Status::kNonFinite;
+      break;
+    }
+    column_norms_ = jac_.colwise().norm().transpose();
+    if (jacobians == 1) {
+      if (lm_.scale_by_jacobian_columns) {
+        for (Index j = 0; j < n; ++j) diag_[j] = column_norms_[j] == 0.0 ? 1.0 : column_norms_[j];
+      } else {
+        diag_.setOnes();
+      }
+      xnorm = diag_.cwiseProduct(x_).norm();
+      delta = xnorm > 0.0 ? lm_.initial_radius_factor * xnorm : lm_.initial_radius_factor;
+    } else if (lm_.scale_by_jacobian_columns) {
+      diag_ = diag_.cwiseMax(column_norms_);
+    }
+    qr_.compute(jac_);
+    r_ = qr_.matrixR().topRows(n).template triangularView<Eigen::Upper>();
+    for (Index j = 0; j < n; ++j) {
+      perm_[j] = qr_.colsPermutation().indices()[j];
+      diag_p_[j] = diag_[perm_[j]];
+    }
+    work_m_ = f_;
+    work_m_.applyOnTheLeft(qr_.householderQ().adjoint());
+    qtf_ = work_m_.head(n);
+
+    // MINPACK's gtol: the largest cosine between F and a column of J.
+    double cosine = 0.0;
+    if (fnorm > 0.0) {
+      for (Index j = 0; j < n; ++j) {
+        const double norm = column_norms_[perm_[j]];
+        if (norm == 0.0) continue;
+        cosine =
+            std::max(cosine, std::abs(r_.col(j).head(j + 1).dot(qtf_.head(j + 1)) / fnorm) / norm);
+      }
+    }
+    if (cosine <= lm_.gradient_tolerance) {
+      if (least_squares) {
+        summary.message = "the gradient vanishes: cos(F, J e_j) <= gradient_tolerance";
+        status = Status::kConverged;
+      } else {
+        stagnate("a local minimum of |F| that is not a root: J^T F = 0");
+      }
+      break;
+    }
+
+    // Inner loop: trial steps with this Jacobian until one is accepted.
+    while (!status) {
+      lambda = find_lambda(delta, lambda);
+      for (Index j = 0; j < n; ++j) v_[perm_[j]] = -z_[j];  // the step in x's order
+      const double vnorm = diag_.cwiseProduct(v_).norm();
+      if (first_trial) delta = std::min(delta, vnorm);
+      first_trial = false;
+      if (evaluations >= stop.max_evaluations) {
+        status = Status::kMaxEvaluations;
+        break;
+      }
+      p_ = v_;
+      bool accelerated = false;
+      if (lm_.geodesic_acceleration) {
+        // r_vv ≈ (2/h)((F(x + h v) − F(x))/h − J v); a = −(JᵀJ + λD²)⁻¹ Jᵀ r_vv.
+        const double h = lm_.second_derivative_step;
+        xt_ = x_ + h * v_;
+        if (evaluate(xt_, fh_)) {
+          work_m_.noalias() = jac_ * v_;
+          work_m_ = (2.0 / h) * ((fh_ - f_) / h - work_m_);
+          work_m_.applyOnTheLeft(qr_.householderQ().adjoint());
+          qtr_ = work_m_.head(n);
+          solve_damped(lambda, qtr_, z_);
+          for (Index j = 0; j < n; ++j) a_[perm_[j]] = -z_[j];
+          if (2.0 * diag_.cwiseProduct(a_).norm() <= lm_.acceleration_ratio * vnorm) {
+            p_ = v_ + 0.5 * a_;
+            accelerated = true;
+          }
+        }
+        if (evaluations >= stop.max_evaluations) {
+          status = Status::kMaxEvaluations;
+          break;
+        }
+      }
+      const double pnorm = diag_.cwiseProduct(p_).norm();
+      xt_ = x_ + p_;
+      const bool finite = evaluate(xt_, ft_);
+      const double fnorm_trial = finite ? ft_.norm() : std::numeric_limits<double>::infinity();
+      const double actual =
+          0.1 * fnorm_trial < fnorm ? 1.0 - std::pow(fnorm_trial / fnorm, 2) : -1.0;
+      // Predicted reduction of the linear model, for the velocity v (Moré's formula).
+      work_m_.noalias() = jac_ * v_;
+      const double t1 = work_m_.norm() / fnorm;
+      const double t2 = std::sqrt(lambda) * vnorm / fnorm;
+      const double predicted = t1 * t1 + 2.0 * t2 * t2;
+      const double directional = -(t1 * t1 + t2 * t2);
+      const double ratio = predicted != 0.0 ? actual / predicted : 0.0;
+
+      if (ratio <= 0.25) {
+        double shrink = actual >= 0.0 ? 0.5 : 0.5 * directional / (directional + 0.5 * actual);
+        if (0.1 * fnorm_trial >= fnorm || shrink < 0.1) shrink = 0.1;
+        delta = shrink * std::min(delta, pnorm / 0.1);
+        lambda /= shrink;
+      } else if (lambda == 0.0 || ratio >= 0.75) {
+        delta = pnorm / 0.5;
+        lambda *= 0.5;
+      }
+      const bool accepted = ratio >= 1e-4;
+      if (accepted) {
+        x_ = xt_;
+        std::swap(f_, ft_);
+        fnorm = fnorm_trial;
+        xnorm = diag_.cwiseProduct(x_).norm();
+        last_step = p_.template lpNorm<Eigen::Infinity>();
+        // A step with λ = 0 is the Gauss–Newton step: its size measures the distance to a
+        // solution; a damped one does not.
+        if (auto s = monitor.update(last_step, f_.template lpNorm<Eigen::Infinity>(),
+                                    x_.template lpNorm<Eigen::Infinity>(),
+                                    lambda == 0.0 && !accelerated)) {
+          status = s;
+        }
+        if (this->options_.record_trace) {
+          summary.trace.push_back(
+              {monitor.iterations(), last_step, f_.template lpNorm<Eigen::Infinity>(), x_});
+        }
+        if (status) break;
+        if (fnorm == 0.0) {
+          status = Status::kConverged;
+          break;
+        }
+      }
+      if (std::abs(actual) <= lm_.function_tolerance && predicted <= lm_.function_tolerance &&
+          0.5 * ratio <= 1.0) {
+        if (least_squares) {
+          summary.message = "relative reduction of |F|^2 <= function_tolerance";
+          status = Status::kConverged;
+        } else {
+          stagnate(
+              "no relative reduction of |F|^2 above function_tolerance: a local minimum "
+              "of |F| that is not a root");
+        }
+        break;
+      }
+      if (delta <= eps * xnorm) {
+        stagnate("the trust radius fell below machine precision relative to |x|");
+        break;
+      }
+      if (accepted) break;  // a new Jacobian at the new point
+    }
+  }
+
+  x = x_;
+  summary.status = *status;
+  summary.function_evaluations = evaluations;
+  summary.jacobian_evaluations = jacobians;
+  monitor.fill(summary, f_.allFinite() ? f_.template lpNorm<Eigen::Infinity>()
+                                       : std::numeric_limits<double>::infinity());
+  summary.record_answer(x, this->options_.stop, least_squares);
+  return summary;
+}
+
+template <int N>
+Summary LevenbergMarquardtEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
+  detail::check_initial_guess(name(), problem, x);
+  const Index n = x.size();
+  auto residual = [&](const Vector<N>& at, ResidualVector& f) {
+    problem.evaluate(at, g_);
+    detail::check_output_size(problem, g_);
+    f = g_ - at;
+    return f.allFinite();
+  };
+  auto jacobian = [&](const Vector<N>& at, const ResidualVector& f, JacobianMatrix& jac) {
+    int spent = 0;
+    if (problem.has_jacobian()) {
+      problem.jacobian(at, r_);
+    } else {
+      xt_ = f + at;  // G(x)
+      spent = finite_difference_jacobian(problem, at, xt_, r_, lm_.finite_difference, fd_);
+    }
+    jac = r_;
+    jac.diagonal().array() -= 1.0;
+    return spent;
+  };
+  return run(residual, jacobian, n, x);
+}
+
+template <int N>
+Summary LevenbergMarquardtEngine<N>::solve_least_squares(const RootProblem<N, Dynamic>& problem,
+                                                         Vector<N>& x) {
+  detail::check_initial_guess<N>(name(), problem.size(), x);
+  const Index m = problem.residual_size();
+  if (m < problem.size()) {
+    std::ostringstream os;
+    os << name() << ": F maps R^" << problem.size() << " to R^" << m
+       << "; Levenberg-Marquardt needs at least as many residuals as unknowns";
+    throw InvalidInput(os.str());
+  }
+  auto residual = [&](const Vector<N>& at, ResidualVector& f) {
+    problem.evaluate(at, f);
+    if (f.size() != m) {
+      std::ostringstream os;
+      os << "F returned a vector of size " << f.size() << ", expected " << m;
+      throw InvalidInput(os.str());
+    }
+    return f.allFinite();
+  };
+  auto jacobian = [&](const Vector<N>& at, const ResidualVector& f, JacobianMatrix& jac) {
+    if (problem.has_jacobian()) {
+      problem.jacobian(at, jac);
+      return 0;
+    }
+    return finite_difference_jacobian<N, Dynamic>(
+        [&problem](const Vector<N>& p, ResidualVector& out) { problem.evaluate(p, out); }, at, f,
+        jac, lm_.finite_difference, fd_, fp_, fm_);
+  };
+  return run(residual, jacobian, m, x);
+}
+
+// Compiled once in the library for its sizes (nlobs/solvers/library_sizes.hpp).
+#define NLOBS_EXTERN_LM_ENGINE(n) extern template class LevenbergMarquardtEngine<n>;
+NLOBS_FOR_EACH_LIBRARY_SIZE(NLOBS_EXTERN_LM_ENGINE)
+#undef NLOBS_EXTERN_LM_ENGINE
+
+}  // namespace nlobs
