@@ -40,7 +40,7 @@ TEST(Dogleg, SolvesASmallSystemToMachinePrecision) {
   EXPECT_EQ(s.engine, "dogleg");
   EXPECT_LE(s.residual_norm, 1e-12);
   // Broyden updates between Jacobians: fewer Jacobians than iterations.
-  EXPECT_LT(s.jacobian_evaluations, s.iterations + 1);
+  EXPECT_LT(s.jacobian_evaluations, s.iterations);
 }
 
 TEST(Dogleg, EveryAcceptedStepDecreasesTheResidual) {
@@ -53,8 +53,9 @@ TEST(Dogleg, EveryAcceptedStepDecreasesTheResidual) {
   const Summary s = dogleg.solve(to_fixed_point(c.problem), x);
   ASSERT_TRUE(s.converged()) << s.full_report();
   EXPECT_LT((x - Eigen::VectorXd::Ones(2)).norm(), 1e-10);
-  double previous = INFINITY;
   Eigen::VectorXd f(2);
+  c.problem.evaluate(c.start(10.0), f);
+  double previous = f.norm();
   for (const TraceEntry& t : s.trace) {
     c.problem.evaluate(t.x, f);
     EXPECT_LE(f.norm(), previous) << "iteration " << t.iteration;
@@ -106,6 +107,40 @@ TEST(Dogleg, AModelThatLeavesItsDomainShrinksTheRegion) {
   const Summary s = DoglegEngine<1>({}, strict()).solve(problem, x);
   ASSERT_TRUE(s.converged()) << s.full_report();
   EXPECT_NEAR(x[0], std::exp(-5.0), 1e-14);
+}
+
+TEST(Dogleg, ManyNonFiniteTrialsInARowAreNotStagnation) {
+  // log x + 5 from x0 = 1e6: the radius is halved through a long run of NaN trials (x < 0)
+  // before a step lands in the domain; those trials are not Jacobians without progress.
+  const auto problem = to_fixed_point(RootProblem<1>::with_autodiff([](const auto& x) {
+    using std::log;
+    using T = typename std::decay_t<decltype(x)>::Scalar;
+    Eigen::Matrix<T, 1, 1> f;
+    f[0] = log(x[0]) + 5.0;
+    return f;
+  }));
+  Vector<1> x(1e6);
+  const Summary s = DoglegEngine<1>({}, strict()).solve(problem, x);
+  ASSERT_TRUE(s.converged()) << s.full_report();
+  EXPECT_NEAR(x[0], std::exp(-5.0), 1e-14);
+}
+
+TEST(Dogleg, FiniteDifferenceJacobiansStayWithinTheBudget) {
+  const reference::MghCase c = reference::mgh_case(4, 4);  // Wood, no Jacobian given below
+  const auto no_jacobian = FixedPointProblem<>::from_map(
+      [&c](const Eigen::VectorXd& x, Eigen::VectorXd& g) {
+        c.problem.evaluate(x, g);
+        g += x;
+      },
+      4);
+  for (const int budget : {1, 8, 9, 10, 17, 30}) {
+    SolverOptions o = strict();
+    o.stop.max_evaluations = budget;
+    Eigen::VectorXd x = c.start(1.0);
+    const Summary s = DoglegEngine<>({}, o).solve(no_jacobian, x);  // central: 8 per Jacobian
+    EXPECT_LE(s.function_evaluations, budget) << s.full_report();
+    EXPECT_EQ(s.status, Status::kMaxEvaluations) << budget;
+  }
 }
 
 TEST(Dogleg, FarStartsOfTheHelicalValley) {
@@ -167,7 +202,8 @@ TEST(Dogleg, FixedAndDynamicSizesGiveTheSameIterates) {
   ASSERT_TRUE(sa.converged()) << sa.full_report();
   EXPECT_EQ(sa.iterations, sb.iterations);
   EXPECT_EQ(sa.function_evaluations, sb.function_evaluations);
-  EXPECT_EQ(Eigen::VectorXd(xa), xb);
+  EXPECT_NEAR(xa[0], xb[0], 1e-13);
+  EXPECT_NEAR(xa[1], xb[1], 1e-13);
 }
 
 TEST(Dogleg, NonFiniteStartAndBudget) {

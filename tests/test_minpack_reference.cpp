@@ -15,6 +15,8 @@
 
 #include "nlobs/reference/root_reference.hpp"
 #include "nlobs/registry/problem_sets/mgh_problems.hpp"
+#include "nlobs/solvers/builtin_engines.hpp"
+#include "nlobs/solvers/root_adapter.hpp"
 
 namespace nlobs::reference {
 namespace {
@@ -128,6 +130,43 @@ TEST(MinpackReference, OurHybrjRowIsMinpackAsPublishedRunByRun) {
       "minpack:hybrj vs cminpack's hyjdrv: %d of %d runs solved in both; F evaluations "
       "ours/published: median %.3f, range %.3f..%.3f, equal on %d runs\n",
       ours_solved, compared, ratios[ratios.size() / 2], ratios.front(), ratios.back(), exact);
+}
+
+// Our own engines on the same 50 runs, judged like the suite (budget 1000 (n + 1), ‖F‖₂ ≤ 1e-8):
+// dogleg (MINPACK's method) and auto must solve every run MINPACK's published output solves,
+// auto at least 48 of the 50 (issue "Root finding that beats MINPACK").
+TEST(MinpackReference, DoglegAndAutoSolveEveryRunMinpackSolves) {
+  const auto runs = read_driver_output(NLOBS_MINPACK_REFERENCE);
+  for (const char* spec : {"dogleg", "auto"}) {
+    int solved = 0, missed_published = 0;
+    for (const PublishedRun& r : runs) {
+      if (!have_case(r.problem, r.n)) continue;
+      const MghCase c = mgh_case(r.problem, r.n);
+      SolverOptions o;
+      o.stop.step_tolerance = 1e-12;
+      o.stop.residual_tolerance = 1e-10;
+      o.stop.max_evaluations = 1000 * (r.n + 1);
+      const auto engine = EngineRegistry<>::global().create(spec, o);
+      Eigen::VectorXd x = c.start(r.scale), f(r.n);
+      const Summary s = engine->solve(to_fixed_point(c.problem), x);
+      c.problem.evaluate(x, f);
+      const bool ok = x.allFinite() && f.norm() <= 1e-8;
+      solved += ok;
+      if (r.final_norm <= 1e-8 && !ok) {
+        ++missed_published;
+        ADD_FAILURE() << spec << " misses " << c.name << " n=" << r.n << " x" << r.scale
+                      << ", which MINPACK solves: " << s.brief_report();
+      }
+    }
+    EXPECT_EQ(missed_published, 0) << spec;
+    // Measured: dogleg 46 (MINPACK's 44 and Powell badly scaled x10, Broyden tridiagonal x1),
+    // auto 49 (Chebyquad n = 8, which has no root, is the one left).
+    EXPECT_GE(solved, 46) << spec;
+    if (std::string(spec) == "auto") {
+      EXPECT_GE(solved, 48);
+    }
+    std::printf("%s: %d of the 50 shared runs (MINPACK 44)\n", spec, solved);
+  }
 }
 
 }  // namespace

@@ -70,7 +70,7 @@ std::string Summary::unusable_reason() const {
 
 std::string Summary::brief_report() const {
   std::ostringstream os;
-  if (!engine.empty()) os << engine << ": ";
+  if (!engine.empty()) os << engine << (stage.empty() ? "" : " (" + stage + ")") << ": ";
   os << to_string(status) << " after " << iterations << " iterations (" << function_evaluations
      << " evaluations";
   if (jacobian_evaluations > 0) os << ", " << jacobian_evaluations << " Jacobians";
@@ -86,6 +86,7 @@ std::string Summary::full_report() const {
   std::ostringstream os;
   os << "nlobs solver summary\n";
   if (!engine.empty()) os << "  engine                 " << engine << '\n';
+  if (!stage.empty()) os << "  answer from stage      " << stage << '\n';
   os << "  status                 " << to_string(status) << '\n';
   if (!message.empty()) os << "  message                " << message << '\n';
   os << "  iterations             " << iterations << '\n'

@@ -15,8 +15,16 @@
 #include "nlobs/solvers/levenberg_marquardt_engine.hpp"
 #include "nlobs/solvers/newton_engine.hpp"
 #include "nlobs/solvers/nlopt_engine.hpp"
+#include "nlobs/solvers/polyalgorithm_engine.hpp"
+#include "nlobs/solvers/pseudo_transient_engine.hpp"
 
 namespace nlobs {
+
+// The stages of `auto`, in order, each from x0: Newton first (the cheapest when it works), the
+// dogleg where its full steps fail, Levenberg-Marquardt where the dogleg stagnates, the
+// pseudo-transient flow last. Measured on the MGH set against other orders (docs/solvers.md).
+inline constexpr const char* kAutoOrder = "newton/dogleg/levenberg-marquardt/pseudo-transient";
+
 namespace detail {
 inline FiniteDifference parse_finite_difference(const char* engine, const std::string& v) {
   if (v == "central") return FiniteDifference::kCentral;
@@ -65,11 +73,13 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
   add({"newton",
        "Newton on F = G - x, any Jacobian source",
        {{"linesearch", "0/1 Armijo backtracking; default 0"},
+        {"trustregion", "0/1 dogleg trust region, a Jacobian every iterate; default 0"},
         {"fd", "forward|central differences when no Jacobian; default central"}},
-       {"newton", "newton:linesearch=1"},
+       {"newton", "newton:linesearch=1", "newton:trustregion=1"},
        [](EngineSpecReader& s, SolverOptions o) {
          NewtonOptions n;
          if (auto v = s.boolean("linesearch")) n.line_search = *v;
+         if (auto v = s.boolean("trustregion")) n.trust_region = *v;
          if (auto v = s.text("fd"))
            n.finite_difference = detail::parse_finite_difference("newton", *v);
          return std::make_unique<NewtonEngine<N>>(n, std::move(o));
@@ -128,6 +138,64 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
            l.finite_difference = detail::parse_finite_difference("levenberg-marquardt", *v);
          }
          return std::make_unique<LevenbergMarquardtEngine<N>>(l, std::move(o));
+       }});
+  add({"pseudo-transient",
+       "pseudo-transient continuation (Kelley-Keyes): implicit Euler on a flow to the root, "
+       "growing "
+       "step",
+       {{"flow", "residual|fixed-point: dx/dt = -F = x - G(x) or G(x) - x; default residual"},
+        {"delta0", "initial pseudo time step; default 1e-2"},
+        {"delta_max", "largest pseudo time step; default 1e12"},
+        {"fd", "forward|central differences when no Jacobian; default central"}},
+       {"pseudo-transient:flow=fixed-point", "pseudo-transient:flow=fixed-point,delta0=1e-4"},
+       [](EngineSpecReader& s, SolverOptions o) {
+         PseudoTransientOptions p;
+         if (auto v = s.text("flow")) {
+           if (*v == "fixed-point")
+             p.flow = PseudoTransientOptions::Flow::kFixedPoint;
+           else if (*v == "residual")
+             p.flow = PseudoTransientOptions::Flow::kResidual;
+           else
+             throw InvalidInput("pseudo-transient: flow=" + *v + " is not residual or fixed-point");
+         }
+         if (auto v = s.number("delta0")) p.initial_pseudo_step = *v;
+         if (auto v = s.number("delta_max")) p.max_pseudo_step = *v;
+         if (p.min_pseudo_step > p.initial_pseudo_step) p.min_pseudo_step = p.initial_pseudo_step;
+         if (auto v = s.text("fd")) {
+           p.finite_difference = detail::parse_finite_difference("pseudo-transient", *v);
+         }
+         return std::make_unique<PseudoTransientEngine<N>>(p, std::move(o));
+       }});
+  add({"auto",
+       "polyalgorithm: engines in order within one budget, until one answer is usable",
+       {{"order", std::string("engine names separated by '/'; default ") + kAutoOrder},
+        {"from", "start|best: each stage from x0 or from the best point so far; default start"}},
+       {"auto", "auto:order=dogleg/levenberg-marquardt,from=best"},
+       [](EngineSpecReader& s, SolverOptions o) {
+         PolyalgorithmOptions p;
+         if (auto v = s.text("from")) {
+           if (*v == "best")
+             p.restart_from_best = true;
+           else if (*v == "start")
+             p.restart_from_best = false;
+           else
+             throw InvalidInput("auto: from=" + *v + " is not best or start");
+         }
+         const std::string order = s.text("order").value_or(kAutoOrder);
+         std::vector<std::unique_ptr<Engine<N>>> stages;
+         for (std::size_t at = 0; at <= order.size();) {
+           const std::size_t slash = std::min(order.find('/', at), order.size());
+           const std::string stage = order.substr(at, slash - at);
+           if (stage.empty() || stage == "auto") {
+             throw InvalidInput("auto: order=" + quoted_excerpt(order) +
+                                " needs engine names "
+                                "other than auto, separated by '/'");
+           }
+           // Stages by name from the process-wide registry (a user's engines included).
+           stages.push_back(EngineRegistry<N>::global().create(stage, o));
+           at = slash + 1;
+         }
+         return std::make_unique<PolyalgorithmEngine<N>>(std::move(stages), p, std::move(o));
        }});
   add({"ceres",
        "Ceres least squares, Levenberg-Marquardt or dogleg",

@@ -192,7 +192,7 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
   x_ = x;
   std::optional<Status> status;
   if (!residual_at(x_, f_)) status = Status::kNonFinite;
-  double fnorm = f_.norm();
+  double fnorm = f_.stableNorm();  // overflow-safe, as MINPACK's enorm
   if (!status &&
       (fnorm == 0.0 || (stop.residual_tolerance &&
                         f_.template lpNorm<Eigen::Infinity>() <= *stop.residual_tolerance))) {
@@ -200,7 +200,8 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
   }
   double delta = 0.0, xnorm = 0.0, last_step = 0.0;
   int slow_iterations = 0, slow_jacobians = 0;  // MINPACK's nslow1, nslow2
-  bool first_trial = true;
+  bool accepted_any = false;  // until the first accepted step Δ ≤ ‖Dp‖ (MINPACK's iter = 1)
+  int failures = 0, successes = 0;  // consecutive; MINPACK's ncfail, ncsuc
 
   while (!status) {
     if (evaluations >= stop.max_evaluations) {
@@ -208,6 +209,11 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
       break;
     }
     // J_F = ∂G − I, factored J = Q R.
+    if (!problem.has_jacobian() &&
+        evaluations + finite_difference_cost(dogleg_.finite_difference, n) > stop.max_evaluations) {
+      status = Status::kMaxEvaluations;  // the differences would overrun the budget
+      break;
+    }
     if (problem.has_jacobian()) {
       problem.jacobian(x_, jac_);
     } else {
@@ -240,19 +246,18 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
     qtf_.noalias() = q_.transpose() * f_;
 
     bool fresh_jacobian = true;
-    int failures = 0, successes = 0;  // consecutive, since the last Jacobian
     while (!status) {
       dogleg_step(delta);
       const double pnorm = diag_.cwiseProduct(p_).norm();
-      if (first_trial) delta = std::min(delta, pnorm);
-      first_trial = false;
+      if (!accepted_any) delta = std::min(delta, pnorm);
       if (evaluations >= stop.max_evaluations) {
         status = Status::kMaxEvaluations;
         break;
       }
       xt_ = x_ + p_;
       const bool finite = residual_at(xt_, ft_);
-      const double fnorm_trial = finite ? ft_.norm() : std::numeric_limits<double>::infinity();
+      const double fnorm_trial =
+          finite ? ft_.stableNorm() : std::numeric_limits<double>::infinity();
       // Actual and predicted reductions of ‖F‖₂², relative: 1 − (‖F⁺‖/‖F‖)², 1 − (‖F + Jp‖/‖F‖)².
       const double actual = fnorm_trial < fnorm ? 1.0 - std::pow(fnorm_trial / fnorm, 2) : -1.0;
       work_.noalias() = r_.template triangularView<Eigen::Upper>() * p_;
@@ -274,6 +279,7 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
       const bool accepted = ratio >= 1e-4;
       std::optional<Status> monitor_status;
       if (accepted) {
+        accepted_any = true;
         x_ = xt_;
         std::swap(f_, ft_);  // ft_ now holds F at the previous iterate
         fnorm = fnorm_trial;
@@ -290,6 +296,7 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
       slow_iterations = actual >= 1e-3 ? 0 : slow_iterations + 1;
       if (fresh_jacobian) ++slow_jacobians;
       if (actual >= 0.1) slow_jacobians = 0;
+      fresh_jacobian = false;  // the next trial uses an updated (or the same) Jacobian
 
       if (monitor_status) {
         status = monitor_status;
@@ -304,7 +311,9 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
         why =
             "the trust radius fell below machine precision relative to |x|: no further "
             "improvement possible";
-      } else if (slow_jacobians == 5) {
+      } else if (dogleg_.broyden_updates && slow_jacobians == 5) {
+        // (Without Broyden updates every iterate has a Jacobian: the ten-iteration rule below
+        // is the one that measures progress.)
         why = "no 10% reduction of |F|2 over the last five Jacobian evaluations";
       } else if (slow_iterations == 10) {
         why = "no 0.1% reduction of |F|2 over the last ten iterations";
@@ -333,7 +342,6 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
       }
       v_ = diag_.cwiseProduct(diag_.cwiseProduct(p_) / pnorm);
       rank_one_update();
-      fresh_jacobian = false;
     }
   }
 

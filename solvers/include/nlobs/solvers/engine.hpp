@@ -43,6 +43,14 @@ class Engine {
   virtual bool needs_contraction() const { return false; }
 
   const SolverOptions& options() const { return options_; }
+  // Sets StopCriteria::max_evaluations (≥ 1) for the solves that follow: how a polyalgorithm
+  // hands each stage what the earlier ones left.
+  void limit_evaluations(int max_evaluations) {
+    if (max_evaluations < 1) {
+      throw InvalidInput(std::string(name()) + ": an evaluation budget must be >= 1");
+    }
+    options_.stop.max_evaluations = max_evaluations;
+  }
 
  protected:
   explicit Engine(SolverOptions options) : options_(std::move(options)) { validate(options_.stop); }

@@ -18,6 +18,11 @@ struct FiniteDifferenceWorkspace {
   void resize(Index n) { xp.resize(n), gp.resize(n), gm.resize(n); }
 };
 
+// Evaluations one difference Jacobian of n unknowns costs: n forward, 2n central.
+inline int finite_difference_cost(FiniteDifference scheme, Index n) {
+  return static_cast<int>(scheme == FiniteDifference::kForward ? n : 2 * n);
+}
+
 // jac = ∂f(x) for any f: R^N → R^M called as f(x, out); fx = f(x) is reused by the forward
 // scheme. `work` holds the perturbed point and values. Returns the evaluations of f spent.
 template <int N, int M, typename F>

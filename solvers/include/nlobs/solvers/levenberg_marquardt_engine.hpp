@@ -41,7 +41,8 @@ struct LevenbergMarquardtOptions {
   double initial_radius_factor = 100.0;
   // MINPACK's ftol: relative reductions of ‖F‖₂² below which a least-squares run has converged.
   double function_tolerance = 1e-10;
-  // MINPACK's gtol: max_j |cos(F, J e_j)| below which the gradient vanishes (0 = off).
+  // MINPACK's gtol: max_j |cos(F, J e_j)| at or below which the gradient vanishes (0: only an
+  // exactly orthogonal F stops).
   double gradient_tolerance = 1e-12;
   // Geodesic acceleration ([TS12]): off by default (one more evaluation per step).
   bool geodesic_acceleration = false;
@@ -71,8 +72,9 @@ class LevenbergMarquardtEngine : public Engine<N> {
 
   // The iteration on F given as residual(x, f) → finite? and jacobian(x, J) (evaluations it
   // spent); m = rows of F.
+  // jacobian_cost: the evaluations of F one Jacobian spends (0 when the problem carries one).
   template <typename Residual, typename Jacobian>
-  Summary run(Residual&& residual, Jacobian&& jacobian, Index m, Vector<N>& x);
+  Summary run(Residual&& residual, Jacobian&& jacobian, int jacobian_cost, Index m, Vector<N>& x);
   // min ‖[R; √λ D_P] z − [b; 0]‖ (MINPACK's qrsolv) into z; leaves S (the triangular factor of
   // the augmented matrix) in s_ and its diagonal in sdiag_.
   void solve_damped(double lambda, const Vector<N>& b, Vector<N>& z);
@@ -222,7 +224,7 @@ double LevenbergMarquardtEngine<N>::find_lambda(double delta, double lambda) {
   double paru = gnorm / delta;
   if (paru == 0.0) paru = dwarf / std::min(delta, 0.1);
 
-  lambda = std::clamp(lambda, parl, paru);
+  lambda = std::min(std::max(lambda, parl), paru);  // MINPACK's order (parl > paru by rounding)
   if (lambda == 0.0) lambda = gnorm / dxnorm;
   for (int iteration = 1;; ++iteration) {
     if (lambda == 0.0) lambda = std::max(dwarf, 0.001 * paru);
@@ -251,8 +253,8 @@ double LevenbergMarquardtEngine<N>::find_lambda(double delta, double lambda) {
 
 template <int N>
 template <typename Residual, typename Jacobian>
-Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobian, Index m,
-                                         Vector<N>& x) {
+Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobian,
+                                         int jacobian_cost, Index m, Vector<N>& x) {
   const Index n = x.size();
   const bool least_squares = m > n;
   StopCriteria stop = this->options_.stop;
@@ -271,14 +273,14 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
   x_ = x;
   std::optional<Status> status;
   if (!evaluate(x_, f_)) status = Status::kNonFinite;
-  double fnorm = f_.norm();
+  double fnorm = f_.stableNorm();  // overflow-safe, as MINPACK's enorm
   if (!status &&
       (fnorm == 0.0 || (stop.residual_tolerance &&
                         f_.template lpNorm<Eigen::Infinity>() <= *stop.residual_tolerance))) {
     status = Status::kConverged;
   }
   double delta = 0.0, xnorm = 0.0, lambda = 0.0, last_step = 0.0;
-  bool first_trial = true;
+  bool accepted_any = false;  // until the first accepted step Δ ≤ ‖Dp‖ (MINPACK's iter = 1)
   auto stagnate = [&](const char* why) {
     summary.message = why;
     status = Status::kStagnated;
@@ -287,6 +289,10 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
   while (!status) {
     if (evaluations >= stop.max_evaluations) {
       status = Status::kMaxEvaluations;
+      break;
+    }
+    if (evaluations + jacobian_cost > stop.max_evaluations) {
+      status = Status::kMaxEvaluations;  // the differences would overrun the budget
       break;
     }
     evaluations += jacobian(x_, f_, jac_);
@@ -343,8 +349,11 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
       lambda = find_lambda(delta, lambda);
       for (Index j = 0; j < n; ++j) v_[perm_[j]] = -z_[j];  // the step in x's order
       const double vnorm = diag_.cwiseProduct(v_).norm();
-      if (first_trial) delta = std::min(delta, vnorm);
-      first_trial = false;
+      if (!std::isfinite(lambda) || !v_.allFinite()) {
+        stagnate("the Levenberg-Marquardt step is not finite (J or F near overflow)");
+        break;
+      }
+      if (!accepted_any) delta = std::min(delta, vnorm);
       if (evaluations >= stop.max_evaluations) {
         status = Status::kMaxEvaluations;
         break;
@@ -375,7 +384,8 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
       const double pnorm = diag_.cwiseProduct(p_).norm();
       xt_ = x_ + p_;
       const bool finite = evaluate(xt_, ft_);
-      const double fnorm_trial = finite ? ft_.norm() : std::numeric_limits<double>::infinity();
+      const double fnorm_trial =
+          finite ? ft_.stableNorm() : std::numeric_limits<double>::infinity();
       const double actual =
           0.1 * fnorm_trial < fnorm ? 1.0 - std::pow(fnorm_trial / fnorm, 2) : -1.0;
       // Predicted reduction of the linear model, for the velocity v (Moré's formula).
@@ -386,7 +396,7 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
       const double directional = -(t1 * t1 + t2 * t2);
       const double ratio = predicted != 0.0 ? actual / predicted : 0.0;
 
-      if (ratio <= 0.25) {
+      if (!(ratio > 0.25)) {  // (a NaN ratio shrinks too)
         double shrink = actual >= 0.0 ? 0.5 : 0.5 * directional / (directional + 0.5 * actual);
         if (0.1 * fnorm_trial >= fnorm || shrink < 0.1) shrink = 0.1;
         delta = shrink * std::min(delta, pnorm / 0.1);
@@ -397,6 +407,7 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
       }
       const bool accepted = ratio >= 1e-4;
       if (accepted) {
+        accepted_any = true;
         x_ = xt_;
         std::swap(f_, ft_);
         fnorm = fnorm_trial;
@@ -471,7 +482,8 @@ Summary LevenbergMarquardtEngine<N>::solve(const FixedPointProblem<N>& problem, 
     jac.diagonal().array() -= 1.0;
     return spent;
   };
-  return run(residual, jacobian, n, x);
+  const int cost = problem.has_jacobian() ? 0 : finite_difference_cost(lm_.finite_difference, n);
+  return run(residual, jacobian, cost, n, x);
 }
 
 template <int N>
@@ -503,7 +515,9 @@ Summary LevenbergMarquardtEngine<N>::solve_least_squares(const RootProblem<N, Dy
         [&problem](const Vector<N>& p, ResidualVector& out) { problem.evaluate(p, out); }, at, f,
         jac, lm_.finite_difference, fd_, fp_, fm_);
   };
-  return run(residual, jacobian, m, x);
+  const int cost =
+      problem.has_jacobian() ? 0 : finite_difference_cost(lm_.finite_difference, problem.size());
+  return run(residual, jacobian, cost, m, x);
 }
 
 // Compiled once in the library for its sizes (nlobs/solvers/library_sizes.hpp).

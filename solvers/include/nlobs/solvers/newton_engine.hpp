@@ -3,6 +3,9 @@
 // on the window problem it is the Moraal–Grizzle observer, [MG95]:
 // w ← w + (∂H/∂w)⁻¹ (Y − H(w))). The Jacobian J = ∂G − I comes from the problem (user-supplied
 // or AD) or from finite differences. Optional backtracking line search on ½‖F‖₂² (Armijo).
+// Or a trust-region globalisation: the dogleg step between the Newton and the Cauchy step in
+// ‖p‖₂ ≤ Δ, a fresh Jacobian at every iterate (DoglegEngine without Broyden updates, whose
+// radius rules and stop tests it shares).
 // The residual at the returned point is always known: no extra evaluation.
 #include <Eigen/LU>
 #include <cmath>
@@ -11,6 +14,7 @@
 #include <sstream>
 #include <string_view>
 
+#include "nlobs/solvers/dogleg_engine.hpp"
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
@@ -20,6 +24,8 @@ namespace nlobs {
 
 struct NewtonOptions {
   bool line_search = false;
+  // Trust region instead (not with line_search): DoglegOptions' defaults, broyden_updates off.
+  bool trust_region = false;
   double sufficient_decrease = 1e-4;  // Armijo c ∈ (0, 0.5)
   double backtrack_factor = 0.5;      // t ← factor · t, factor ∈ (0, 1)
   int max_backtracks = 30;            // ≥ 1
@@ -44,7 +50,17 @@ class NewtonEngine : public Engine<N> {
       fail("backtrack_factor", newton_.backtrack_factor, "must lie in (0, 1)");
     }
     if (newton_.max_backtracks < 1) fail("max_backtracks", newton_.max_backtracks, "must be >= 1");
+    if (newton_.line_search && newton_.trust_region) {
+      throw InvalidInput(
+          "NewtonOptions: line_search and trust_region are two globalisations; "
+          "choose one");
+    }
     detail::require_lipschitz_for_error_bound(name(), this->options_.stop);
+    if (newton_.trust_region) {
+      trust_region_.emplace(
+          DoglegOptions{.broyden_updates = false, .finite_difference = newton_.finite_difference},
+          this->options_);
+    }
   }
 
   std::string_view name() const override { return "newton"; }
@@ -54,6 +70,7 @@ class NewtonEngine : public Engine<N> {
 
  private:
   NewtonOptions newton_;
+  std::optional<DoglegEngine<N>> trust_region_;
   Vector<N> x_ = zero_vector<N>(), g_ = zero_vector<N>(), f_ = zero_vector<N>(),
             dx_ = zero_vector<N>(), xt_ = zero_vector<N>(), ft_ = zero_vector<N>();
   Matrix<N, N> jac_;
@@ -67,6 +84,11 @@ class NewtonEngine : public Engine<N> {
 template <int N>
 Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
   detail::check_initial_guess(name(), problem, x);
+  if (trust_region_) {
+    Summary s = trust_region_->solve(problem, x);
+    s.engine = name();
+    return s;
+  }
   const StopCriteria& stop = this->options_.stop;
   const Index n = x.size();
   if constexpr (N == Dynamic) {
@@ -102,6 +124,11 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
       break;
     }
     // J_F = ∂G − I.
+    if (!problem.has_jacobian() &&
+        evaluations + finite_difference_cost(newton_.finite_difference, n) > stop.max_evaluations) {
+      status = Status::kMaxEvaluations;  // the differences would overrun the budget
+      break;
+    }
     if (problem.has_jacobian()) {
       problem.jacobian(x_, jac_);
     } else {

@@ -44,6 +44,8 @@ struct Summary {
   // Minimisation engines (NLopt): the objective at the returned x.
   std::optional<double> objective;
   std::string message;  // detail for kInvalidInput, kSingularJacobian, kSolverFailure, backends
+  // A polyalgorithm (auto): the label of the engine whose answer this is; empty otherwise.
+  std::string stage;
   std::vector<TraceEntry> trace;
 
   // What usable() judges by, recorded by the engine (record_answer()) from the x it returned

@@ -1,0 +1,216 @@
+#pragma once
+// Pseudo-transient continuation for F(x) = G(x) − x = 0 ([KK98]): follow a flow to its steady
+// state by linearly implicit Euler steps whose pseudo time step δ grows as ‖F‖ falls (switched
+// evolution relaxation):
+//   ẋ = σ F(x):   (δ_k⁻¹ I − σ J(x_k)) p_k = σ F(x_k),   x_{k+1} = x_k + p_k,
+//   δ_{k+1} = δ_k ‖F(x_{k−1})‖₂/‖F(x_k)‖₂, capped at max_pseudo_step.
+// σ = −1 (Flow::kResidual, the default): ẋ = −F(x), Kelley–Keyes' u_t = −F(u) for a root
+// problem F(x) = 0 adapted with Ψ = I (to_fixed_point); its roots attract where the eigenvalues
+// of J have positive real parts (discretised elliptic problems, gradients of convex functions).
+// σ = +1 (Flow::kFixedPoint): ẋ = G(x) − x, the flow whose explicit Euler step with δ = 1 is
+// Picard's x ← G(x); its fixed points attract where every eigenvalue of ∂G has real part < 1 (a
+// weaker condition than Picard's ρ(∂G) < 1). Small δ follows the flow (robust far from a root,
+// where Newton's local model is useless); large δ is Newton (quadratic convergence near the root).
+// A root the chosen flow leaves is not reached: the run ends without converging.
+//
+// Stop rules. Converged: StopCriteria's residual criterion, or its step criterion on a step that
+// is Newton's within 1 % (‖p‖ ≤ 0.01 δ ‖F‖: the pseudo-time term no longer shapes it). A trial
+// point where F is not finite halves δ and retries from the same iterate; δ below
+// min_pseudo_step ends the run non_finite. ‖F‖ may rise along the way (the flow is followed,
+// not ‖F‖ minimised): StopCriteria's stagnation rule is not applied; max_iterations,
+// max_evaluations and divergence_limit are.
+#include <Eigen/LU>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <string_view>
+
+#include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/finite_difference.hpp"
+#include "nlobs/solvers/library_sizes.hpp"
+#include "nlobs/solvers/stop_monitor.hpp"
+
+namespace nlobs {
+
+struct PseudoTransientOptions {
+  enum class Flow { kResidual, kFixedPoint };  // ẋ = −(G(x) − x)  or  ẋ = G(x) − x
+  // On the MGH root problems the residual flow solves 29 of 57 runs, the fixed-point flow 13.
+  Flow flow = Flow::kResidual;
+  double initial_pseudo_step = 1e-2;  // δ₀ > 0
+  double max_pseudo_step = 1e12;      // δ_max ≥ δ₀: beyond it the step is Newton's
+  double min_pseudo_step = 1e-12;     // δ_min ∈ (0, δ₀]: after NaN trials, give up below it
+  // Used only when the problem carries no Jacobian.
+  FiniteDifference finite_difference = FiniteDifference::kCentral;
+};
+
+template <int N = Dynamic>
+class PseudoTransientEngine : public Engine<N> {
+ public:
+  explicit PseudoTransientEngine(PseudoTransientOptions ptc = {}, SolverOptions options = {})
+      : Engine<N>(std::move(options)), ptc_(ptc) {
+    auto require = [](bool ok, const char* option, double value, const char* requirement) {
+      if (ok) return;
+      std::ostringstream os;
+      os << "PseudoTransientOptions::" << option << " = " << value
+         << " is invalid: " << requirement;
+      throw InvalidInput(os.str());
+    };
+    require(ptc_.initial_pseudo_step > 0.0 && std::isfinite(ptc_.initial_pseudo_step),
+            "initial_pseudo_step", ptc_.initial_pseudo_step, "must be finite and > 0");
+    require(ptc_.max_pseudo_step >= ptc_.initial_pseudo_step && std::isfinite(ptc_.max_pseudo_step),
+            "max_pseudo_step", ptc_.max_pseudo_step, "must be finite and >= initial_pseudo_step");
+    require(ptc_.min_pseudo_step > 0.0 && ptc_.min_pseudo_step <= ptc_.initial_pseudo_step,
+            "min_pseudo_step", ptc_.min_pseudo_step, "must lie in (0, initial_pseudo_step]");
+    detail::require_lipschitz_for_error_bound(name(), this->options_.stop);
+  }
+
+  std::string_view name() const override { return "pseudo-transient"; }
+  const PseudoTransientOptions& pseudo_transient_options() const { return ptc_; }
+
+  Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
+
+ private:
+  PseudoTransientOptions ptc_;
+  Vector<N> x_ = zero_vector<N>(), g_ = zero_vector<N>(), f_ = zero_vector<N>(),
+            p_ = zero_vector<N>(), xt_ = zero_vector<N>(), ft_ = zero_vector<N>();
+  Matrix<N, N> jac_, shifted_;
+  Eigen::PartialPivLU<Matrix<N, N>> lu_;
+  FiniteDifferenceWorkspace<N> fd_;
+};
+
+template <int N>
+Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
+  detail::check_initial_guess(name(), problem, x);
+  StopCriteria stop = this->options_.stop;
+  stop.stagnation_patience = 0;  // ‖F‖ and the steps may grow along the flow
+  const Index n = x.size();
+  if constexpr (N == Dynamic) {
+    for (Vector<N>* v : {&x_, &g_, &f_, &p_, &xt_, &ft_}) v->resize(n);
+    jac_.resize(n, n), shifted_.resize(n, n), fd_.resize(n);
+    if (lu_.rows() != n) lu_ = Eigen::PartialPivLU<Matrix<N, N>>(n);
+  }
+  Summary summary;
+  summary.engine = name();
+  StopMonitor monitor(stop, x.template lpNorm<Eigen::Infinity>(), /*estimate_lipschitz=*/false);
+  int evaluations = 0, jacobians = 0;
+
+  auto residual_at = [&](const Vector<N>& at, Vector<N>& f) {
+    problem.evaluate(at, g_);
+    ++evaluations;
+    detail::check_output_size(problem, g_);
+    f = g_ - at;
+    return f.allFinite();
+  };
+
+  x_ = x;
+  std::optional<Status> status;
+  if (!residual_at(x_, f_)) status = Status::kNonFinite;
+  double fnorm = f_.stableNorm();  // overflow-safe
+  if (!status &&
+      (fnorm == 0.0 || (stop.residual_tolerance &&
+                        f_.template lpNorm<Eigen::Infinity>() <= *stop.residual_tolerance))) {
+    status = Status::kConverged;
+  }
+  double delta = ptc_.initial_pseudo_step;
+  const int sigma = ptc_.flow == PseudoTransientOptions::Flow::kFixedPoint ? 1 : -1;
+
+  while (!status) {
+    if (evaluations >= stop.max_evaluations) {
+      status = Status::kMaxEvaluations;
+      break;
+    }
+    if (!problem.has_jacobian() &&
+        evaluations + finite_difference_cost(ptc_.finite_difference, n) > stop.max_evaluations) {
+      status = Status::kMaxEvaluations;  // the differences would overrun the budget
+      break;
+    }
+    if (problem.has_jacobian()) {
+      problem.jacobian(x_, jac_);
+    } else {
+      g_ = f_ + x_;
+      evaluations += finite_difference_jacobian(problem, x_, g_, jac_, ptc_.finite_difference, fd_);
+    }
+    ++jacobians;
+    jac_.diagonal().array() -= 1.0;  // J_F = ∂G − I
+    if (!jac_.allFinite()) {
+      summary.message = "the Jacobian of F is not finite";
+      status = Status::kNonFinite;
+      break;
+    }
+    // Trial steps from x_k: a non-finite F(x_k + p) halves δ and tries again.
+    bool stepped = false;
+    while (!status && !stepped) {
+      // σ = +1: (δ⁻¹I − J) p = F;  σ = −1: (δ⁻¹I + J) p = −F.
+      if (sigma > 0) {
+        shifted_ = -jac_;
+      } else {
+        shifted_ = jac_;
+      }
+      shifted_.diagonal().array() += 1.0 / delta;
+      lu_.compute(shifted_);
+      const double smallest_pivot = lu_.matrixLU().diagonal().cwiseAbs().minCoeff();
+      if (!(smallest_pivot > 1e-13 * shifted_.cwiseAbs().maxCoeff())) {
+        std::ostringstream os;
+        os << (sigma > 0 ? "delta^-1 I - J" : "delta^-1 I + J") << " is singular at iteration "
+           << monitor.iterations() + 1 << " (delta " << delta << ", smallest LU pivot "
+           << smallest_pivot << ")";
+        summary.message = os.str();
+        status = Status::kSingularJacobian;
+        break;
+      }
+      p_ = lu_.solve(f_);
+      if (sigma < 0) p_ = -p_;
+      if (evaluations >= stop.max_evaluations) {
+        status = Status::kMaxEvaluations;
+        break;
+      }
+      xt_ = x_ + p_;
+      if (p_.allFinite() && residual_at(xt_, ft_)) {
+        stepped = true;
+      } else {
+        delta *= 0.5;
+        if (delta < ptc_.min_pseudo_step) {
+          std::ostringstream os;
+          os << "F is not finite along the pseudo-transient path: delta fell below "
+             << ptc_.min_pseudo_step;
+          summary.message = os.str();
+          status = Status::kNonFinite;
+        }
+      }
+    }
+    if (status) break;
+    const double previous = fnorm;
+    x_ = xt_;
+    std::swap(f_, ft_);
+    fnorm = f_.stableNorm();
+    const double step = p_.template lpNorm<Eigen::Infinity>();
+    // Newton's step within 1 %: ‖δ⁻¹ p‖ = ‖F + J p‖ ≤ 0.01 ‖F‖ at the previous iterate.
+    const bool newton_like = p_.norm() <= 0.01 * delta * previous;
+    status = monitor.update(step, f_.template lpNorm<Eigen::Infinity>(),
+                            x_.template lpNorm<Eigen::Infinity>(), newton_like);
+    if (this->options_.record_trace) {
+      summary.trace.push_back(
+          {monitor.iterations(), step, f_.template lpNorm<Eigen::Infinity>(), x_});
+    }
+    if (!status && fnorm == 0.0) status = Status::kConverged;
+    // Switched evolution relaxation.
+    if (fnorm > 0.0) delta = std::min(delta * previous / fnorm, ptc_.max_pseudo_step);
+  }
+
+  x = x_;
+  summary.status = *status;
+  summary.function_evaluations = evaluations;
+  summary.jacobian_evaluations = jacobians;
+  monitor.fill(summary, f_.allFinite() ? f_.template lpNorm<Eigen::Infinity>()
+                                       : std::numeric_limits<double>::infinity());
+  summary.record_answer(x, this->options_.stop);
+  return summary;
+}
+
+// Compiled once in the library for its sizes (nlobs/solvers/library_sizes.hpp).
+#define NLOBS_EXTERN_PSEUDO_TRANSIENT_ENGINE(n) extern template class PseudoTransientEngine<n>;
+NLOBS_FOR_EACH_LIBRARY_SIZE(NLOBS_EXTERN_PSEUDO_TRANSIENT_ENGINE)
+#undef NLOBS_EXTERN_PSEUDO_TRANSIENT_ENGINE
+
+}  // namespace nlobs
