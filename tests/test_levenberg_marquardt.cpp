@@ -203,6 +203,7 @@ TEST(LevenbergMarquardt, FiniteDifferenceJacobiansStayWithinTheBudget) {
     Eigen::VectorXd p = Eigen::Vector3d(1.0, -0.1, 0.0);
     const Summary s = Lm({}, o).solve_least_squares(no_jacobian, p);  // central: 6 per Jacobian
     EXPECT_LE(s.function_evaluations, budget) << s.full_report();
+    EXPECT_EQ(s.status, Status::kMaxEvaluations) << budget;
   }
 }
 

@@ -5,9 +5,11 @@
 
 #include <cmath>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "nlobs/solvers/builtin_engines.hpp"
+#include "nlobs/solvers/dynamic_size_engine.hpp"
 #include "test_support.hpp"
 
 namespace nlobs {
@@ -30,6 +32,41 @@ FixedPointProblem<> parabola(double c) {
       },
       1, 1));
 }
+
+// A user's stage: records where it started, moves x to `to` in one evaluation and stops as
+// `status`; optionally throws, ignores its limit (reports `spend` evaluations) or skips
+// record_answer.
+class ScriptedEngine : public Engine<> {
+ public:
+  struct Script {
+    Eigen::VectorXd to;
+    Status status = Status::kStagnated;
+    bool throws = false;
+    int spend = 1;
+    bool record = true;
+  };
+  ScriptedEngine(Script script, Eigen::VectorXd* started_at)
+      : Engine<>(SolverOptions{}), script_(std::move(script)), started_at_(started_at) {}
+  std::string_view name() const override { return "scripted"; }
+  Summary solve(const FixedPointProblem<>& problem, Eigen::VectorXd& x) override {
+    if (started_at_) *started_at_ = x;
+    if (script_.throws) throw std::runtime_error("scripted failure");
+    x = script_.to;
+    Eigen::VectorXd g(x.size());
+    problem.evaluate(x, g);
+    Summary s;
+    s.engine = name();
+    s.status = script_.status;
+    s.function_evaluations = script_.spend;
+    s.residual_norm = (g - x).lpNorm<Eigen::Infinity>();
+    if (script_.record) s.record_answer(x, options().stop);
+    return s;
+  }
+
+ private:
+  Script script_;
+  Eigen::VectorXd* started_at_;
+};
 
 std::unique_ptr<PolyalgorithmEngine<>> poly(const std::vector<std::string>& names,
                                             PolyalgorithmOptions p = {},
@@ -57,7 +94,7 @@ TEST(Polyalgorithm, SwitchesWhenTheFirstEngineFails) {
 }
 
 TEST(Polyalgorithm, OneBudgetForAllStages) {
-  // No root: every stage fails; together they never exceed the budget.
+  // No root: every stage fails; together they never exceed the budget, and each one ran.
   SolverOptions o = strict();
   o.stop.max_evaluations = 40;
   auto engine = poly({"dogleg", "levenberg-marquardt", "pseudo-transient"}, {}, o);
@@ -68,19 +105,90 @@ TEST(Polyalgorithm, OneBudgetForAllStages) {
   // The best point any stage found: close to the minimiser 0 of ‖F‖, with its residual.
   EXPECT_LT(std::abs(x[0]), 0.1);
   EXPECT_NEAR(s.residual_norm, x[0] * x[0] + 1.0, 1e-12);
-  EXPECT_NE(s.message.find("dogleg"), std::string::npos) << s.message;
+  for (const char* stage : {"dogleg", "levenberg-marquardt"}) {
+    EXPECT_NE(s.message.find(stage), std::string::npos) << s.message;
+  }
+  // newton:trustregion=1 runs an inner dogleg built with its own (large) budget: auto's limit
+  // reaches it too. From 30 it needs more than 5 evaluations to reach the root 1.
+  SolverOptions small = strict();
+  small.stop.max_evaluations = 5;
+  std::vector<std::unique_ptr<Engine<>>> stages;
+  stages.push_back(EngineRegistry<>::global().create("newton:trustregion=1", strict()));
+  PolyalgorithmEngine<> nested(std::move(stages), {}, small);
+  x.setConstant(30.0);
+  const Summary n = nested.solve(parabola(-1.0), x);
+  EXPECT_LE(n.function_evaluations, 5) << n.full_report();
+  EXPECT_FALSE(n.usable());
 }
 
 TEST(Polyalgorithm, RestartsFromTheBestPointOrFromTheStart) {
-  // Stage 1 (picard on G = x + F, with F = x² − 4) diverges from 1.5 after a few steps; from
-  // the best point so far and from the start the dogleg then finds the root +2.
+  // Stage 1 moves x from 3 to 0.5 (|F| from 8 to 0.75 for F = x² − 1) and gives up; stage 2
+  // starts at 0.5 with restart_from_best, at 3 without.
   for (const bool best : {true, false}) {
-    auto engine = poly({"picard", "dogleg"}, {.restart_from_best = best});
-    Eigen::VectorXd x = Eigen::VectorXd::Constant(1, 1.5);
-    const Summary s = engine->solve(parabola(-4.0), x);
-    ASSERT_TRUE(s.converged()) << s.full_report();
+    Eigen::VectorXd first_start, second_start;
+    std::vector<std::unique_ptr<Engine<>>> stages;
+    stages.push_back(std::make_unique<ScriptedEngine>(
+        ScriptedEngine::Script{.to = Eigen::VectorXd::Constant(1, 0.5)}, &first_start));
+    stages.push_back(std::make_unique<ScriptedEngine>(
+        ScriptedEngine::Script{.to = Eigen::VectorXd::Constant(1, 1.0),
+                               .status = Status::kConverged},
+        &second_start));
+    PolyalgorithmEngine<> engine(std::move(stages), {.restart_from_best = best}, strict());
+    Eigen::VectorXd x = Eigen::VectorXd::Constant(1, 3.0);
+    const Summary s = engine.solve(parabola(-1.0), x);
+    ASSERT_TRUE(s.usable()) << s.full_report();
+    EXPECT_EQ(first_start[0], 3.0);
+    EXPECT_EQ(second_start[0], best ? 0.5 : 3.0);
+    EXPECT_EQ(x[0], 1.0);
+  }
+}
+
+TEST(Polyalgorithm, UsersStagesThatThrowSkipRecordingOrOverrunTheirLimit) {
+  Eigen::VectorXd ignored;
+  const Eigen::VectorXd root = Eigen::VectorXd::Constant(1, 1.0);
+  {  // a throwing stage is a line of the history; the next stage answers
+    std::vector<std::unique_ptr<Engine<>>> stages;
+    stages.push_back(std::make_unique<ScriptedEngine>(
+        ScriptedEngine::Script{.to = root, .throws = true}, &ignored));
+    stages.push_back(EngineRegistry<>::global().create("dogleg", strict()));
+    PolyalgorithmEngine<> engine(std::move(stages), {}, strict());
+    Eigen::VectorXd x = Eigen::VectorXd::Constant(1, 3.0);
+    const Summary s = engine.solve(parabola(-1.0), x);
+    EXPECT_TRUE(s.converged()) << s.full_report();
     EXPECT_EQ(s.stage, "dogleg");
-    EXPECT_NEAR(std::abs(x[0]), 2.0, 1e-12);
+    EXPECT_NE(s.message.find("scripted threw: scripted failure"), std::string::npos) << s.message;
+  }
+  {  // a converged answer without record_answer is still an answer: no further stage runs
+    Eigen::VectorXd second_start;
+    std::vector<std::unique_ptr<Engine<>>> stages;
+    stages.push_back(std::make_unique<ScriptedEngine>(
+        ScriptedEngine::Script{.to = root, .status = Status::kConverged, .record = false},
+        &ignored));
+    stages.push_back(
+        std::make_unique<ScriptedEngine>(ScriptedEngine::Script{.to = root}, &second_start));
+    PolyalgorithmEngine<> engine(std::move(stages), {}, strict());
+    Eigen::VectorXd x = Eigen::VectorXd::Constant(1, 3.0);
+    const Summary s = engine.solve(parabola(-1.0), x);
+    EXPECT_TRUE(s.usable()) << s.full_report();
+    EXPECT_EQ(second_start.size(), 0);
+  }
+  {  // a stage that overruns its limit ends the run; the overrun is reported, not hidden
+    SolverOptions o = strict();
+    o.stop.max_evaluations = 10;
+    Eigen::VectorXd second_start;
+    std::vector<std::unique_ptr<Engine<>>> stages;
+    stages.push_back(std::make_unique<ScriptedEngine>(
+        ScriptedEngine::Script{.to = Eigen::VectorXd::Constant(1, 2.0), .spend = 25}, &ignored));
+    stages.push_back(
+        std::make_unique<ScriptedEngine>(ScriptedEngine::Script{.to = root}, &second_start));
+    PolyalgorithmEngine<> engine(std::move(stages), {}, o);
+    Eigen::VectorXd x = Eigen::VectorXd::Constant(1, 3.0);
+    const Summary s = engine.solve(parabola(-1.0), x);
+    EXPECT_FALSE(s.usable());
+    EXPECT_EQ(s.function_evaluations, 25);
+    EXPECT_EQ(second_start.size(), 0);
+    EXPECT_EQ(s.status, Status::kStagnated);  // its own status, never turned into a usable one
+    EXPECT_NE(s.message.find("budget (10) is spent"), std::string::npos) << s.message;
   }
 }
 
@@ -107,8 +215,16 @@ TEST(Polyalgorithm, SpecsAndBadInput) {
               PolyalgorithmEngine<>(std::vector<std::unique_ptr<Engine<>>>{});
             }).find("at least one"),
             std::string::npos);
-  // A fixed size gets fixed-size stages.
-  EXPECT_EQ(EngineRegistry<3>::global().create("auto")->name(), "auto");
+  // A fixed size gets fixed-size stages, not the Dynamic ones adapted.
+  const auto fixed = EngineRegistry<3>::global().create("auto");
+  const auto* poly3 = dynamic_cast<const PolyalgorithmEngine<3>*>(fixed.get());
+  ASSERT_NE(poly3, nullptr);
+  for (const auto& stage : poly3->stages()) {
+    EXPECT_EQ(dynamic_cast<const DynamicSizeEngine<3>*>(stage.get()), nullptr) << stage->name();
+  }
+  EXPECT_NE(
+      test::message_of([&] { registry.create("auto:order=auto:from=best/dogleg"); }).find("other"),
+      std::string::npos);
 }
 
 }  // namespace

@@ -48,9 +48,13 @@ TEST(PseudoTransient, FollowsTheFlowWhereNewtonDiverges) {
   ASSERT_TRUE(s.converged()) << s.full_report();
   EXPECT_NEAR(x[0], 0.0, 1e-12);
   EXPECT_EQ(s.engine, "pseudo-transient");
-  // Early steps follow the flow (small), the last ones are Newton's (quadratic).
+  // The first step follows the flow (δ₀ |atan 10| ≈ 0.015, Newton's would be −144); near the
+  // root δ has grown with 1/‖F‖ and the steps shrink superlinearly (measured: by 40× from one
+  // step to the next; not quadratically, as long as δ⁻¹ still weighs in).
   ASSERT_GE(s.trace.size(), 4u);
-  EXPECT_LT(s.trace.front().step_norm, 1.0);
+  EXPECT_LT(s.trace.front().step_norm, 0.1);
+  const auto& t = s.trace;
+  EXPECT_LT(t[t.size() - 2].step_norm, 0.1 * t[t.size() - 3].step_norm);
 }
 
 TEST(PseudoTransient, ARootTheFlowLeavesIsNotReachedAndNotClaimed) {
@@ -98,6 +102,7 @@ TEST(PseudoTransient, ANonFiniteTrialHalvesThePseudoStep) {
           .solve(problem, x);
   ASSERT_TRUE(s.converged()) << s.full_report();
   EXPECT_NEAR(x[0], std::exp(-5.0), 1e-14);
+  EXPECT_GT(s.function_evaluations, s.iterations + 1);  // the rejected trials were evaluated
 
   const auto nowhere = FixedPointProblem<1>::with_jacobian(
       [](const Vector<1>& v, Vector<1>& g) {

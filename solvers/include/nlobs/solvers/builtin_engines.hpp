@@ -186,7 +186,7 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
          for (std::size_t at = 0; at <= order.size();) {
            const std::size_t slash = std::min(order.find('/', at), order.size());
            const std::string stage = order.substr(at, slash - at);
-           if (stage.empty() || stage == "auto") {
+           if (stage.empty() || parse_engine_spec(stage).name == "auto") {
              throw InvalidInput("auto: order=" + quoted_excerpt(order) +
                                 " needs engine names "
                                 "other than auto, separated by '/'");

@@ -33,6 +33,9 @@ class DynamicSizeEngine final : public Engine<N> {
   Summary solve_least_squares(const RootProblem<N, Dynamic>& problem, Vector<N>& x) override;
 
  private:
+  void on_limit_evaluations(int max_evaluations) override {
+    engine_->limit_evaluations(max_evaluations);
+  }
   std::unique_ptr<Engine<Dynamic>> engine_;
 };
 

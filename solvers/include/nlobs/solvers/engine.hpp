@@ -44,16 +44,20 @@ class Engine {
 
   const SolverOptions& options() const { return options_; }
   // Sets StopCriteria::max_evaluations (≥ 1) for the solves that follow: how a polyalgorithm
-  // hands each stage what the earlier ones left.
+  // hands each stage what the earlier ones left. An engine that runs other engines passes it on
+  // (on_limit_evaluations).
   void limit_evaluations(int max_evaluations) {
     if (max_evaluations < 1) {
       throw InvalidInput(std::string(name()) + ": an evaluation budget must be >= 1");
     }
     options_.stop.max_evaluations = max_evaluations;
+    on_limit_evaluations(max_evaluations);
   }
 
  protected:
   explicit Engine(SolverOptions options) : options_(std::move(options)) { validate(options_.stop); }
+  // Engines holding inner engines (DynamicSizeEngine, Newton's trust region) forward the limit.
+  virtual void on_limit_evaluations(int /*max_evaluations*/) {}
   SolverOptions options_;
 
  private:

@@ -69,6 +69,9 @@ class NewtonEngine : public Engine<N> {
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
 
  private:
+  void on_limit_evaluations(int max_evaluations) override {
+    if (trust_region_) trust_region_->limit_evaluations(max_evaluations);
+  }
   NewtonOptions newton_;
   std::optional<DoglegEngine<N>> trust_region_;
   Vector<N> x_ = zero_vector<N>(), g_ = zero_vector<N>(), f_ = zero_vector<N>(),

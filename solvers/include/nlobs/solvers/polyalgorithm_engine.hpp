@@ -3,8 +3,12 @@
 // from the best point so far (smallest ‖F‖∞), until one returns a usable answer
 // (Summary::usable()). The registry's `auto` is this with the stages of kAutoOrder
 // (builtin_engines.hpp), the order measured on the MGH set (docs/solvers.md). Summary::stage names
-// the engine whose answer is returned; Summary::message lists how every stage before it ended.
+// the engine whose answer is returned; Summary::message lists how every stage before it ended (a
+// stage that throws is one of them). The budget is shared through Engine::limit_evaluations: a
+// stage that ignores it ends the run after it.
+#include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -36,6 +40,7 @@ class PolyalgorithmEngine : public Engine<N> {
     if (stages_.empty()) throw InvalidInput("auto: needs at least one engine to try");
     for (const auto& s : stages_) {
       if (!s) throw InvalidInput("auto: a stage engine is null");
+      caps_.push_back(s->options().stop.max_evaluations);  // a stage's own cap stays a cap
     }
   }
 
@@ -49,28 +54,41 @@ class PolyalgorithmEngine : public Engine<N> {
     Vector<N> best = x, trial = x;
     double best_residual = std::numeric_limits<double>::infinity();
     Summary best_summary, last;
-    bool have_best = false;
+    bool have_best = false, have_last = false;
     int evaluations = 0, jacobians = 0, iterations = 0;
     std::ostringstream history;
-    for (const auto& stage : stages_) {
+    auto note = [&history](const std::string& what) {
+      if (history.tellp() > 0) history << "; ";
+      history << what;
+    };
+    for (std::size_t k = 0; k < stages_.size(); ++k) {
+      Engine<N>& stage = *stages_[k];
       const int left = budget - evaluations;
       if (left < 1) break;
-      stage->limit_evaluations(left);
+      stage.limit_evaluations(std::min(left, caps_[k]));
       trial = poly_.restart_from_best && have_best ? best : start;
-      last = stage->solve(problem, trial);
+      try {
+        last = stage.solve(problem, trial);
+      } catch (const std::exception& e) {  // a stage's failure is a row of the history
+        note(stage.label() + " threw: " + e.what());
+        continue;
+      }
+      have_last = true;
+      // A user's engine may not record its answer; judge it by the point it returned.
+      if (!last.answer_recorded) last.record_answer(trial, stage.options().stop);
       evaluations += last.function_evaluations;
       jacobians += last.jacobian_evaluations;
       iterations += last.iterations;
-      last.stage = stage->label();
+      last.stage = stage.label();
       if (last.usable()) {
         best = trial;
         best_summary = std::move(last);
         have_best = true;
         break;
       }
-      if (history.tellp() > 0) history << "; ";
-      history << stage->label() << ' ' << to_string(last.status);
-      if (!last.message.empty()) history << " (" << last.message << ')';
+      std::string what = stage.label() + " " + std::string(to_string(last.status));
+      if (!last.message.empty()) what += " (" + last.message + ")";
+      note(what);
       // The best point so far: finite, with the smallest residual any stage returned.
       if (trial.allFinite() && last.residual_norm < best_residual) {
         best_residual = last.residual_norm;
@@ -78,29 +96,45 @@ class PolyalgorithmEngine : public Engine<N> {
         best_summary = last;
         have_best = true;
       }
+      if (last.function_evaluations > left) break;  // a stage that ignored its limit
     }
-    Summary s = have_best ? std::move(best_summary) : std::move(last);
-    if (!have_best) {
-      best = start;
-      if (s.stage.empty()) s.status = Status::kMaxEvaluations;
+    Summary s;
+    if (have_best) {
+      s = std::move(best_summary);
+      x = best;
+    } else if (have_last) {
+      // No stage left a point with a known residual: the last stage's point, if finite.
+      s = std::move(last);
+      if (trial.allFinite()) {
+        x = trial;
+      } else {
+        x = start;
+        s.residual_norm = std::numeric_limits<double>::quiet_NaN();
+        s.step_norm = 0.0;
+        s.trace.clear();
+      }
+    } else {  // every stage threw
+      x = start;
+      s.status = Status::kSolverFailure;
     }
-    // A failed run reports the budget when it ran out, else the best stage's own status.
-    if (!s.usable() && evaluations >= budget) s.status = Status::kMaxEvaluations;
-    const std::string before = history.str();
-    if (!before.empty()) {
-      s.message = s.usable() ? "after " + before : before;
+    const bool usable = s.usable();
+    std::string before = history.str();
+    if (!usable && evaluations >= budget) {
+      before += (before.empty() ? "" : "; ") + std::string("the evaluation budget (") +
+                std::to_string(budget) + ") is spent";
     }
+    if (!before.empty()) s.message = usable ? "after " + before : before;
     s.engine = name();
     s.function_evaluations = evaluations;
     s.jacobian_evaluations = jacobians;
     s.iterations = iterations;
-    x = best;
-    s.record_answer(x, this->options_.stop);
+    s.record_answer(x, this->options_.stop, s.residual_minimised);
     return s;
   }
 
  private:
   std::vector<std::unique_ptr<Engine<N>>> stages_;
+  std::vector<int> caps_;
   PolyalgorithmOptions poly_;
 };
 
