@@ -1,7 +1,8 @@
 // Code from a plugin against the same code built into the program (issue: a plugin's model or
 // engine runs as fast as a built-in, within 5 %). The example plugin (examples/plugin) is loaded
 // at the first benchmark; its sources are also compiled into this binary:
-//   engine/*: Broyden on the plugin's bratu-1d (n = 8) from u = 0, through the registry (the
+//   engine/*: Broyden's second method (bad-broyden) on the plugin's bratu-1d (n = 8) from u = 0,
+//   through the registry (the
 //             plugin's copy) or constructed here; the problem is the same object.
 //   model/*:  one window-estimator step (engine newton, N = the default window) on the
 //             FitzHugh–Nagumo model registered by the plugin, or by this binary under another
@@ -10,7 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "broyden_engine.hpp"
+#include "bad_broyden_engine.hpp"
 #include "fitzhugh_nagumo.hpp"
 #include "nlobs/observers/core/simulation.hpp"
 #include "nlobs/registry/observer_types.hpp"
@@ -57,7 +58,7 @@ void solve_bratu(benchmark::State& state, nlobs::Engine<>& engine) {
     x = p.starts.at(0).x;
     const nlobs::Summary s = engine.solve_least_squares(p.residual, x);
     benchmark::DoNotOptimize(x.data());
-    if (!s.converged()) state.SkipWithError("broyden did not converge on bratu-1d");
+    if (!s.converged()) state.SkipWithError("bad-broyden did not converge on bratu-1d");
     evaluations += s.function_evaluations, ++solves;
   }
   state.counters["evaluations"] = static_cast<double>(evaluations) / static_cast<double>(solves);
@@ -65,16 +66,16 @@ void solve_bratu(benchmark::State& state, nlobs::Engine<>& engine) {
 
 void BM_PluginEngine(benchmark::State& state) {
   load_example_plugin();
-  auto engine = nlobs::EngineRegistry<nlobs::Dynamic>::global().create("broyden", tight());
+  auto engine = nlobs::EngineRegistry<nlobs::Dynamic>::global().create("bad-broyden", tight());
   solve_bratu(state, *engine);
 }
-BENCHMARK(BM_PluginEngine)->Name("plugin/engine/broyden_bratu8/plugin");
+BENCHMARK(BM_PluginEngine)->Name("plugin/engine/bad_broyden_bratu8/plugin");
 
 void BM_BuiltInEngine(benchmark::State& state) {
-  example::BroydenEngine<> engine(tight(), {});
+  example::BadBroydenEngine<> engine(tight(), {});
   solve_bratu(state, engine);
 }
-BENCHMARK(BM_BuiltInEngine)->Name("plugin/engine/broyden_bratu8/built_in");
+BENCHMARK(BM_BuiltInEngine)->Name("plugin/engine/bad_broyden_bratu8/built_in");
 
 // One window step on the model `name` from the registry, the CLI's way.
 void window_step(benchmark::State& state, const char* name) {

@@ -89,9 +89,18 @@ TEST(Allocations, FixedSizeSolvesAllocateNothing) {
   DoglegEngine<3> dogleg({}, o);
   // Its residual and Jacobian workspaces have m rows: sized by the warm-up, reused after.
   LevenbergMarquardtEngine<3> lm({}, o);
-  for (Engine<3>* e : std::initializer_list<Engine<3>*>{&picard, &aitken, &steffensen, &anderson,
-                                                        &newton, &newton_ls, &tiny, &dogleg, &lm}) {
+  BroydenEngine<3> broyden({}, o);
+  for (Engine<3>* e :
+       std::initializer_list<Engine<3>*>{&picard, &aitken, &steffensen, &anderson, &newton,
+                                         &newton_ls, &tiny, &dogleg, &lm, &broyden}) {
     EXPECT_EQ(allocations_during_solve(*e, cw.problem), 0) << e->name();
+  }
+  // In a box (wide enough to hold the run): the projection and the box allocate nothing either.
+  const BoxBounds box{Eigen::Vector3d::Constant(-100.0), Eigen::Vector3d::Constant(100.0)};
+  for (Engine<3>* e :
+       std::initializer_list<Engine<3>*>{&newton, &newton_ls, &dogleg, &lm, &broyden}) {
+    e->set_bounds(box);
+    EXPECT_EQ(allocations_during_solve(*e, cw.problem), 0) << e->name() << " in a box";
   }
 }
 

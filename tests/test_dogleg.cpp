@@ -14,21 +14,8 @@
 namespace nlobs {
 namespace {
 
-// F(x) = [x1² + x2² − 4, x1 − x2]: root (√2, √2).
-RootProblem<2> circle_line() {
-  return RootProblem<2>::with_autodiff([](const auto& x) {
-    using T = typename std::decay_t<decltype(x)>::Scalar;
-    Eigen::Matrix<T, 2, 1> f;
-    f << x[0] * x[0] + x[1] * x[1] - 4.0, x[0] - x[1];
-    return f;
-  });
-}
-
-SolverOptions strict() {
-  SolverOptions o = test::tolerance(1e-13);
-  o.stop.residual_tolerance = 1e-12;
-  return o;
-}
+using test::circle_line;
+using test::strict;
 
 TEST(Dogleg, SolvesASmallSystemToMachinePrecision) {
   DoglegEngine<2> dogleg({}, strict());

@@ -62,7 +62,7 @@ TEST(Usable, CutShortCountsOnlyWithASmallResidual) {
 
 TEST(Usable, FailuresAreNeverUsable) {
   for (Status bad : {Status::kDiverged, Status::kNonFinite, Status::kSingularJacobian,
-                     Status::kSolverFailure, Status::kInvalidInput}) {
+                     Status::kSolverFailure, Status::kInvalidInput, Status::kBlockedByBound}) {
     EXPECT_FALSE(summary_with(bad, 0.0).usable()) << to_string(bad);
   }
 }

@@ -13,11 +13,7 @@
 namespace nlobs {
 namespace {
 
-SolverOptions strict() {
-  SolverOptions o = test::tolerance(1e-13);
-  o.stop.residual_tolerance = 1e-12;
-  return o;
-}
+using test::strict;
 
 using Lm = LevenbergMarquardtEngine<>;
 

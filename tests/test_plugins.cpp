@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "broyden_engine.hpp"
+#include "bad_broyden_engine.hpp"
 #include "cli_test_files.hpp"
 #include "nlobs/reference/problem_suite.hpp"
 #include "nlobs/registry/plugin.hpp"
@@ -51,16 +51,16 @@ TEST(Plugins, TheExamplePluginRegistersOneEntryOfEachKind) {
   const LoadedPlugin loaded = load_plugin(kExample);
   EXPECT_EQ(loaded.source, kExample);
   EXPECT_EQ(loaded.models, std::vector<std::string>{"fitzhugh-nagumo"});
-  EXPECT_EQ(loaded.engines, std::vector<std::string>{"broyden"});
+  EXPECT_EQ(loaded.engines, std::vector<std::string>{"bad-broyden"});
   EXPECT_EQ(loaded.problem_sets, std::vector<std::string>{"example"});
   EXPECT_EQ(loaded.observer_types, std::vector<std::string>{"output_injection"});
   EXPECT_EQ(observer_type_registry().source("output_injection"), kExample);
   EXPECT_EQ(model_registry().source("fitzhugh-nagumo"), kExample);
   EXPECT_EQ(problem_set_registry().source("example"), kExample);
-  EXPECT_EQ(EngineRegistry<Dynamic>::global().source("broyden"), kExample);
+  EXPECT_EQ(EngineRegistry<Dynamic>::global().source("bad-broyden"), kExample);
   // One registration at Dynamic serves every fixed size.
-  EXPECT_NE(EngineRegistry<2>::global().create("broyden:backtracks=4"), nullptr);
-  EXPECT_NE(EngineRegistry<7>::global().create("broyden"), nullptr);
+  EXPECT_NE(EngineRegistry<2>::global().create("bad-broyden:backtracks=4"), nullptr);
+  EXPECT_NE(EngineRegistry<7>::global().create("bad-broyden"), nullptr);
   // The built-ins are still there, and the plugin's entries are listed after them.
   EXPECT_EQ(model_registry().names().back(), "fitzhugh-nagumo");
   EXPECT_TRUE(model_registry().contains("lorenz"));
@@ -85,7 +85,7 @@ TEST(Plugins, APluginModelRunsWithTheObserverTypesItAdmitsAndAPluginEngine) {
   }
   // Noise-free data: the windows (Newton's and the plugin's Broyden), the EKF, the MVT and
   // high-gain observers reconstruct the state.
-  EXPECT_EQ(r.metrics[1].engine, "broyden");
+  EXPECT_EQ(r.metrics[1].engine, "bad-broyden");
   for (size_t i = 0; i < 5; ++i) {
     SCOPED_TRACE(r.metrics[i].name);
     EXPECT_LT(r.metrics[i].mse_after_window.maxCoeff(), 1e-6);
@@ -113,12 +113,12 @@ TEST(Plugins, APluginEngineRunsInTheSuiteBesideKinsolAndMinpackOnAPluginSet) {
   const ProblemSelection selection = select_problems("example", problem_set_registry());
   ASSERT_EQ(selection.problems.size(), 2u);
   const auto rows = reference::run_suite(*selection.set, selection.problems,
-                                         {"broyden", "kinsol:newton", "minpack:hybrj"});
+                                         {"bad-broyden", "kinsol:newton", "minpack:hybrj"});
   ASSERT_EQ(rows.size(), 12u);  // 2 problems × 2 starts × 3 solvers
   int broyden_solved = 0;
   for (const auto& row : rows) {
     SCOPED_TRACE(row.problem + " " + row.start + " " + row.solver);
-    if (row.solver == "broyden") broyden_solved += row.solved;
+    if (row.solver == "bad-broyden") broyden_solved += row.solved;
     if (row.problem == "circle-line" && row.solved) {
       EXPECT_LT(row.error, 1e-8);  // the known root (1, 1), inside the box
     }
@@ -128,7 +128,7 @@ TEST(Plugins, APluginEngineRunsInTheSuiteBesideKinsolAndMinpackOnAPluginSet) {
 
 // The example's engine on its own: success, and each failure a status, never a wrong answer.
 TEST(Plugins, TheExampleBroydenEngineSolvesAndFailsClearly) {
-  using Engine = example::BroydenEngine<2>;
+  using Engine = example::BadBroydenEngine<2>;
   SolverOptions options;
   options.stop.residual_tolerance = 1e-12;
   {  // Rosenbrock's F = (10 (x2 − x1²), 1 − x1) from the far start of MGH
@@ -284,7 +284,7 @@ TEST(Plugins, LoadingAPluginTwiceIsRefusedAndTheFirstStays) {
   load_plugin(kExample);
   const std::string why = refusal(kExample);
   EXPECT_TRUE(contains(why, "from " + kExample + " is already registered by " + kExample)) << why;
-  EXPECT_NE(EngineRegistry<Dynamic>::global().create("broyden"), nullptr);
+  EXPECT_NE(EngineRegistry<Dynamic>::global().create("bad-broyden"), nullptr);
 }
 
 TEST(Plugins, ThePluginPathTakesFilesAndDirectories) {
@@ -324,10 +324,10 @@ TEST(Plugins, AProgramsOwnRegistrationHasTheSameChecks) {
   EXPECT_FALSE(problem_set_registry().contains("my-set"));
   const auto twice = [](PluginRegistrar& r) {
     r.add_engine({.name = "mine", .make = [](EngineSpecReader&, SolverOptions o) {
-                    return std::unique_ptr<Engine<>>(new example::BroydenEngine<>(o, {}));
+                    return std::unique_ptr<Engine<>>(new example::BadBroydenEngine<>(o, {}));
                   }});
     r.add_engine({.name = "mine", .make = [](EngineSpecReader&, SolverOptions o) {
-                    return std::unique_ptr<Engine<>>(new example::BroydenEngine<>(o, {}));
+                    return std::unique_ptr<Engine<>>(new example::BadBroydenEngine<>(o, {}));
                   }});
   };
   try {
@@ -347,7 +347,7 @@ TEST(Plugins, AProgramsOwnRegistrationHasTheSameChecks) {
   }
   const auto good = [](PluginRegistrar& r) {
     r.add_engine({.name = "mine", .make = [](EngineSpecReader&, SolverOptions o) {
-                    return std::unique_ptr<Engine<>>(new example::BroydenEngine<>(o, {}));
+                    return std::unique_ptr<Engine<>>(new example::BadBroydenEngine<>(o, {}));
                   }});
   };
   const LoadedPlugin loaded = register_extensions(good, "my program");
@@ -369,18 +369,18 @@ TEST(Plugins, TheCliLoadsPluginsFromTheCommandLineAndThePath) {
   EXPECT_TRUE(contains(list.out, "observers: window ekf luenberger sliding_mode mvt high_gain"))
       << list.out;
   EXPECT_TRUE(contains(list.out, "; from " + kExample)) << list.out;
-  EXPECT_TRUE(contains(list.out, "broyden — Broyden's good method")) << list.out;
+  EXPECT_TRUE(contains(list.out, "bad-broyden — Broyden")) << list.out;
   EXPECT_TRUE(contains(list.out, "example — the example plugin's two problems")) << list.out;
 
   // After the subcommand, before its arguments: one path per --plugin.
   const CliRun after = cli("", "list --plugin " + kExample + " engines");
   EXPECT_EQ(after.status, 0) << after.out;
-  EXPECT_TRUE(contains(after.out, "broyden — Broyden's good method")) << after.out;
+  EXPECT_TRUE(contains(after.out, "bad-broyden — Broyden")) << after.out;
   EXPECT_FALSE(contains(after.out, "models (JSON")) << after.out;  // `engines` was the subject
   const CliRun run =
       cli("", "run --plugin " + kExample + " " NLOBS_EXAMPLE_SCENARIO " --steps 300");
   EXPECT_EQ(run.status, 0) << run.out;
-  EXPECT_TRUE(contains(run.out, "window:broyden")) << run.out;
+  EXPECT_TRUE(contains(run.out, "window:bad-broyden")) << run.out;
   EXPECT_TRUE(contains(run.out, "output_injection")) << run.out;
 
   const CliRun path = cli("NLOBS_PLUGIN_PATH=" + kExample, "list problems");
@@ -388,7 +388,7 @@ TEST(Plugins, TheCliLoadsPluginsFromTheCommandLineAndThePath) {
   EXPECT_TRUE(contains(path.out, "circle-line:n=2; starts near far; bounded")) << path.out;
 
   const CliRun solve = cli("", "--plugin " + kExample +
-                                   " solve example/circle-line --engines broyden,kinsol:newton "
+                                   " solve example/circle-line --engines bad-broyden,kinsol:newton "
                                    "--json");
   ASSERT_EQ(solve.status, 0) << solve.out;
   const nlohmann::json rows = nlohmann::json::parse(solve.out);

@@ -146,18 +146,39 @@ TEST(ProblemSets, AUsersSetRunsEverySolverOnEveryStartJudgedAlike) {
 
 TEST(ProblemSets, APointOutsideTheBoundsIsNotASolution) {
   register_once();
-  // x² = 1 in [-0.9, 2] from -0.5: Newton goes to -1, a root outside the box.
+  // x² = 1 in [-0.9, 2] from -0.5: MINPACK (unbounded) goes to -1, a root outside the box;
+  // newton gets the box and stops on its bound, where its step points out.
   TestProblem p =
       root_test_problem("square", 1, [](const auto& x, auto& f) { f[0] = x[0] * x[0] - 1.0; },
                         {{"left", Eigen::VectorXd::Constant(1, -0.5)}});
   p.lower = Eigen::VectorXd::Constant(1, -0.9);
   p.upper = Eigen::VectorXd::Constant(1, 2.0);
   const ProblemSetEntry set{.name = "one", .problems = [p] { return std::vector<TestProblem>{p}; }};
-  const auto rows = reference::run_suite(set, build_problem_set(set), {"newton"});
-  ASSERT_EQ(rows.size(), 1u);
+  const auto rows = reference::run_suite(set, build_problem_set(set), {"minpack:hybrj", "newton"});
+  ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(rows[0].status, "outside_bounds");
   EXPECT_FALSE(rows[0].solved);
   EXPECT_LT(rows[0].residual, 1e-8);  // a root, but not in the box
+  EXPECT_EQ(rows[1].status, "blocked_by_bound");
+  EXPECT_FALSE(rows[1].solved);
+  EXPECT_NEAR(rows[1].residual, 0.19, 1e-12);  // at x = -0.9
+}
+
+TEST(ProblemSets, TheBoundedSetGivesItsBoxToTheEnginesThatTakeOne) {
+  // auto gets the box and stays in it; MINPACK has none and is judged the same way.
+  const ProblemSelection s = select_problems("bounded", problem_set_registry());
+  const auto rows = reference::run_suite(*s.set, s.problems, {"auto", "minpack:hybrj"});
+  int auto_solved = 0, minpack_solved = 0;
+  for (const SuiteRow& r : rows) {
+    if (r.solver == "auto") {
+      auto_solved += r.solved;
+      EXPECT_NE(r.status, "outside_bounds") << r.problem << " " << r.start;
+    } else {
+      minpack_solved += r.solved;
+    }
+  }
+  EXPECT_EQ(auto_solved, 6);     // all but bullard-biegler from b (docs/solvers.md, "Bounds")
+  EXPECT_EQ(minpack_solved, 2);  // measured; unbounded, it leaves the box or F's domain
 }
 
 TEST(ProblemSets, AThrowingProblemOrEngineIsARowNotTheEnd) {

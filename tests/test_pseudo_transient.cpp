@@ -11,11 +11,7 @@
 namespace nlobs {
 namespace {
 
-SolverOptions strict() {
-  SolverOptions o = test::tolerance(1e-13);
-  o.stop.residual_tolerance = 1e-12;
-  return o;
-}
+using test::strict;
 
 template <typename F>
 FixedPointProblem<1> scalar_root(F f) {

@@ -213,7 +213,7 @@ TEST(Status, EveryStatusHasAName) {
   for (Status st :
        {Status::kConverged, Status::kMaxIterations, Status::kMaxEvaluations, Status::kStagnated,
         Status::kRepeatedIterates, Status::kDiverged, Status::kNonFinite, Status::kSingularJacobian,
-        Status::kInvalidInput, Status::kSolverFailure}) {
+        Status::kInvalidInput, Status::kSolverFailure, Status::kBlockedByBound}) {
     EXPECT_NE(to_string(st), "unknown");
   }
 }

@@ -46,4 +46,21 @@ inline SolverOptions tolerance(double step) {
   return o;
 }
 
+// The Newton-type engines' tests: steps to 1e-13, |F|∞ to 1e-12.
+inline SolverOptions strict() {
+  SolverOptions o = tolerance(1e-13);
+  o.stop.residual_tolerance = 1e-12;
+  return o;
+}
+
+// F(x) = [x1² + x2² − 4, x1 − x2]: root (√2, √2).
+inline RootProblem<2> circle_line() {
+  return RootProblem<2>::with_autodiff([](const auto& x) {
+    using T = typename std::decay_t<decltype(x)>::Scalar;
+    Eigen::Matrix<T, 2, 1> f;
+    f << x[0] * x[0] + x[1] * x[1] - 4.0, x[0] - x[1];
+    return f;
+  });
+}
+
 }  // namespace nlobs::test

@@ -5,7 +5,7 @@
 namespace example {
 
 void add_fitzhugh_nagumo(nlobs::PluginRegistrar& registrar);   // fitzhugh_nagumo_entry.cpp
-void add_broyden(nlobs::PluginRegistrar& registrar);           // broyden_entry.cpp
+void add_bad_broyden(nlobs::PluginRegistrar& registrar);       // bad_broyden_entry.cpp
 void add_example_problems(nlobs::PluginRegistrar& registrar);  // example_problems.cpp
 void add_output_injection(nlobs::PluginRegistrar& registrar);  // output_injection_entry.cpp
 

@@ -1,4 +1,4 @@
-// A two-problem set, `example`: `nlobs suite example` runs broyden beside the built-in engines,
+// A two-problem set, `example`: `nlobs suite example` runs bad-broyden beside the built-in engines,
 // KINSOL, MINPACK and GSL on every (problem, start).
 #include <cmath>
 

@@ -1,13 +1,13 @@
 // The example plugin's entry point: `nlobs --plugin libnlobs_example_plugin.so list` shows a
-// model (fitzhugh-nagumo), an engine (broyden), an observer type (output_injection) and a
-// problem set (example) beside the built-ins.
+// model (fitzhugh-nagumo), an engine (bad-broyden, Broyden's second method), an observer type
+// (output_injection) and a problem set (example) beside the built-ins.
 #include "example_plugin.hpp"
 
 namespace {
 
 void register_example_plugin(nlobs::PluginRegistrar& registrar) {
   example::add_fitzhugh_nagumo(registrar);
-  example::add_broyden(registrar);
+  example::add_bad_broyden(registrar);
   example::add_example_problems(registrar);
   example::add_output_injection(registrar);
 }

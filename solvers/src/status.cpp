@@ -26,6 +26,8 @@ std::string_view to_string(Status status) {
       return "invalid_input";
     case Status::kSolverFailure:
       return "solver_failure";
+    case Status::kBlockedByBound:
+      return "blocked_by_bound";
   }
   return "unknown";
 }

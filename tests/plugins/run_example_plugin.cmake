@@ -55,7 +55,7 @@ endforeach()
 
 # The plugin's engine beside KINSOL on the plugin's problem set.
 execute_process(COMMAND ${nlobs} --plugin ${plugin} suite example
-                        --solvers broyden,newton,kinsol:newton --json
+                        --solvers bad-broyden,newton,kinsol:newton --json
                 OUTPUT_VARIABLE rows ERROR_VARIABLE err RESULT_VARIABLE rc)
 if(rc)
   message(FATAL_ERROR "nlobs suite example failed (${rc}):\n${rows}\n${err}")
@@ -69,7 +69,7 @@ foreach(i RANGE ${last})
   string(JSON solved GET "${rows}" ${i} solved)
   string(JSON problem GET "${rows}" ${i} problem)
   string(JSON start GET "${rows}" ${i} start)
-  if(solver STREQUAL "broyden" AND solved)
+  if(solver STREQUAL "bad-broyden" AND solved)
     math(EXPR broyden_solved "${broyden_solved} + 1")
   endif()
   if(solver STREQUAL "kinsol:newton")
@@ -78,6 +78,6 @@ foreach(i RANGE ${last})
   message(STATUS "${problem} ${start} ${solver}: solved ${solved}")
 endforeach()
 if(broyden_solved LESS 3 OR NOT kinsol_rows EQUAL 4)
-  message(FATAL_ERROR "expected broyden to solve at least 3 of the 4 (problem, start) pairs and "
+  message(FATAL_ERROR "expected bad-broyden to solve at least 3 of the 4 (problem, start) pairs and "
                       "4 KINSOL rows; got ${broyden_solved} and ${kinsol_rows}:\n${rows}")
 endif()

@@ -1,5 +1,5 @@
 #pragma once
-// The built-in problem sets in their documented order: chua-window, mgh.
+// The built-in problem sets in their documented order: chua-window, mgh, bounded.
 #include "nlobs/registry/problem_sets.hpp"
 
 namespace nlobs::detail {

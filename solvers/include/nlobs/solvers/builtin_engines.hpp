@@ -8,6 +8,7 @@
 #include <string>
 #include <utility>
 
+#include "nlobs/solvers/broyden_engine.hpp"
 #include "nlobs/solvers/ceres_engine.hpp"
 #include "nlobs/solvers/dogleg_engine.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
@@ -108,6 +109,20 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
          if (auto v = s.text("fd"))
            d.finite_difference = detail::parse_finite_difference("dogleg", *v);
          return std::make_unique<DoglegEngine<N>>(d, std::move(o));
+       }});
+  add({"broyden",
+       "Broyden's good method: line search, Jacobian restarts, O(n^2) inverse updates",
+       {{"backtracks", "step halvings before the Jacobian is renewed, 0..60; default 10"},
+        {"updates", "updates before a fresh Jacobian regardless, 0 = off; default 0"},
+        {"fd", "forward|central differences when no Jacobian; default central"}},
+       {"broyden", "broyden:fd=forward,updates=20"},
+       [](EngineSpecReader& s, SolverOptions o) {
+         BroydenOptions b;
+         if (auto v = s.integer("backtracks", 0, 60)) b.max_backtracks = *v;
+         if (auto v = s.integer("updates", 0, 1 << 30)) b.max_updates = *v;
+         if (auto v = s.text("fd"))
+           b.finite_difference = detail::parse_finite_difference("broyden", *v);
+         return std::make_unique<BroydenEngine<N>>(b, std::move(o));
        }});
   add({"levenberg-marquardt",
        "Levenberg-Marquardt as MINPACK lmder (More's lambda and scaling), square or least "

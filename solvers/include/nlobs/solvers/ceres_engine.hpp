@@ -70,10 +70,15 @@ class CeresEngine : public Engine<N> {
       }
     }
     detail::validate_box("CeresOptions", ceres_.lower_bounds, ceres_.upper_bounds);
+    this->bounds_ = {ceres_.lower_bounds, ceres_.upper_bounds};
   }
 
   std::string_view name() const override { return "ceres"; }
   const CeresOptions& ceres_options() const { return ceres_; }
+  // Every back end but TinySolver (set_bounds replaces CeresOptions' bounds).
+  bool accepts_bounds() const override {
+    return ceres_.backend != CeresOptions::Backend::kTinySolver;
+  }
   // Which back end solve() uses (for a fixed-size problem).
   bool uses_tiny_solver() const {
     return N != Dynamic && ceres_.backend != CeresOptions::Backend::kSolver &&
@@ -320,6 +325,12 @@ class CeresEngine : public Engine<N> {
     Summary s = finish<M>(source, w, x, status, static_cast<int>(ceres_summary_.iterations.size()));
     if (s.status == Status::kSolverFailure) s.message = ceres_summary_.message;
     return s;
+  }
+
+  void on_set_bounds() override {
+    ceres_.lower_bounds = this->bounds_.lower;
+    ceres_.upper_bounds = this->bounds_.upper;
+    problem_.reset();  // prepared again, with the new box, by the next solve
   }
 
   void prepare(int n, int m) {

@@ -17,6 +17,11 @@
 // stagnation_patience (a rule for monotone fixed-point steps; the radius makes steps grow and
 // shrink by design) is not used. A non-finite F at a trial point is a failed step: the radius
 // shrinks and the last good iterate is kept.
+//
+// Bounds (Engine::set_bounds): the trial point is P(x + p), the projection onto the box, and the
+// step taken p' = P(x + p) − x is the one the ratio, the model ‖F + J p'‖ and the Broyden update
+// use (a projected Gauss–Newton step is no step criterion). A stop of the progress tests at a
+// point where a bound holds x against −∇(½‖F‖²) is blocked_by_bound.
 #include <Eigen/Householder>
 #include <Eigen/Jacobi>
 #include <Eigen/QR>
@@ -30,6 +35,7 @@
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
+#include "nlobs/solvers/square_system.hpp"
 #include "nlobs/solvers/stop_monitor.hpp"
 
 namespace nlobs {
@@ -67,6 +73,7 @@ class DoglegEngine : public Engine<N> {
 
   std::string_view name() const override { return "dogleg"; }
   const DoglegOptions& dogleg_options() const { return dogleg_; }
+  bool accepts_bounds() const override { return true; }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
 
@@ -78,15 +85,15 @@ class DoglegEngine : public Engine<N> {
   void rank_one_update();
 
   DoglegOptions dogleg_;
-  Vector<N> x_ = zero_vector<N>(), g_ = zero_vector<N>(), f_ = zero_vector<N>(),
-            xt_ = zero_vector<N>(), ft_ = zero_vector<N>(), p_ = zero_vector<N>(),
-            qtf_ = zero_vector<N>(), diag_ = zero_vector<N>(), u_ = zero_vector<N>(),
-            v_ = zero_vector<N>(), gauss_newton_ = zero_vector<N>(), gradient_ = zero_vector<N>(),
+  Vector<N> x_ = zero_vector<N>(), f_ = zero_vector<N>(), xt_ = zero_vector<N>(),
+            ft_ = zero_vector<N>(), p_ = zero_vector<N>(), qtf_ = zero_vector<N>(),
+            diag_ = zero_vector<N>(), u_ = zero_vector<N>(), v_ = zero_vector<N>(),
+            gauss_newton_ = zero_vector<N>(), gradient_ = zero_vector<N>(),
             work_ = zero_vector<N>();
   Matrix<N, N> jac_, q_, r_;
   Eigen::HouseholderQR<Matrix<N, N>> qr_;
   Vector<N> householder_work_ = zero_vector<N>();
-  FiniteDifferenceWorkspace<N> fd_;
+  detail::SquareSystem<N> system_;
   bool step_was_gauss_newton_ = false;
 };
 
@@ -163,72 +170,60 @@ void DoglegEngine<N>::rank_one_update() {
 
 template <int N>
 Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
-  detail::check_initial_guess(name(), problem, x);
   StopCriteria stop = this->options_.stop;
   stop.stagnation_patience = 0;  // replaced by the trust region's own progress tests
+  system_.start(name(), problem, x, this->bounds_, dogleg_.finite_difference, stop.max_evaluations);
+  const detail::Box<N>& box = system_.box();
   const Index n = x.size();
   if constexpr (N == Dynamic) {
-    for (Vector<N>* v : {&x_, &g_, &f_, &xt_, &ft_, &p_, &qtf_, &diag_, &u_, &v_, &gauss_newton_,
+    for (Vector<N>* v : {&x_, &f_, &xt_, &ft_, &p_, &qtf_, &diag_, &u_, &v_, &gauss_newton_,
                          &gradient_, &work_, &householder_work_}) {
       v->resize(n);
     }
-    jac_.resize(n, n), q_.resize(n, n), r_.resize(n, n), fd_.resize(n);
+    jac_.resize(n, n), q_.resize(n, n), r_.resize(n, n);
     if (qr_.rows() != n) qr_ = Eigen::HouseholderQR<Matrix<N, N>>(n, n);
   }
   Summary summary;
   summary.engine = name();
   StopMonitor monitor(stop, x.template lpNorm<Eigen::Infinity>(), /*estimate_lipschitz=*/false);
-  int evaluations = 0, jacobians = 0;
   const double eps = std::numeric_limits<double>::epsilon();
-
-  auto residual_at = [&](const Vector<N>& at, Vector<N>& f) {
-    problem.evaluate(at, g_);
-    ++evaluations;
-    detail::check_output_size(problem, g_);
-    f = g_ - at;
-    return f.allFinite();
-  };
 
   x_ = x;
   std::optional<Status> status;
-  if (!residual_at(x_, f_)) status = Status::kNonFinite;
-  double fnorm = f_.stableNorm();  // overflow-safe, as MINPACK's enorm
-  if (!status &&
-      (fnorm == 0.0 || (stop.residual_tolerance &&
-                        f_.template lpNorm<Eigen::Infinity>() <= *stop.residual_tolerance))) {
-    status = Status::kConverged;  // x0 already solves F
+  if (!system_.residual(x_, f_)) {
+    status = Status::kNonFinite;
+  } else if (detail::solved_at_start(f_, stop)) {
+    status = Status::kConverged;
   }
+  double fnorm = f_.stableNorm();  // overflow-safe, as MINPACK's enorm
   double delta = 0.0, xnorm = 0.0, last_step = 0.0;
   int slow_iterations = 0, slow_jacobians = 0;  // MINPACK's nslow1, nslow2
   bool accepted_any = false;  // until the first accepted step Δ ≤ ‖Dp‖ (MINPACK's iter = 1)
   int failures = 0, successes = 0;  // consecutive; MINPACK's ncfail, ncsuc
 
+  // No further progress: blocked where the box holds x against −∇(½‖F‖²) = −Rᵀ Qᵀ F, else
+  // stagnated for `why`.
+  auto stop_stuck = [&](const char* why) {
+    gradient_.noalias() = r_.template triangularView<Eigen::Upper>().transpose() * qtf_;
+    gradient_ = -gradient_;
+    if (const std::optional<Index> i = box.blocking(x_, gradient_)) {
+      summary.message = box.blocked_message(*i, x_, f_.template lpNorm<Eigen::Infinity>(),
+                                            "the descent direction");
+      status = Status::kBlockedByBound;
+    } else {
+      summary.message = why;
+      status = Status::kStagnated;
+    }
+  };
+  int jacobians = 0;
   while (!status) {
-    if (evaluations >= stop.max_evaluations) {
+    if (system_.budget_spent()) {
       status = Status::kMaxEvaluations;
       break;
     }
     // J_F = ∂G − I, factored J = Q R.
-    if (!problem.has_jacobian() &&
-        evaluations + finite_difference_cost(dogleg_.finite_difference, n) > stop.max_evaluations) {
-      status = Status::kMaxEvaluations;  // the differences would overrun the budget
-      break;
-    }
-    if (problem.has_jacobian()) {
-      problem.jacobian(x_, jac_);
-    } else {
-      g_ = f_ + x_;
-      evaluations +=
-          finite_difference_jacobian(problem, x_, g_, jac_, dogleg_.finite_difference, fd_);
-    }
-    ++jacobians;
-    jac_.diagonal().array() -= 1.0;
-    if (!jac_.allFinite()) {
-      summary.message = "the Jacobian of F is not finite";
-      status = Status::kNonFinite;
-      break;
-    }
-    if (jacobians == 1) {
+    if ((status = system_.jacobian(x_, f_, jac_, summary.message))) break;
+    if (++jacobians == 1) {
       if (dogleg_.scaling == DoglegOptions::Scaling::kJacobianColumns) {
         diag_ = jac_.colwise().norm().transpose();
         for (Index j = 0; j < n; ++j) diag_[j] = diag_[j] == 0.0 ? 1.0 : diag_[j];
@@ -248,14 +243,28 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
     bool fresh_jacobian = true;
     while (!status) {
       dogleg_step(delta);
-      const double pnorm = diag_.cwiseProduct(p_).norm();
-      if (!accepted_any) delta = std::min(delta, pnorm);
-      if (evaluations >= stop.max_evaluations) {
+      if (!accepted_any) delta = std::min(delta, diag_.cwiseProduct(p_).norm());
+      if (system_.budget_spent()) {
         status = Status::kMaxEvaluations;
         break;
       }
+      // In a box the step is P(x + p) − x: the model, the ratio and the update all use it.
       xt_ = x_ + p_;
-      const bool finite = residual_at(xt_, ft_);
+      const bool projected = box.project(xt_);
+      if (projected) {
+        p_ = xt_ - x_;
+        step_was_gauss_newton_ = false;
+      }
+      const double pnorm = diag_.cwiseProduct(p_).norm();
+      if (projected && pnorm == 0.0) {
+        // The box holds x against this step: no evaluation, no failure counted against the
+        // Jacobian; a smaller radius turns the step towards −∇(½‖F‖²).
+        delta *= 0.5;
+        if (0.01 * delta > eps * xnorm) continue;
+        stop_stuck("the trust radius fell below machine precision relative to |x|");
+        break;
+      }
+      const bool finite = system_.residual(xt_, ft_);
       const double fnorm_trial =
           finite ? ft_.stableNorm() : std::numeric_limits<double>::infinity();
       // Actual and predicted reductions of ‖F‖₂², relative: 1 − (‖F⁺‖/‖F‖)², 1 − (‖F + Jp‖/‖F‖)².
@@ -319,8 +328,7 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
         why = "no 0.1% reduction of |F|2 over the last ten iterations";
       }
       if (why) {
-        summary.message = why;
-        status = Status::kStagnated;
+        stop_stuck(why);
         break;
       }
       // A fresh Jacobian after two failures (MINPACK); without Broyden updates after every
@@ -346,12 +354,7 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
   }
 
   x = x_;
-  summary.status = *status;
-  summary.function_evaluations = evaluations;
-  summary.jacobian_evaluations = jacobians;
-  monitor.fill(summary, f_.allFinite() ? f_.template lpNorm<Eigen::Infinity>()
-                                       : std::numeric_limits<double>::infinity());
-  summary.record_answer(x, this->options_.stop);
+  system_.finish(summary, *status, monitor, x, f_, this->options_.stop);
   return summary;
 }
 

@@ -26,6 +26,7 @@ class DynamicSizeEngine final : public Engine<N> {
   std::string_view name() const override { return engine_->name(); }
   bool least_squares() const override { return engine_->least_squares(); }
   bool needs_contraction() const override { return engine_->needs_contraction(); }
+  bool accepts_bounds() const override { return engine_->accepts_bounds(); }
   Engine<Dynamic>& engine() { return *engine_; }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
@@ -36,6 +37,7 @@ class DynamicSizeEngine final : public Engine<N> {
   void on_limit_evaluations(int max_evaluations) override {
     engine_->limit_evaluations(max_evaluations);
   }
+  void on_set_bounds() override { engine_->set_bounds(this->bounds_); }
   std::unique_ptr<Engine<Dynamic>> engine_;
 };
 

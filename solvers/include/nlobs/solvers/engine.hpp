@@ -6,6 +6,7 @@
 #include <string>
 #include <string_view>
 
+#include "nlobs/solvers/box_bounds.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
 #include "nlobs/solvers/problem.hpp"
 #include "nlobs/solvers/stop_criteria.hpp"
@@ -54,11 +55,39 @@ class Engine {
     on_limit_evaluations(max_evaluations);
   }
 
+  // Box bounds lower ≤ x ≤ upper for the solves that follow (an empty side: no bound; ±inf
+  // entries: no bound on that component). An engine that accepts them keeps every point where it
+  // evaluates G inside the box, finite-difference points included, and refuses (InvalidInput) a
+  // start outside it; the Newton-type engines project their steps (docs/solvers.md, "Bounds"),
+  // Ceres and NLopt pass the box to their libraries. The others throw InvalidInput here, as do
+  // bounds with lower > upper, NaN, lower = +inf or upper = −inf. Empty bounds remove the box.
+  virtual bool accepts_bounds() const { return false; }
+  void set_bounds(BoxBounds bounds) {
+    if (!bounds.empty() && !accepts_bounds()) {
+      throw InvalidInput(std::string(name()) +
+                         " does not accept bounds; engines that do: newton, dogleg, "
+                         "levenberg-marquardt, broyden, pseudo-transient, auto, ceres, nlopt");
+    }
+    detail::validate_box(name(), bounds.lower, bounds.upper);
+    BoxBounds previous = std::move(bounds_);
+    bounds_ = std::move(bounds);
+    try {
+      on_set_bounds();
+    } catch (...) {  // a box the engine's library refuses: the engine keeps the one it had
+      bounds_ = std::move(previous);
+      throw;
+    }
+  }
+  const BoxBounds& bounds() const { return bounds_; }
+
  protected:
   explicit Engine(SolverOptions options) : options_(std::move(options)) { validate(options_.stop); }
   // Engines holding inner engines (DynamicSizeEngine, Newton's trust region) forward the limit.
   virtual void on_limit_evaluations(int /*max_evaluations*/) {}
+  // Engines holding inner engines or a library's own copy of the box (Ceres, NLopt) take it here.
+  virtual void on_set_bounds() {}
   SolverOptions options_;
+  BoxBounds bounds_;
 
  private:
   std::string label_;

@@ -16,6 +16,16 @@
 // and gtol (the cosine between F and every column of J below it). On a square system those two
 // mean a local minimum of ‖F‖ that is not a root: stagnated, with the reason. Stagnated also:
 // the radius below ε‖D x‖₂. A non-finite F at a trial point is a failed step.
+//
+// Bounds (Engine::set_bounds): the trial point is P(x + p), the projection onto the box; the
+// ratio uses the reduction ‖F‖² − ‖F + J p'‖² the linear model predicts for the step taken,
+// p' = P(x + p) − x (Moré's formula when nothing was projected). At each Jacobian the variables a
+// bound holds against −Jᵀ F are frozen (an active set: their columns of J are zeroed, so the step
+// leaves them and the badly scaled held ones do not swamp the free ones, as in scipy's dogbox).
+// The gradient test then judges the free variables: a least-squares run has converged there (a
+// minimum on the box) and a square one is blocked_by_bound, as is a stagnation where a bound
+// holds x.
+// Geodesic acceleration is refused with bounds (its second-difference point may leave the box).
 #include <Eigen/Householder>
 #include <Eigen/QR>
 #include <algorithm>
@@ -28,6 +38,7 @@
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
+#include "nlobs/solvers/square_system.hpp"
 #include "nlobs/solvers/stop_monitor.hpp"
 
 namespace nlobs {
@@ -60,6 +71,7 @@ class LevenbergMarquardtEngine : public Engine<N> {
   std::string_view name() const override { return "levenberg-marquardt"; }
   const LevenbergMarquardtOptions& lm_options() const { return lm_; }
   bool least_squares() const override { return true; }
+  bool accepts_bounds() const override { return true; }
 
   // Square: F = G − x, J = ∂G − I.
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
@@ -82,19 +94,28 @@ class LevenbergMarquardtEngine : public Engine<N> {
   double find_lambda(double delta, double lambda);
 
   void resize(Index n, Index m);
+  void on_set_bounds() override {
+    if (lm_.geodesic_acceleration && !this->bounds_.empty()) {
+      throw InvalidInput(
+          "levenberg-marquardt: geodesic acceleration does not take bounds (its "
+          "second-difference point may leave the box)");
+    }
+  }
 
   LevenbergMarquardtOptions lm_;
   Vector<N> x_ = zero_vector<N>(), xt_ = zero_vector<N>(), p_ = zero_vector<N>(),
             diag_ = zero_vector<N>(), diag_p_ = zero_vector<N>(), qtf_ = zero_vector<N>(),
             z_ = zero_vector<N>(), w_ = zero_vector<N>(), sdiag_ = zero_vector<N>(),
             b_ = zero_vector<N>(), v_ = zero_vector<N>(), a_ = zero_vector<N>(),
-            qtr_ = zero_vector<N>(), g_ = zero_vector<N>(), column_norms_ = zero_vector<N>();
+            qtr_ = zero_vector<N>(), g_ = zero_vector<N>(), column_norms_ = zero_vector<N>(),
+            gradient_ = zero_vector<N>();
   ResidualVector f_, ft_, fh_, fp_, fm_, work_m_;
   JacobianMatrix jac_;
   Matrix<N, N> r_, s_;
   Eigen::ColPivHouseholderQR<JacobianMatrix> qr_;
   Eigen::Matrix<Index, N, 1> perm_;
   FiniteDifferenceWorkspace<N> fd_;
+  detail::Box<N> box_;
 };
 
 template <int N>
@@ -125,7 +146,7 @@ template <int N>
 void LevenbergMarquardtEngine<N>::resize(Index n, Index m) {
   if constexpr (N == Dynamic) {
     for (Vector<N>* v : {&x_, &xt_, &p_, &diag_, &diag_p_, &qtf_, &z_, &w_, &sdiag_, &b_, &v_, &a_,
-                         &qtr_, &g_, &column_norms_}) {
+                         &qtr_, &g_, &column_norms_, &gradient_}) {
       v->resize(n);
     }
     perm_.resize(n), r_.resize(n, n), s_.resize(n, n), fd_.resize(n);
@@ -272,16 +293,22 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
 
   x_ = x;
   std::optional<Status> status;
-  if (!evaluate(x_, f_)) status = Status::kNonFinite;
-  double fnorm = f_.stableNorm();  // overflow-safe, as MINPACK's enorm
-  if (!status &&
-      (fnorm == 0.0 || (stop.residual_tolerance &&
-                        f_.template lpNorm<Eigen::Infinity>() <= *stop.residual_tolerance))) {
+  if (!evaluate(x_, f_)) {
+    status = Status::kNonFinite;
+  } else if (detail::solved_at_start<Dynamic>(f_, stop)) {
     status = Status::kConverged;
   }
+  double fnorm = f_.stableNorm();  // overflow-safe, as MINPACK's enorm
   double delta = 0.0, xnorm = 0.0, lambda = 0.0, last_step = 0.0;
   bool accepted_any = false;  // until the first accepted step Δ ≤ ‖Dp‖ (MINPACK's iter = 1)
+  // A square system stuck where a bound holds x against −∇(½‖F‖²) = −Jᵀ F is blocked.
   auto stagnate = [&](const char* why) {
+    if (const std::optional<Index> i = box_.blocking(x_, gradient_)) {
+      summary.message = box_.blocked_message(*i, x_, f_.template lpNorm<Eigen::Infinity>(),
+                                             "the descent direction");
+      status = Status::kBlockedByBound;
+      return;
+    }
     summary.message = why;
     status = Status::kStagnated;
   };
@@ -301,6 +328,19 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
       summary.message = "the Jacobian of F is not finite";
       status = Status::kNonFinite;
       break;
+    }
+    // −∇(½‖F‖²) = −Jᵀ F; in a box, the active set: the variables a bound holds against it are
+    // frozen for this Jacobian (their columns zeroed, so the step leaves them where they are).
+    gradient_.noalias() = -(jac_.transpose() * f_);
+    bool bound_held = false;
+    if (box_.active()) {
+      for (Index k = 0; k < n; ++k) {
+        if ((x_[k] <= box_.lower()[k] && gradient_[k] < 0.0) ||
+            (x_[k] >= box_.upper()[k] && gradient_[k] > 0.0)) {
+          jac_.col(k).setZero();
+          bound_held = true;
+        }
+      }
     }
     column_norms_ = jac_.colwise().norm().transpose();
     if (jacobians == 1) {
@@ -324,7 +364,8 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
     work_m_.applyOnTheLeft(qr_.householderQ().adjoint());
     qtf_ = work_m_.head(n);
 
-    // MINPACK's gtol: the largest cosine between F and a column of J.
+    // MINPACK's gtol: the largest cosine between F and a column of J (in a box, of the free
+    // variables' columns: the frozen ones are zero).
     double cosine = 0.0;
     if (fnorm > 0.0) {
       for (Index j = 0; j < n; ++j) {
@@ -336,7 +377,8 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
     }
     if (cosine <= lm_.gradient_tolerance) {
       if (least_squares) {
-        summary.message = "the gradient vanishes: cos(F, J e_j) <= gradient_tolerance";
+        summary.message = bound_held ? "the projected gradient vanishes: a minimum on the box"
+                                     : "the gradient vanishes: cos(F, J e_j) <= gradient_tolerance";
         status = Status::kConverged;
       } else {
         stagnate("a local minimum of |F| that is not a root: J^T F = 0");
@@ -381,19 +423,37 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
           break;
         }
       }
-      const double pnorm = diag_.cwiseProduct(p_).norm();
       xt_ = x_ + p_;
+      const bool projected = box_.project(xt_);
+      if (projected) p_ = xt_ - x_;
+      const double pnorm = diag_.cwiseProduct(p_).norm();
+      if (projected && pnorm == 0.0) {
+        // The box holds x against this step: no evaluation; a smaller radius (a larger λ) turns
+        // the step towards −Jᵀ F.
+        delta *= 0.5;
+        if (delta > eps * xnorm) continue;
+        stagnate("the trust radius fell below machine precision relative to |x|");
+        break;
+      }
       const bool finite = evaluate(xt_, ft_);
       const double fnorm_trial =
           finite ? ft_.stableNorm() : std::numeric_limits<double>::infinity();
       const double actual =
           0.1 * fnorm_trial < fnorm ? 1.0 - std::pow(fnorm_trial / fnorm, 2) : -1.0;
-      // Predicted reduction of the linear model, for the velocity v (Moré's formula).
-      work_m_.noalias() = jac_ * v_;
-      const double t1 = work_m_.norm() / fnorm;
-      const double t2 = std::sqrt(lambda) * vnorm / fnorm;
-      const double predicted = t1 * t1 + 2.0 * t2 * t2;
-      const double directional = -(t1 * t1 + t2 * t2);
+      // Predicted reduction of the linear model: for the velocity v, Moré's formula; for a
+      // projected step p', 1 − ‖F + J p'‖²/‖F‖² directly. directional = Fᵀ J p / ‖F‖².
+      double predicted = 0.0, directional = 0.0;
+      if (projected) {
+        work_m_.noalias() = jac_ * p_;
+        directional = f_.dot(work_m_) / (fnorm * fnorm);
+        predicted = -2.0 * directional - work_m_.squaredNorm() / (fnorm * fnorm);
+      } else {
+        work_m_.noalias() = jac_ * v_;
+        const double t1 = work_m_.norm() / fnorm;
+        const double t2 = std::sqrt(lambda) * vnorm / fnorm;
+        predicted = t1 * t1 + 2.0 * t2 * t2;
+        directional = -(t1 * t1 + t2 * t2);
+      }
       const double ratio = predicted != 0.0 ? actual / predicted : 0.0;
 
       if (!(ratio > 0.25)) {  // (a NaN ratio shrinks too)
@@ -417,7 +477,7 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
         // solution; a damped one does not.
         if (auto s = monitor.update(last_step, f_.template lpNorm<Eigen::Infinity>(),
                                     x_.template lpNorm<Eigen::Infinity>(),
-                                    lambda == 0.0 && !accelerated)) {
+                                    lambda == 0.0 && !accelerated && !projected)) {
           status = s;
         }
         if (this->options_.record_trace) {
@@ -463,6 +523,7 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
 template <int N>
 Summary LevenbergMarquardtEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
   detail::check_initial_guess(name(), problem, x);
+  box_.start(name(), this->bounds_, x);
   const Index n = x.size();
   auto residual = [&](const Vector<N>& at, ResidualVector& f) {
     problem.evaluate(at, g_);
@@ -476,7 +537,7 @@ Summary LevenbergMarquardtEngine<N>::solve(const FixedPointProblem<N>& problem, 
       problem.jacobian(at, r_);
     } else {
       xt_ = f + at;  // G(x)
-      spent = finite_difference_jacobian(problem, at, xt_, r_, lm_.finite_difference, fd_);
+      spent = finite_difference_jacobian(problem, at, xt_, r_, lm_.finite_difference, fd_, &box_);
     }
     jac = r_;
     jac.diagonal().array() -= 1.0;
@@ -490,6 +551,7 @@ template <int N>
 Summary LevenbergMarquardtEngine<N>::solve_least_squares(const RootProblem<N, Dynamic>& problem,
                                                          Vector<N>& x) {
   detail::check_initial_guess<N>(name(), problem.size(), x);
+  box_.start(name(), this->bounds_, x);
   const Index m = problem.residual_size();
   if (m < problem.size()) {
     std::ostringstream os;
@@ -513,7 +575,7 @@ Summary LevenbergMarquardtEngine<N>::solve_least_squares(const RootProblem<N, Dy
     }
     return finite_difference_jacobian<N, Dynamic>(
         [&problem](const Vector<N>& p, ResidualVector& out) { problem.evaluate(p, out); }, at, f,
-        jac, lm_.finite_difference, fd_, fp_, fm_);
+        jac, lm_.finite_difference, fd_, fp_, fm_, &box_);
   };
   const int cost =
       problem.has_jacobian() ? 0 : finite_difference_cost(lm_.finite_difference, problem.size());

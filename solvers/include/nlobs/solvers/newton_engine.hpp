@@ -7,6 +7,11 @@
 // ‖p‖₂ ≤ Δ, a fresh Jacobian at every iterate (DoglegEngine without Broyden updates, whose
 // radius rules and stop tests it shares).
 // The residual at the returned point is always known: no extra evaluation.
+// Bounds (Engine::set_bounds): the step is projected onto the box, x ← P(x + t Δx); with a line
+// search the Armijo test takes the projected step, and when the Newton path finds no decrease the
+// projected steepest-descent path of ½‖F‖² is searched from its Cauchy point. A point where a
+// bound holds x against the descent direction and neither path decreases ‖F‖ ends the run
+// blocked_by_bound (without a line search: where the projected Newton step is zero).
 #include <Eigen/LU>
 #include <cmath>
 #include <limits>
@@ -18,6 +23,7 @@
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
+#include "nlobs/solvers/square_system.hpp"
 #include "nlobs/solvers/stop_monitor.hpp"
 
 namespace nlobs {
@@ -65,6 +71,7 @@ class NewtonEngine : public Engine<N> {
 
   std::string_view name() const override { return "newton"; }
   const NewtonOptions& newton_options() const { return newton_; }
+  bool accepts_bounds() const override { return true; }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
 
@@ -72,79 +79,82 @@ class NewtonEngine : public Engine<N> {
   void on_limit_evaluations(int max_evaluations) override {
     if (trust_region_) trust_region_->limit_evaluations(max_evaluations);
   }
+  void on_set_bounds() override {
+    if (trust_region_) trust_region_->set_bounds(this->bounds_);
+  }
   NewtonOptions newton_;
   std::optional<DoglegEngine<N>> trust_region_;
-  Vector<N> x_ = zero_vector<N>(), g_ = zero_vector<N>(), f_ = zero_vector<N>(),
-            dx_ = zero_vector<N>(), xt_ = zero_vector<N>(), ft_ = zero_vector<N>();
+  detail::SquareSystem<N> system_;
+  Vector<N> x_ = zero_vector<N>(), f_ = zero_vector<N>(), dx_ = zero_vector<N>(),
+            xt_ = zero_vector<N>(), ft_ = zero_vector<N>(), gradient_ = zero_vector<N>();
   Matrix<N, N> jac_;
   // Partial pivoting (3–4× cheaper than full pivoting at n = 3); a pivot below this fraction
   // of the largest |J_ij| is treated as a zero pivot: the Newton step would be meaningless.
   static constexpr double kSingularPivot = 1e-13;
   Eigen::PartialPivLU<Matrix<N, N>> lu_;
-  FiniteDifferenceWorkspace<N> fd_;
 };
 
 template <int N>
 Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
-  detail::check_initial_guess(name(), problem, x);
   if (trust_region_) {
     Summary s = trust_region_->solve(problem, x);
     s.engine = name();
     return s;
   }
   const StopCriteria& stop = this->options_.stop;
+  system_.start(name(), problem, x, this->bounds_, newton_.finite_difference, stop.max_evaluations);
+  const detail::Box<N>& box = system_.box();
   const Index n = x.size();
   if constexpr (N == Dynamic) {
-    x_.resize(n), g_.resize(n), f_.resize(n), dx_.resize(n), xt_.resize(n), ft_.resize(n);
-    jac_.resize(n, n), fd_.resize(n);
+    for (Vector<N>* v : {&x_, &f_, &dx_, &xt_, &ft_, &gradient_}) v->resize(n);
+    jac_.resize(n, n);
     if (lu_.rows() != n) lu_ = Eigen::PartialPivLU<Matrix<N, N>>(n);
   }
   Summary summary;
   summary.engine = name();
   StopMonitor monitor(stop, x.template lpNorm<Eigen::Infinity>(), /*estimate_lipschitz=*/false);
-  int evaluations = 0, jacobians = 0;
 
-  // F at a point into (g, f); false when non-finite.
-  auto residual_at = [&](const Vector<N>& at, Vector<N>& f) {
-    problem.evaluate(at, g_);
-    ++evaluations;
-    detail::check_output_size(problem, g_);
-    f = g_ - at;
-    return f.allFinite();
+  // Backtracking along the projected path P(x + t d), t = t0, t0·factor, …: the first t with
+  // ‖F(x_t)‖₂² ≤ ‖F(x)‖₂² + 2c ∇φᵀ(x_t − x), φ = ½‖F‖₂², ∇φ = J_Fᵀ F (Armijo). For the Newton
+  // direction without a box ∇φᵀ t d = −t‖F‖₂², the test in its usual form. With armijo = false,
+  // the first finite trial. x_t in xt_, F(x_t) in ft_; false when none, or when the box holds x
+  // in place (held_in_place).
+  bool projected = false, held_in_place = false;
+  double t = 1.0;
+  auto search = [&](const Vector<N>& d, double t0, bool armijo) {
+    const double phi0 = f_.squaredNorm();
+    t = t0;
+    for (int k = 0; k <= newton_.max_backtracks && !system_.budget_spent(); ++k) {
+      xt_ = x_ + t * d;
+      projected = box.project(xt_);
+      held_in_place = projected && xt_ == x_;
+      if (held_in_place) return false;  // every component that would move is held
+      const bool finite = system_.residual(xt_, ft_);
+      if (!armijo) return finite;
+      const double decrease = projected || box.active()
+                                  ? -2.0 * newton_.sufficient_decrease * gradient_.dot(xt_ - x_)
+                                  : 2.0 * newton_.sufficient_decrease * t * phi0;
+      if (finite && ft_.squaredNorm() <= phi0 - decrease) return true;
+      t *= newton_.backtrack_factor;
+    }
+    return false;
   };
 
   x_ = x;
   std::optional<Status> status;
-  if (!residual_at(x_, f_)) status = Status::kNonFinite;
-  double fnorm = f_.template lpNorm<Eigen::Infinity>();
-  if (!status && stop.residual_tolerance && fnorm <= *stop.residual_tolerance) {
-    status = Status::kConverged;  // x0 already solves F within tolerance
+  if (!system_.residual(x_, f_)) {
+    status = Status::kNonFinite;
+  } else if (detail::solved_at_start(f_, stop)) {
+    status = Status::kConverged;
   }
+  double fnorm = f_.template lpNorm<Eigen::Infinity>();
 
   while (!status) {
-    if (evaluations >= stop.max_evaluations) {
+    if (system_.budget_spent()) {
       status = Status::kMaxEvaluations;
       break;
     }
-    // J_F = ∂G − I.
-    if (!problem.has_jacobian() &&
-        evaluations + finite_difference_cost(newton_.finite_difference, n) > stop.max_evaluations) {
-      status = Status::kMaxEvaluations;  // the differences would overrun the budget
-      break;
-    }
-    if (problem.has_jacobian()) {
-      problem.jacobian(x_, jac_);
-    } else {
-      g_ = f_ + x_;
-      evaluations +=
-          finite_difference_jacobian(problem, x_, g_, jac_, newton_.finite_difference, fd_);
-    }
-    ++jacobians;
-    jac_.diagonal().array() -= 1.0;
-    if (!jac_.allFinite()) {
-      status = Status::kNonFinite;
-      break;
-    }
+    if ((status = system_.jacobian(x_, f_, jac_, summary.message))) break;
     lu_.compute(jac_);
     const double smallest_pivot = lu_.matrixLU().diagonal().cwiseAbs().minCoeff();
     if (!(smallest_pivot > kSingularPivot * jac_.cwiseAbs().maxCoeff())) {
@@ -162,28 +172,34 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
       status = Status::kSingularJacobian;
       break;
     }
+    if (box.active()) gradient_.noalias() = jac_.transpose() * f_;
 
-    // Full step, or backtrack until ½‖F‖₂² decreases enough: ‖F(x+t dx)‖² ≤ (1 − 2ct)‖F(x)‖².
-    double t = 1.0;
-    const double phi0 = f_.squaredNorm();
-    bool accepted = false;
-    for (int k = 0; k <= newton_.max_backtracks; ++k) {
-      if (evaluations >= stop.max_evaluations) break;
-      xt_ = x_ + t * dx_;
-      const bool finite = residual_at(xt_, ft_);
-      if (!newton_.line_search) {
-        accepted = finite;
-        break;
+    // The Newton step (backtracked with a line search); in a box, when that finds no decrease,
+    // the projected steepest-descent path from the Cauchy point of the linear model.
+    bool descent_step = false;
+    bool accepted = search(dx_, 1.0, newton_.line_search);
+    if (!accepted && newton_.line_search && box.active() && !system_.budget_spent()) {
+      const double curvature = (jac_ * gradient_).squaredNorm();
+      if (curvature > 0.0) {
+        dx_ = -gradient_;
+        accepted = search(dx_, gradient_.squaredNorm() / curvature, true);
+        descent_step = true;
       }
-      if (finite && ft_.squaredNorm() <= (1.0 - 2.0 * newton_.sufficient_decrease * t) * phi0) {
-        accepted = true;
-        break;
-      }
-      t *= newton_.backtrack_factor;
     }
     if (!accepted) {
-      if (evaluations >= stop.max_evaluations) {
+      // Blocked: without a line search where the box holds the Newton step in place; with one
+      // where neither path decreases |F| and a bound holds x against −∇φ.
+      std::optional<Index> held;
+      if (box.active() && (newton_.line_search || held_in_place)) {
+        if (newton_.line_search) dx_ = -gradient_;
+        held = box.blocking(x_, dx_);
+      }
+      if (system_.budget_spent()) {
         status = Status::kMaxEvaluations;
+      } else if (held) {
+        summary.message = box.blocked_message(
+            *held, x_, fnorm, newton_.line_search ? "the descent direction" : "the Newton step");
+        status = Status::kBlockedByBound;
       } else if (!newton_.line_search) {
         status = Status::kNonFinite;
       } else {
@@ -192,22 +208,21 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
       }
       break;
     }
-    const double step = t * dx_.template lpNorm<Eigen::Infinity>();
+    const double step = projected ? (xt_ - x_).template lpNorm<Eigen::Infinity>()
+                                  : t * dx_.template lpNorm<Eigen::Infinity>();
     x_ = xt_;
     f_ = ft_;
     fnorm = f_.template lpNorm<Eigen::Infinity>();
-    status = monitor.update(step, fnorm, x_.template lpNorm<Eigen::Infinity>());
+    // A step the box cut short, or a descent step, says nothing about the distance to a root.
+    status = monitor.update(step, fnorm, x_.template lpNorm<Eigen::Infinity>(),
+                            !projected && !descent_step);
     if (this->options_.record_trace) {
       summary.trace.push_back({monitor.iterations(), step, fnorm, x_});
     }
   }
 
   x = x_;
-  summary.status = *status;
-  summary.function_evaluations = evaluations;
-  summary.jacobian_evaluations = jacobians;
-  monitor.fill(summary, f_.allFinite() ? fnorm : std::numeric_limits<double>::infinity());
-  summary.record_answer(x, stop);
+  system_.finish(summary, *status, monitor, x, f_, stop);
   return summary;
 }
 

@@ -54,16 +54,9 @@ class NloptEngine : public Engine<N> {
                          "' is not an NLopt algorithm; valid: " + valid);
     }
     algorithm_ = static_cast<nlopt_algorithm>(found - names.begin());
-    const Eigen::VectorXd& lb = nlopt_.lower_bounds;
-    const Eigen::VectorXd& ub = nlopt_.upper_bounds;
-    detail::validate_box("NloptOptions", lb, ub);
-    if (is_global()) {
-      const Index n = std::max(lb.size(), ub.size());
-      if (lb.size() == 0 || ub.size() == 0 || !lb.allFinite() || !ub.allFinite() || n == 0) {
-        throw InvalidInput("NloptOptions: global algorithm " + nlopt_.algorithm +
-                           " needs finite lower_bounds and upper_bounds");
-      }
-    }
+    detail::validate_box("NloptOptions", nlopt_.lower_bounds, nlopt_.upper_bounds);
+    require_finite_box_if_global(nlopt_.lower_bounds, nlopt_.upper_bounds);
+    this->bounds_ = {nlopt_.lower_bounds, nlopt_.upper_bounds};
     if (nlopt_.initial_step && !(*nlopt_.initial_step > 0.0)) {
       throw InvalidInput("NloptOptions::initial_step must be > 0");
     }
@@ -73,6 +66,8 @@ class NloptEngine : public Engine<N> {
   const NloptOptions& nlopt_options() const { return nlopt_; }
   bool needs_gradient() const { return nlopt_.algorithm.size() > 1 && nlopt_.algorithm[1] == 'D'; }
   bool is_global() const { return !nlopt_.algorithm.empty() && nlopt_.algorithm[0] == 'G'; }
+  // set_bounds replaces NloptOptions' bounds (a global algorithm still needs a finite box).
+  bool accepts_bounds() const override { return true; }
 
   // min ½‖G(x) − x‖₂².
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
@@ -89,6 +84,19 @@ class NloptEngine : public Engine<N> {
   Summary minimize(const ObjectiveProblem<N>& problem, Vector<N>& x);
 
  private:
+  void require_finite_box_if_global(const Eigen::VectorXd& lb, const Eigen::VectorXd& ub) const {
+    if (!is_global()) return;
+    if (lb.size() == 0 || ub.size() == 0 || !lb.allFinite() || !ub.allFinite()) {
+      throw InvalidInput("NloptOptions: global algorithm " + nlopt_.algorithm +
+                         " needs finite lower_bounds and upper_bounds");
+    }
+  }
+  void on_set_bounds() override {
+    require_finite_box_if_global(this->bounds_.lower, this->bounds_.upper);
+    nlopt_.lower_bounds = this->bounds_.lower;
+    nlopt_.upper_bounds = this->bounds_.upper;
+    prepared_n_ = -1;  // prepared again, with the new box, by the next solve
+  }
   using ObjectiveThunk = double (*)(void*, const Vector<N>&, Vector<N>*);
 
   template <int M>

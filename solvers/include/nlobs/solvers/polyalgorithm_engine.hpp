@@ -46,6 +46,11 @@ class PolyalgorithmEngine : public Engine<N> {
 
   std::string_view name() const override { return "auto"; }
   const std::vector<std::unique_ptr<Engine<N>>>& stages() const { return stages_; }
+  // Bounds reach every stage: accepted when every stage accepts them.
+  bool accepts_bounds() const override {
+    return std::all_of(stages_.begin(), stages_.end(),
+                       [](const auto& s) { return s->accepts_bounds(); });
+  }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override {
     detail::check_initial_guess(name(), problem, x);
@@ -133,6 +138,9 @@ class PolyalgorithmEngine : public Engine<N> {
   }
 
  private:
+  void on_set_bounds() override {
+    for (auto& s : stages_) s->set_bounds(this->bounds_);
+  }
   std::vector<std::unique_ptr<Engine<N>>> stages_;
   std::vector<int> caps_;
   PolyalgorithmOptions poly_;

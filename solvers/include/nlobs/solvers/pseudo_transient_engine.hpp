@@ -19,6 +19,10 @@
 // min_pseudo_step ends the run non_finite. ‖F‖ may rise along the way (the flow is followed,
 // not ‖F‖ minimised): StopCriteria's stagnation rule is not applied; max_iterations,
 // max_evaluations and divergence_limit are.
+//
+// Bounds (Engine::set_bounds): x_{k+1} = P(x_k + p_k), the projection onto the box (a step the
+// box cut short is no step criterion); where the box holds x_k in place the flow leaves the box
+// there, and the run ends blocked_by_bound.
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
@@ -30,6 +34,7 @@
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
+#include "nlobs/solvers/square_system.hpp"
 #include "nlobs/solvers/stop_monitor.hpp"
 
 namespace nlobs {
@@ -68,77 +73,53 @@ class PseudoTransientEngine : public Engine<N> {
 
   std::string_view name() const override { return "pseudo-transient"; }
   const PseudoTransientOptions& pseudo_transient_options() const { return ptc_; }
+  bool accepts_bounds() const override { return true; }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
 
  private:
   PseudoTransientOptions ptc_;
-  Vector<N> x_ = zero_vector<N>(), g_ = zero_vector<N>(), f_ = zero_vector<N>(),
-            p_ = zero_vector<N>(), xt_ = zero_vector<N>(), ft_ = zero_vector<N>();
+  Vector<N> x_ = zero_vector<N>(), f_ = zero_vector<N>(), p_ = zero_vector<N>(),
+            xt_ = zero_vector<N>(), ft_ = zero_vector<N>();
   Matrix<N, N> jac_, shifted_;
   Eigen::PartialPivLU<Matrix<N, N>> lu_;
-  FiniteDifferenceWorkspace<N> fd_;
+  detail::SquareSystem<N> system_;
 };
 
 template <int N>
 Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
-  detail::check_initial_guess(name(), problem, x);
   StopCriteria stop = this->options_.stop;
   stop.stagnation_patience = 0;  // ‖F‖ and the steps may grow along the flow
+  system_.start(name(), problem, x, this->bounds_, ptc_.finite_difference, stop.max_evaluations);
+  const detail::Box<N>& box = system_.box();
   const Index n = x.size();
   if constexpr (N == Dynamic) {
-    for (Vector<N>* v : {&x_, &g_, &f_, &p_, &xt_, &ft_}) v->resize(n);
-    jac_.resize(n, n), shifted_.resize(n, n), fd_.resize(n);
+    for (Vector<N>* v : {&x_, &f_, &p_, &xt_, &ft_}) v->resize(n);
+    jac_.resize(n, n), shifted_.resize(n, n);
     if (lu_.rows() != n) lu_ = Eigen::PartialPivLU<Matrix<N, N>>(n);
   }
   Summary summary;
   summary.engine = name();
   StopMonitor monitor(stop, x.template lpNorm<Eigen::Infinity>(), /*estimate_lipschitz=*/false);
-  int evaluations = 0, jacobians = 0;
-
-  auto residual_at = [&](const Vector<N>& at, Vector<N>& f) {
-    problem.evaluate(at, g_);
-    ++evaluations;
-    detail::check_output_size(problem, g_);
-    f = g_ - at;
-    return f.allFinite();
-  };
 
   x_ = x;
   std::optional<Status> status;
-  if (!residual_at(x_, f_)) status = Status::kNonFinite;
-  double fnorm = f_.stableNorm();  // overflow-safe
-  if (!status &&
-      (fnorm == 0.0 || (stop.residual_tolerance &&
-                        f_.template lpNorm<Eigen::Infinity>() <= *stop.residual_tolerance))) {
+  if (!system_.residual(x_, f_)) {
+    status = Status::kNonFinite;
+  } else if (detail::solved_at_start(f_, stop)) {
     status = Status::kConverged;
   }
+  double fnorm = f_.stableNorm();  // overflow-safe
   double delta = ptc_.initial_pseudo_step;
   const int sigma = ptc_.flow == PseudoTransientOptions::Flow::kFixedPoint ? 1 : -1;
 
+  bool projected = false;
   while (!status) {
-    if (evaluations >= stop.max_evaluations) {
+    if (system_.budget_spent()) {
       status = Status::kMaxEvaluations;
       break;
     }
-    if (!problem.has_jacobian() &&
-        evaluations + finite_difference_cost(ptc_.finite_difference, n) > stop.max_evaluations) {
-      status = Status::kMaxEvaluations;  // the differences would overrun the budget
-      break;
-    }
-    if (problem.has_jacobian()) {
-      problem.jacobian(x_, jac_);
-    } else {
-      g_ = f_ + x_;
-      evaluations += finite_difference_jacobian(problem, x_, g_, jac_, ptc_.finite_difference, fd_);
-    }
-    ++jacobians;
-    jac_.diagonal().array() -= 1.0;  // J_F = ∂G − I
-    if (!jac_.allFinite()) {
-      summary.message = "the Jacobian of F is not finite";
-      status = Status::kNonFinite;
-      break;
-    }
+    if ((status = system_.jacobian(x_, f_, jac_, summary.message))) break;  // J_F = ∂G − I
     // Trial steps from x_k: a non-finite F(x_k + p) halves δ and tries again.
     bool stepped = false;
     while (!status && !stepped) {
@@ -169,12 +150,21 @@ Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vec
       }
       p_ = lu_.solve(f_);
       if (sigma < 0) p_ = -p_;
-      if (evaluations >= stop.max_evaluations) {
+      if (system_.budget_spent()) {
         status = Status::kMaxEvaluations;
         break;
       }
       xt_ = x_ + p_;
-      if (p_.allFinite() && residual_at(xt_, ft_)) {
+      projected = box.project(xt_);
+      if (projected && xt_ == x_) {
+        if (const std::optional<Index> i = box.blocking(x_, p_)) {
+          summary.message = box.blocked_message(*i, x_, f_.template lpNorm<Eigen::Infinity>(),
+                                                "the pseudo-transient flow");
+          status = Status::kBlockedByBound;
+          break;
+        }
+      }
+      if (p_.allFinite() && system_.residual(xt_, ft_)) {
         stepped = true;
       } else {
         delta *= 0.5;
@@ -189,13 +179,14 @@ Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vec
     }
     if (status) break;
     const double previous = fnorm;
+    if (projected) p_ = xt_ - x_;  // the step taken
     x_ = xt_;
     std::swap(f_, ft_);
     fnorm = f_.stableNorm();
     const double step = p_.template lpNorm<Eigen::Infinity>();
     // Newton-like: the pseudo-time term δ⁻¹p = σ(F + Jp) is below 1 % of ‖F‖, so the step
     // solves the Newton equation to a residual of 0.01 ‖F‖.
-    const bool newton_like = p_.norm() <= 0.01 * delta * previous;
+    const bool newton_like = !projected && p_.norm() <= 0.01 * delta * previous;
     status = monitor.update(step, f_.template lpNorm<Eigen::Infinity>(),
                             x_.template lpNorm<Eigen::Infinity>(), newton_like);
     if (this->options_.record_trace) {
@@ -210,12 +201,7 @@ Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vec
   }
 
   x = x_;
-  summary.status = *status;
-  summary.function_evaluations = evaluations;
-  summary.jacobian_evaluations = jacobians;
-  monitor.fill(summary, f_.allFinite() ? f_.template lpNorm<Eigen::Infinity>()
-                                       : std::numeric_limits<double>::infinity());
-  summary.record_answer(x, this->options_.stop);
+  system_.finish(summary, *status, monitor, x, f_, this->options_.stop);
   return summary;
 }
 

@@ -4,6 +4,8 @@
 //   nlobs/solvers/ceres_engine.hpp, nlobs/solvers/nlopt_engine.hpp,
 //   nlobs/solvers/engine_registry.hpp
 #include "nlobs/solvers/accelerated_engine.hpp"
+#include "nlobs/solvers/box_bounds.hpp"
+#include "nlobs/solvers/broyden_engine.hpp"
 #include "nlobs/solvers/contraction.hpp"
 #include "nlobs/solvers/dogleg_engine.hpp"
 #include "nlobs/solvers/engine.hpp"

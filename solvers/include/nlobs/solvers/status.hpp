@@ -20,6 +20,12 @@ enum class Status {
   kSingularJacobian,  // Newton: the Jacobian of F is (numerically) singular
   kInvalidInput,      // only from solve_or_report(): bad dimensions, x0 or options
   kSolverFailure,     // a backend (Ceres, NLopt) reported a failure; see Summary::message
+  // A bounded solve (Engine::set_bounds) can go no further inside the box: at a point on its
+  // boundary the engine's direction — Newton's step, the pseudo-transient flow, or the descent
+  // direction −∇½‖F‖² — points out of it (the held component is named in Summary::message).
+  // For the descent direction the point is a minimum of ‖F‖ on the boundary: a root in the box,
+  // if any, lies elsewhere (another start; `auto`).
+  kBlockedByBound,
 };
 
 // Lowercase snake_case name used in reports and JSON ("converged", "max_iterations", ...).

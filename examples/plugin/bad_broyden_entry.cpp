@@ -2,23 +2,23 @@
 // registration serves a window of any size and every problem of a set.
 #include <memory>
 
-#include "broyden_engine.hpp"
+#include "bad_broyden_engine.hpp"
 #include "example_plugin.hpp"
 
 namespace example {
 
-void add_broyden(nlobs::PluginRegistrar& registrar) {
+void add_bad_broyden(nlobs::PluginRegistrar& registrar) {
   registrar.add_engine(
-      {.name = "broyden",
-       .description = "Broyden's good method with backtracking and Jacobian restarts "
+      {.name = "bad-broyden",
+       .description = "Broyden's second (bad) method with backtracking and Jacobian restarts "
                       "(example plugin)",
        .options = {{"backtracks", "step halvings before the Jacobian is renewed; default 10"}},
-       .examples = {"broyden", "broyden:backtracks=4"},
+       .examples = {"bad-broyden", "bad-broyden:backtracks=4"},
        .make = [](nlobs::EngineSpecReader& spec,
                   nlobs::SolverOptions options) -> std::unique_ptr<nlobs::Engine<>> {
-         BroydenOptions broyden;
+         BadBroydenOptions broyden;
          if (auto k = spec.integer("backtracks", 0, 60)) broyden.max_backtracks = *k;
-         return std::make_unique<BroydenEngine<>>(std::move(options), broyden);
+         return std::make_unique<BadBroydenEngine<>>(std::move(options), broyden);
        }});
 }
 

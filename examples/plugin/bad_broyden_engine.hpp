@@ -1,9 +1,9 @@
 #pragma once
-// Broyden's "good" method for F(x) = G(x) − x = 0, an engine nlobs does not ship (Broyden, Math.
-// Comp. 19, 1965; Dennis & Schnabel, Numerical Methods for Unconstrained Optimization, §8.1):
+// Broyden's second ("bad") method for F(x) = G(x) − x = 0, an engine nlobs does not ship (nlobs'
+// `broyden` is the first, "good" one; Broyden, Math. Comp. 19, 1965; Dennis & Schnabel,
+// Numerical Methods for Unconstrained Optimization, §8.1): the inverse is updated directly,
 //   H_0 = J_F(x_0)⁻¹,  s_k = −t_k H_k F(x_k)  (t_k: backtracking on ‖F‖₂²),
-//   H_{k+1} = H_k + (s_k − H_k y_k) s_kᵀ H_k / (s_kᵀ H_k y_k),  y_k = F(x_{k+1}) − F(x_k),
-// the Sherman–Morrison form of B_{k+1} = B_k + (y_k − B_k s_k) s_kᵀ / (s_kᵀ s_k): O(n²) per step.
+//   H_{k+1} = H_k + (s_k − H_k y_k) y_kᵀ / (y_kᵀ y_k),  y_k = F(x_{k+1}) − F(x_k):  O(n²) per step.
 // The Jacobian is computed again (the problem's, or forward differences) when the line search
 // finds no decrease along the quasi-Newton direction or the update's denominator vanishes.
 // Fixed-size members: a solve at a fixed N allocates nothing.
@@ -21,26 +21,26 @@
 
 namespace example {
 
-struct BroydenOptions {
+struct BadBroydenOptions {
   int max_backtracks = 10;            // halvings of the step before the Jacobian is renewed
   double sufficient_decrease = 1e-4;  // c in ‖F(x + t s)‖² ≤ (1 − 2ct) ‖F(x)‖²
 };
 
 template <int N = nlobs::Dynamic>
-class BroydenEngine final : public nlobs::Engine<N> {
+class BadBroydenEngine final : public nlobs::Engine<N> {
  public:
   using Vec = nlobs::Vector<N>;
   using Mat = nlobs::Matrix<N, N>;
 
-  BroydenEngine(nlobs::SolverOptions options, BroydenOptions broyden)
+  BadBroydenEngine(nlobs::SolverOptions options, BadBroydenOptions broyden)
       : nlobs::Engine<N>(std::move(options)), broyden_(broyden) {
     if (broyden_.max_backtracks < 0 || !(broyden_.sufficient_decrease > 0.0) ||
         !(broyden_.sufficient_decrease < 0.5)) {
       throw nlobs::InvalidInput(
-          "broyden: max_backtracks must be >= 0 and sufficient_decrease in (0, 0.5)");
+          "bad-broyden: max_backtracks must be >= 0 and sufficient_decrease in (0, 0.5)");
     }
   }
-  std::string_view name() const override { return "broyden"; }
+  std::string_view name() const override { return "bad-broyden"; }
 
   nlobs::Summary solve(const nlobs::FixedPointProblem<N>& problem, Vec& x) override {
     nlobs::detail::check_initial_guess(name(), problem, x);
@@ -48,7 +48,7 @@ class BroydenEngine final : public nlobs::Engine<N> {
     const nlobs::Index n = x.size();
     if constexpr (N == nlobs::Dynamic) {
       x_.resize(n), g_.resize(n), f_.resize(n), s_.resize(n), xt_.resize(n), ft_.resize(n);
-      hy_.resize(n), h_.resize(n, n), jac_.resize(n, n), fd_.resize(n);
+      hy_.resize(n), y_.resize(n), h_.resize(n, n), jac_.resize(n, n), fd_.resize(n);
     }
     nlobs::Summary summary;
     summary.engine = name();
@@ -143,18 +143,17 @@ class BroydenEngine final : public nlobs::Engine<N> {
         break;
       }
       s_ *= t;
-      // y = F(x + s) − F(x), kept in f_ until f_ takes F(x + s).
-      f_ = ft_ - f_;
-      hy_ = h_ * f_;
-      const double denominator = s_.dot(hy_);
+      y_ = ft_ - f_;  // y = F(x + s) − F(x)
+      hy_ = h_ * y_;
+      const double denominator = y_.squaredNorm();
       const double step = s_.template lpNorm<Eigen::Infinity>();
       x_ = xt_;
       f_ = ft_;
       fnorm = f_.template lpNorm<Eigen::Infinity>();
       status = monitor.update(step, fnorm, x_.template lpNorm<Eigen::Infinity>());
       if (status) break;
-      if (std::abs(denominator) > 1e-14 * s_.norm() * hy_.norm() && std::isfinite(denominator)) {
-        h_ += ((s_ - hy_) / denominator) * (s_.transpose() * h_);
+      if (denominator > 0.0 && std::isfinite(denominator)) {
+        h_ += ((s_ - hy_) / denominator) * y_.transpose();
         fresh = false;
       } else {
         status = renew_inverse("where the Broyden update broke down");
@@ -171,10 +170,10 @@ class BroydenEngine final : public nlobs::Engine<N> {
   }
 
  private:
-  BroydenOptions broyden_;
+  BadBroydenOptions broyden_;
   Vec x_ = nlobs::zero_vector<N>(), g_ = nlobs::zero_vector<N>(), f_ = nlobs::zero_vector<N>(),
       s_ = nlobs::zero_vector<N>(), xt_ = nlobs::zero_vector<N>(), ft_ = nlobs::zero_vector<N>(),
-      hy_ = nlobs::zero_vector<N>();
+      hy_ = nlobs::zero_vector<N>(), y_ = nlobs::zero_vector<N>();
   Mat h_, jac_;
   nlobs::FiniteDifferenceWorkspace<N> fd_;
 };

@@ -1,0 +1,235 @@
+#pragma once
+// Broyden's "good" method for F(x) = G(x) − x = 0 with a line search and Jacobian restarts
+// ([Bro65]; [DS96] §8.1, Algorithm 8.2.1 globalised by backtracking as in [Kel95] §8.3):
+//   H_0 = J_F(x_0)⁻¹,  d_k = −H_k F(x_k),  x_{k+1} = x_k + t_k d_k,
+//   t_k ∈ {1, ½, ¼, …} the first with ‖F(x_{k+1})‖₂² ≤ (1 − 2c t_k) ‖F(x_k)‖₂²,
+//   H_{k+1} = H_k + (s_k − H_k y_k) s_kᵀ H_k / (s_kᵀ H_k y_k),  s_k = x_{k+1} − x_k,
+//   y_k = F(x_{k+1}) − F(x_k):
+// the Sherman–Morrison form of the rank-one update B_{k+1} = B_k + (y_k − B_k s_k) s_kᵀ/(s_kᵀ s_k)
+// of the Jacobian, O(n²) per step against Newton's O(n³) and n (forward) or 2n (central)
+// evaluations for a difference Jacobian. A fresh Jacobian (the restart) is taken when the line
+// search finds no decrease along a direction of updated H, when the update's denominator
+// vanishes, and after max_updates updates (0: never for that reason). A line search that fails
+// along the direction of a fresh Jacobian ends the run stagnated.
+//
+// Bounds (Engine::set_bounds): the trial points are P(x + t d), projected onto the box; when the
+// projected path of a fresh Jacobian finds no decrease, the projected steepest-descent path of
+// ½‖F‖² is searched from the Cauchy point of the linear model (Armijo on ∇φ = J_Fᵀ F), and a
+// point where neither decreases ‖F‖ while a bound holds x against −∇φ is blocked_by_bound.
+//
+// Stop rules: StopCriteria's, the step criterion on full steps t = 1 that no bound cut short.
+#include <Eigen/LU>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <string_view>
+
+#include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/library_sizes.hpp"
+#include "nlobs/solvers/square_system.hpp"
+#include "nlobs/solvers/stop_monitor.hpp"
+
+namespace nlobs {
+
+struct BroydenOptions {
+  int max_backtracks = 10;            // halvings of t before the Jacobian is renewed; 0..60
+  double sufficient_decrease = 1e-4;  // c ∈ (0, 0.5) of the test above
+  int max_updates = 0;                // updates before a fresh Jacobian regardless; ≥ 0, 0 = off
+  // Used only when the problem carries no Jacobian.
+  FiniteDifference finite_difference = FiniteDifference::kCentral;
+
+  // Throws InvalidInput naming the field and its value.
+  void validate() const;
+};
+
+inline void BroydenOptions::validate() const {
+  auto fail = [](const char* option, double value, const char* requirement) {
+    std::ostringstream os;
+    os << "BroydenOptions::" << option << " = " << value << " is invalid: " << requirement;
+    throw InvalidInput(os.str());
+  };
+  if (max_backtracks < 0 || max_backtracks > 60) {
+    fail("max_backtracks", max_backtracks, "must lie in 0..60");
+  }
+  if (!(sufficient_decrease > 0.0 && sufficient_decrease < 0.5)) {
+    fail("sufficient_decrease", sufficient_decrease, "must lie in (0, 0.5)");
+  }
+  if (max_updates < 0) fail("max_updates", max_updates, "must be >= 0");
+}
+
+template <int N = Dynamic>
+class BroydenEngine : public Engine<N> {
+ public:
+  explicit BroydenEngine(BroydenOptions broyden = {}, SolverOptions options = {})
+      : Engine<N>(std::move(options)), broyden_(broyden) {
+    broyden_.validate();
+    detail::require_lipschitz_for_error_bound(name(), this->options_.stop);
+  }
+
+  std::string_view name() const override { return "broyden"; }
+  const BroydenOptions& broyden_options() const { return broyden_; }
+  bool accepts_bounds() const override { return true; }
+
+  Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
+
+ private:
+  // H = J_F(x_)⁻¹ from a fresh Jacobian (kept in jac_); nullopt or the status to stop with.
+  std::optional<Status> renew(std::string& message);
+  // Backtracking from t0 along P(x_ + t d): the sufficient-decrease test above (armijo = false),
+  // or Armijo's on ∇φ = gradient_ (armijo = true). Trial in xt_, ft_; false when none.
+  bool search(const Vector<N>& d, double t0, bool armijo);
+
+  BroydenOptions broyden_;
+  detail::SquareSystem<N> system_;
+  Vector<N> x_ = zero_vector<N>(), f_ = zero_vector<N>(), d_ = zero_vector<N>(),
+            xt_ = zero_vector<N>(), ft_ = zero_vector<N>(), hy_ = zero_vector<N>(),
+            gradient_ = zero_vector<N>();
+  Matrix<N, N> h_, jac_;
+  Eigen::PartialPivLU<Matrix<N, N>> lu_;
+  bool projected_ = false;  // the last trial point was projected onto the box
+  double t_ = 1.0;          // the last trial's t
+};
+
+template <int N>
+std::optional<Status> BroydenEngine<N>::renew(std::string& message) {
+  if (auto s = system_.jacobian(x_, f_, jac_, message)) return s;
+  lu_.compute(jac_);
+  // A pivot below this fraction of the largest |J_ij|: singular, as NewtonEngine judges.
+  const double smallest_pivot = lu_.matrixLU().diagonal().cwiseAbs().minCoeff();
+  if (smallest_pivot > 1e-13 * jac_.cwiseAbs().maxCoeff()) {
+    h_ = lu_.inverse();
+    if (h_.allFinite()) return std::nullopt;
+  }
+  std::ostringstream os;
+  os << "Jacobian of F is singular (smallest LU pivot " << smallest_pivot << ")";
+  message = os.str();
+  return Status::kSingularJacobian;
+}
+
+template <int N>
+bool BroydenEngine<N>::search(const Vector<N>& d, double t0, bool armijo) {
+  const detail::Box<N>& box = system_.box();
+  const double phi0 = f_.squaredNorm();
+  const double c = broyden_.sufficient_decrease;
+  t_ = t0;
+  for (int k = 0; k <= broyden_.max_backtracks && !system_.budget_spent(); ++k) {
+    xt_ = x_ + t_ * d;
+    projected_ = box.project(xt_);
+    if (projected_ && xt_ == x_) return false;  // the box holds x in place along d
+    if (system_.residual(xt_, ft_)) {
+      const double allowed =
+          armijo ? phi0 + 2.0 * c * gradient_.dot(xt_ - x_) : (1.0 - 2.0 * c * t_) * phi0;
+      if (ft_.squaredNorm() <= allowed) return true;
+    }
+    t_ *= 0.5;
+  }
+  return false;
+}
+
+template <int N>
+Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
+  const StopCriteria& stop = this->options_.stop;
+  system_.start(name(), problem, x, this->bounds_, broyden_.finite_difference,
+                stop.max_evaluations);
+  const detail::Box<N>& box = system_.box();
+  const Index n = x.size();
+  if constexpr (N == Dynamic) {
+    for (Vector<N>* v : {&x_, &f_, &d_, &xt_, &ft_, &hy_, &gradient_}) v->resize(n);
+    h_.resize(n, n), jac_.resize(n, n);
+    if (lu_.rows() != n) lu_ = Eigen::PartialPivLU<Matrix<N, N>>(n);
+  }
+  Summary summary;
+  summary.engine = name();
+  StopMonitor monitor(stop, x.template lpNorm<Eigen::Infinity>(), /*estimate_lipschitz=*/false);
+
+  x_ = x;
+  std::optional<Status> status;
+  if (!system_.residual(x_, f_)) {
+    status = Status::kNonFinite;
+  } else if (detail::solved_at_start(f_, stop)) {
+    status = Status::kConverged;
+  }
+  double fnorm = f_.template lpNorm<Eigen::Infinity>();
+  bool fresh = false;  // H is the inverse of a Jacobian computed at x_
+  int updates = 0;
+  if (!status) {
+    status = renew(summary.message);
+    fresh = !status;
+  }
+  while (!status) {
+    if (system_.budget_spent()) {
+      status = Status::kMaxEvaluations;
+      break;
+    }
+    d_.noalias() = -(h_ * f_);
+    bool accepted = search(d_, 1.0, false), descent_step = false;
+    if (!accepted && fresh && box.active() && !system_.budget_spent()) {
+      gradient_.noalias() = jac_.transpose() * f_;
+      const double curvature = (jac_ * gradient_).squaredNorm();
+      if (curvature > 0.0) {
+        d_ = -gradient_;
+        accepted = search(d_, gradient_.squaredNorm() / curvature, true);
+        descent_step = true;
+      }
+    }
+    if (!accepted) {
+      if (system_.budget_spent()) {
+        status = Status::kMaxEvaluations;
+      } else if (!fresh) {  // a stale H: try again along the Newton direction
+        status = renew(summary.message);
+        fresh = !status;
+        updates = 0;
+        if (fresh) continue;
+      } else {
+        gradient_.noalias() = -(jac_.transpose() * f_);
+        if (const std::optional<Index> i = box.blocking(x_, gradient_)) {
+          summary.message = box.blocked_message(*i, x_, fnorm, "the descent direction");
+          status = Status::kBlockedByBound;
+        } else {
+          summary.message = "line search found no decrease of |F| along the Newton direction";
+          status = Status::kStagnated;
+        }
+      }
+      break;
+    }
+    d_ = xt_ - x_;  // s, the step taken
+    f_ = ft_ - f_;  // y = F(x + s) − F(x), until f_ takes F(x + s)
+    hy_.noalias() = h_ * f_;
+    const double denominator = d_.dot(hy_);
+    const double step = d_.template lpNorm<Eigen::Infinity>();
+    const bool full_step = t_ == 1.0 && !projected_ && !descent_step;
+    x_ = xt_;
+    f_ = ft_;
+    fnorm = f_.template lpNorm<Eigen::Infinity>();
+    status = monitor.update(step, fnorm, x_.template lpNorm<Eigen::Infinity>(), full_step);
+    if (this->options_.record_trace) {
+      summary.trace.push_back({monitor.iterations(), step, fnorm, x_});
+    }
+    if (status) break;
+    const bool restart = broyden_.max_updates > 0 && updates >= broyden_.max_updates;
+    if (!restart && std::isfinite(denominator) &&
+        std::abs(denominator) > 1e-14 * d_.norm() * hy_.norm()) {
+      gradient_.noalias() = h_.transpose() * d_;  // Hᵀ s, so that the update is O(n²)
+      h_.noalias() += ((d_ - hy_) / denominator) * gradient_.transpose();
+      fresh = false;
+      ++updates;
+    } else {
+      status = renew(summary.message);
+      fresh = !status;
+      updates = 0;
+    }
+  }
+
+  x = x_;
+  system_.finish(summary, *status, monitor, x, f_, stop);
+  return summary;
+}
+
+// Compiled once in the library for its sizes (nlobs/solvers/library_sizes.hpp).
+#define NLOBS_EXTERN_BROYDEN_ENGINE(n) extern template class BroydenEngine<n>;
+NLOBS_FOR_EACH_LIBRARY_SIZE(NLOBS_EXTERN_BROYDEN_ENGINE)
+#undef NLOBS_EXTERN_BROYDEN_ENGINE
+
+}  // namespace nlobs

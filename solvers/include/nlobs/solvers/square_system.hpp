@@ -1,0 +1,99 @@
+#pragma once
+// F(x) = G(x) − x and J_F = ∂G − I of a fixed-point problem, for the engines that solve it as a
+// square root problem (Newton, dogleg, Levenberg–Marquardt, Broyden, pseudo-transient): the one
+// place that counts evaluations, checks G's size, keeps a difference Jacobian inside the
+// evaluation budget and the box, and fills the Summary at the end.
+#include <limits>
+#include <optional>
+#include <string>
+
+#include "nlobs/solvers/box_bounds.hpp"
+#include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/finite_difference.hpp"
+#include "nlobs/solvers/stop_monitor.hpp"
+
+namespace nlobs::detail {
+
+template <int N>
+class SquareSystem {
+ public:
+  // A new solve of `problem` from x0 (checked: size, finite, inside `bounds`). Sizes the
+  // workspace (at a fixed N nothing allocates).
+  void start(std::string_view engine, const FixedPointProblem<N>& problem, const Vector<N>& x0,
+             const BoxBounds& bounds, FiniteDifference scheme, int max_evaluations) {
+    check_initial_guess(engine, problem, x0);
+    box_.start(engine, bounds, x0);
+    problem_ = &problem;
+    scheme_ = scheme;
+    max_evaluations_ = max_evaluations;
+    evaluations_ = jacobians_ = 0;
+    if constexpr (N == Dynamic) g_.resize(x0.size()), fd_.resize(x0.size());
+  }
+
+  // f = F(x) = G(x) − x; false when a value is not finite.
+  bool residual(const Vector<N>& x, Vector<N>& f) {
+    problem_->evaluate(x, g_);
+    ++evaluations_;
+    check_output_size(*problem_, g_);
+    f = g_ - x;
+    return f.allFinite();
+  }
+
+  // jac = J_F(x) where f = F(x): the problem's ∂G (user or AD) or differences, minus I. nullopt,
+  // or the status to stop with: kMaxEvaluations when the differences would overrun the budget,
+  // kNonFinite (message set) when J is not finite.
+  std::optional<Status> jacobian(const Vector<N>& x, const Vector<N>& f, Matrix<N, N>& jac,
+                                 std::string& message) {
+    if (!problem_->has_jacobian() &&
+        evaluations_ + finite_difference_cost(scheme_, x.size()) > max_evaluations_) {
+      return Status::kMaxEvaluations;
+    }
+    if (problem_->has_jacobian()) {
+      problem_->jacobian(x, jac);
+    } else {
+      g_ = f + x;
+      evaluations_ += finite_difference_jacobian(*problem_, x, g_, jac, scheme_, fd_, &box_);
+    }
+    ++jacobians_;
+    jac.diagonal().array() -= 1.0;
+    if (!jac.allFinite()) {
+      message = "the Jacobian of F is not finite";
+      return Status::kNonFinite;
+    }
+    return std::nullopt;
+  }
+
+  bool budget_spent() const { return evaluations_ >= max_evaluations_; }
+  int evaluations() const { return evaluations_; }
+  const Box<N>& box() const { return box_; }
+  const FixedPointProblem<N>& problem() const { return *problem_; }
+
+  // The summary of a run that ended with `status` at x where f = F(x): counts, the monitor's
+  // figures, ‖F‖∞ (inf when f is not finite), the answer for usable().
+  void finish(Summary& s, Status status, const StopMonitor& monitor, const Vector<N>& x,
+              const Vector<N>& f, const StopCriteria& given, bool minimised = false) const {
+    s.status = status;
+    s.function_evaluations = evaluations_;
+    s.jacobian_evaluations = jacobians_;
+    monitor.fill(s, f.allFinite() ? f.template lpNorm<Eigen::Infinity>()
+                                  : std::numeric_limits<double>::infinity());
+    s.record_answer(x, given, minimised);
+  }
+
+ private:
+  const FixedPointProblem<N>* problem_ = nullptr;
+  FiniteDifference scheme_ = FiniteDifference::kCentral;
+  int max_evaluations_ = 0, evaluations_ = 0, jacobians_ = 0;
+  Vector<N> g_ = zero_vector<N>();
+  FiniteDifferenceWorkspace<N> fd_;
+  Box<N> box_;
+};
+
+// x0 already solves F: ‖F(x0)‖₂ = 0, or StopCriteria's residual criterion holds there.
+template <int N>
+bool solved_at_start(const Vector<N>& f, const StopCriteria& stop) {
+  const double largest = f.template lpNorm<Eigen::Infinity>();
+  return largest == 0.0 || (stop.residual_tolerance && largest <= *stop.residual_tolerance);
+}
+
+}  // namespace nlobs::detail
