@@ -45,6 +45,19 @@ constexpr bool has_picard_steps() {
   }
 }
 
+// An accelerator whose iterates' steps and residuals rise and fall by design (Anderson) declares
+//   static constexpr bool kNonMonotone = true;
+// and the engine judges stagnation and divergence by the best residual over
+// StopCriteria::residual_window iterations instead of by the last steps.
+template <typename A>
+constexpr bool is_non_monotone() {
+  if constexpr (requires { A::kNonMonotone; }) {
+    return A::kNonMonotone;
+  } else {
+    return false;
+  }
+}
+
 template <int N, FixedPointAccelerator<N> Accelerator>
 class AcceleratedEngine : public Engine<N> {
  public:
@@ -80,7 +93,9 @@ Summary AcceleratedEngine<N, Accelerator>::solve(const FixedPointProblem<N>& pro
     point_.resize(n), gx_.resize(n), next_.resize(n), estimate_.resize(n), last_.resize(n);
   }
   StopMonitor monitor(opt.stop, x.template lpNorm<Eigen::Infinity>(),
-                      has_picard_steps<Accelerator>());
+                      has_picard_steps<Accelerator>(),
+                      is_non_monotone<Accelerator>() ? StopMonitor::Progress::kBestResidual
+                                                     : StopMonitor::Progress::kSteps);
   accelerator_.start(x);
   point_ = x;
   last_ = x;

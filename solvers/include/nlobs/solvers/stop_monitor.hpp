@@ -17,10 +17,16 @@ class StopMonitor {
   // estimate_lipschitz: the engine's steps are Picard steps x_{l+1} = G(x_l), so their ratio
   // estimates the contraction factor of G. Other engines' step ratios measure their own
   // convergence, not G's Lipschitz constant, and must not feed an error bound.
-  StopMonitor(const StopCriteria& criteria, double x0_norm, bool estimate_lipschitz)
+  // progress: what stagnation and divergence are judged by — the steps (monotone methods: the
+  // paper's rule, StopCriteria::stagnation_patience) or the best residual over a window
+  // (non-monotone methods such as Anderson: StopCriteria::residual_window).
+  enum class Progress { kSteps, kBestResidual };
+  StopMonitor(const StopCriteria& criteria, double x0_norm, bool estimate_lipschitz,
+              Progress progress = Progress::kSteps)
       : c_(criteria),
         limit_(criteria.divergence_limit * std::max(1.0, x0_norm)),
-        estimate_lipschitz_(estimate_lipschitz) {}
+        estimate_lipschitz_(estimate_lipschitz),
+        progress_(progress) {}
 
   // After each completed iteration: the step ‖x_l − x_{l−1}‖∞, the residual ‖G − x‖∞ at the
   // last evaluated point (NaN when unknown) and ‖x_l‖∞. Returns the final status or nullopt.
@@ -44,7 +50,20 @@ class StopMonitor {
     if (c_.stop_on_repeated_iterates && zero_steps_ >= 2) {
       return Status::kRepeatedIterates;  // x_l = x_{l−1} = x_{l−2}
     }
-    if (iterations_ > 1 && step >= prev_step_) {
+    if (progress_ == Progress::kBestResidual) {
+      if (residual < best_residual_) {  // (NaN: no record)
+        best_residual_ = residual;
+        since_best_ = 0;
+        far_above_ = 0;
+      } else {
+        ++since_best_;
+        far_above_ = residual > c_.divergence_growth * best_residual_ ? far_above_ + 1 : 0;
+      }
+      if (c_.residual_window > 0) {
+        if (far_above_ >= c_.residual_window) return Status::kDiverged;
+        if (since_best_ >= c_.residual_window) return Status::kStagnated;
+      }
+    } else if (iterations_ > 1 && step >= prev_step_) {
       if (non_shrinking_ == 0) run_start_step_ = prev_step_;
       ++non_shrinking_;
       if (c_.stagnation_patience > 0 && non_shrinking_ >= c_.stagnation_patience) {
@@ -127,6 +146,9 @@ class StopMonitor {
   StopCriteria c_;
   double limit_;
   bool estimate_lipschitz_;
+  Progress progress_;
+  double best_residual_ = std::numeric_limits<double>::infinity();
+  int since_best_ = 0, far_above_ = 0;  // iterations since the best residual; run above growth×
   int iterations_ = 0;
   double prev_step_ = 0.0;
   double last_step_ = 0.0;

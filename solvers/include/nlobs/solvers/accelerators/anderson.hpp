@@ -60,6 +60,8 @@ class AndersonMixing {
     }
   }
 
+  // Its residuals rise and fall: judged by the best residual over a window (StopMonitor).
+  static constexpr bool kNonMonotone = true;
   std::string_view name() const { return "anderson"; }
   const AndersonOptions& options() const { return options_; }
 
