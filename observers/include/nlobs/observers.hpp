@@ -7,6 +7,7 @@
 #include "nlobs/models.hpp"
 #include "nlobs/observers/baselines/baselines.hpp"
 #include "nlobs/observers/baselines/finite_difference_observer.hpp"
+#include "nlobs/observers/baselines/unscented_kalman_filter.hpp"
 #include "nlobs/observers/core/any_model.hpp"
 #include "nlobs/observers/core/observer.hpp"
 #include "nlobs/observers/core/simulation.hpp"

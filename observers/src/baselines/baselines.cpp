@@ -4,19 +4,21 @@
 #include <cmath>
 #include <sstream>
 
+#include "nlobs/observers/baselines/unscented_kalman_filter.hpp"
+
 namespace nlobs {
 namespace {
 
 // An optional covariance: empty (the default is used), or square, finite, symmetric and
 // positive semi-definite.
-void require_covariance(const char* field, const Eigen::MatrixXd& m) {
+void require_covariance(const char* owner, const char* field, const Eigen::MatrixXd& m) {
   if (m.size() == 0) return;
   std::ostringstream got;
   got << m.rows() << "x" << m.cols();
   // Square and finite first: the factorisation asserts (or reads out of bounds) otherwise.
   const auto fail = [&](const char* condition, const char* what) {
     got << what;
-    detail::invalid_option("EkfOptions", field, condition, got.str());
+    detail::invalid_option(owner, field, condition, got.str());
   };
   if (m.rows() != m.cols()) fail("be square", "");
   if (!m.allFinite()) fail("be finite", ", not all entries finite");
@@ -46,9 +48,24 @@ void SlidingModeOptions::validate() const {
 void EkfOptions::validate() const {
   detail::require_name("EkfOptions", name);
   detail::require_finite("EkfOptions", "initial_estimate", initial_estimate);
-  require_covariance("process_covariance", process_covariance);
-  require_covariance("measurement_covariance", measurement_covariance);
-  require_covariance("initial_covariance", initial_covariance);
+  require_covariance("EkfOptions", "process_covariance", process_covariance);
+  require_covariance("EkfOptions", "measurement_covariance", measurement_covariance);
+  require_covariance("EkfOptions", "initial_covariance", initial_covariance);
+}
+
+void UkfOptions::validate() const {
+  detail::require_name("UkfOptions", name);
+  detail::require_finite("UkfOptions", "initial_estimate", initial_estimate);
+  require_covariance("UkfOptions", "process_covariance", process_covariance);
+  require_covariance("UkfOptions", "measurement_covariance", measurement_covariance);
+  require_covariance("UkfOptions", "initial_covariance", initial_covariance);
+  if (!(alpha > 0.0 && alpha <= 1.0)) {
+    detail::invalid_option("UkfOptions", "alpha", "lie in (0, 1]", detail::option_value(alpha));
+  }
+  detail::require_non_negative("UkfOptions", "beta", beta);
+  if (!std::isfinite(kappa)) {
+    detail::invalid_option("UkfOptions", "kappa", "be finite", detail::option_value(kappa));
+  }
 }
 
 }  // namespace nlobs

@@ -4,6 +4,7 @@
 #include "builtin_observer_types.hpp"
 #include "nlobs/observers/baselines/baselines.hpp"
 #include "nlobs/observers/baselines/finite_difference_observer.hpp"
+#include "nlobs/observers/baselines/unscented_kalman_filter.hpp"
 
 namespace nlobs::detail {
 namespace {
@@ -104,12 +105,59 @@ void add_ekf(ObserverTypeRegistry& registry) {
       }}));
 }
 
+void add_ukf(ObserverTypeRegistry& registry) {
+  registry.add(observer_type_entry(ObserverTypeDefinition<UkfOptions>{
+      .name = "ukf",
+      .description = "unscented Kalman filter, scaled sigma points (no Jacobians)",
+      .condition = "",
+      .keys = {{"process_covariance", "Q (n x n)", "1e-6 I"},
+               {"measurement_covariance", "R (p x p)", "1e-4 I"},
+               {"initial_covariance", "P0 (n x n)", "I"},
+               {"alpha", "sigma-point spread in (0, 1]", "1"},
+               {"beta", "distribution prior, >= 0", "2"},
+               {"kappa", "secondary scaling", "0"},
+               initial_key(),
+               design_model_key()},
+      .parse =
+          [](JsonReader& o, const ModelInstance&) {
+            UkfOptions s;
+            s.process_covariance = o.matrix("process_covariance").value_or(Eigen::MatrixXd());
+            s.measurement_covariance =
+                o.matrix("measurement_covariance").value_or(Eigen::MatrixXd());
+            s.initial_covariance = o.matrix("initial_covariance").value_or(Eigen::MatrixXd());
+            s.alpha = o.number("alpha").value_or(s.alpha);
+            s.beta = o.number("beta").value_or(s.beta);
+            s.kappa = o.number("kappa").value_or(s.kappa);
+            return s;
+          },
+      .write =
+          [](const UkfOptions& s, nlohmann::json& out) {
+            if (s.process_covariance.size()) {
+              out["process_covariance"] = matrix_json(s.process_covariance);
+            }
+            if (s.measurement_covariance.size()) {
+              out["measurement_covariance"] = matrix_json(s.measurement_covariance);
+            }
+            if (s.initial_covariance.size()) {
+              out["initial_covariance"] = matrix_json(s.initial_covariance);
+            }
+            out["alpha"] = s.alpha;
+            out["beta"] = s.beta;
+            out["kappa"] = s.kappa;
+          },
+      .build = [](UkfOptions s, const ObserverBuild& b) -> std::unique_ptr<Observer> {
+        s.initial_estimate = b.start;
+        return std::make_unique<UnscentedKalmanFilter<AnyModel>>(b.design, std::move(s));
+      }}));
+}
+
 }  // namespace
 
 void add_baseline_types(ObserverTypeRegistry& registry) {
   add_luenberger(registry);
   add_sliding_mode(registry);
   add_ekf(registry);
+  add_ukf(registry);
 }
 
 void add_finite_difference_type(ObserverTypeRegistry& registry) {

@@ -13,6 +13,7 @@
 // bound holds x against the descent direction and neither path decreases ‖F‖ ends the run
 // blocked_by_bound (without a line search: where the projected Newton step is zero).
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -134,7 +135,8 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
       const double decrease = projected || box.active()
                                   ? -2.0 * newton_.sufficient_decrease * gradient_.dot(xt_ - x_)
                                   : 2.0 * newton_.sufficient_decrease * t * phi0;
-      if (finite && ft_.squaredNorm() <= phi0 - decrease) return true;
+      // (A projected Newton path need not descend: ∇φᵀ(x_t − x) > 0 still allows no increase.)
+      if (finite && ft_.squaredNorm() <= std::min(phi0 - decrease, phi0)) return true;
       t *= newton_.backtrack_factor;
     }
     return false;

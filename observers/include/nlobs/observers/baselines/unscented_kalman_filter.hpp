@@ -1,0 +1,201 @@
+#pragma once
+// Unscented Kalman filter ([JU97]) with the scaled sigma points and weights of [WvdM00], for any
+// discrete model x⁺ = f(x, u, k), y = h(x) — a baseline beside the EKF that needs no Jacobian:
+//   λ = α²(n + κ) − n,  χ_0 = x̂,  χ_{±i} = x̂ ± (L)_i,  L Lᵀ = (n + λ) P  (Cholesky),
+//   W_0^m = λ/(n + λ),  W_0^c = W_0^m + 1 − α² + β,  W_{±i} = 1/(2(n + λ)).
+// Update with y_k:  Y_i = h(χ_i), ŷ = Σ W^m Y_i, S = Σ W^c (Y_i − ŷ)(Y_i − ŷ)ᵀ + R,
+//   C = Σ W^c (χ_i − x̂)(Y_i − ŷ)ᵀ, K = C S⁻¹, x̂ ← x̂ + K (y − ŷ), P ← P − K S Kᵀ;
+// report x̂_k; then predict: χ_i ← f(χ_i, u_k, k), x̂ = Σ W^m χ_i, P = Σ W^c (χ_i − x̂)(..)ᵀ + Q.
+// On a linear model it is the Kalman filter (tested).
+//
+// A P that the Cholesky factorisation refuses (rounding, or a negative W_0^c with α < 1) is
+// repaired, never thrown about: symmetrised, then its diagonal raised by
+// δ = 1e-12 · max(1, max_i |P_ii|), ten times more per try, up to 10 tries (covariance_repairs()
+// counts them). When that fails, or a step is not finite, the step is not taken: x̂ keeps its
+// last finite value, P restarts from P0, and the step says so (failure non_finite_estimate).
+// A measurement with a non-finite entry is skipped (measurement_missing).
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "nlobs/models/model.hpp"
+#include "nlobs/observers/core/observer.hpp"
+#include "nlobs/observers/core/option_checks.hpp"
+
+namespace nlobs {
+
+struct UkfOptions {
+  std::string name = "ukf";                // in reports
+  Eigen::VectorXd initial_estimate;        // x̂_0: n finite numbers (required)
+  Eigen::MatrixXd process_covariance;      // Q (n × n); empty: 1e-6 I
+  Eigen::MatrixXd measurement_covariance;  // R (p × p); empty: 1e-4 I
+  Eigen::MatrixXd initial_covariance;      // P0 (n × n); empty: I
+  // The spread of the sigma points, α ∈ (0, 1]; the default 1 with κ = 0 gives λ = 0: no
+  // negative weight, the most robust choice ([WvdM00] suggest α = 1e-3 for a tighter spread).
+  double alpha = 1.0;
+  double beta = 2.0;   // prior knowledge of the distribution; 2 is optimal for a Gaussian; ≥ 0
+  double kappa = 0.0;  // secondary scaling; n + λ must stay > 0
+  // Throws InvalidInput naming the field: as EkfOptions, and α ∉ (0, 1], β < 0, κ not finite.
+  void validate() const;
+};
+
+template <DiscreteModel Model>
+class UnscentedKalmanFilter final : public Observer {
+ public:
+  UnscentedKalmanFilter(Model model, UkfOptions options)
+      : model_(std::move(model)), options_(detail::validated(std::move(options))) {
+    info_.name = options_.name;
+    const Eigen::Index n = model_.states(), p = model_.outputs();
+    q_ = options_.process_covariance.size()
+             ? options_.process_covariance
+             : Eigen::MatrixXd(1e-6 * Eigen::MatrixXd::Identity(n, n));
+    r_ = options_.measurement_covariance.size()
+             ? options_.measurement_covariance
+             : Eigen::MatrixXd(1e-4 * Eigen::MatrixXd::Identity(p, p));
+    p0_ = options_.initial_covariance.size() ? options_.initial_covariance
+                                             : Eigen::MatrixXd(Eigen::MatrixXd::Identity(n, n));
+    detail::require_size("UkfOptions", "initial_estimate", options_.initial_estimate, n);
+    detail::require_shape("UkfOptions", "process_covariance", q_, n, n);
+    detail::require_shape("UkfOptions", "measurement_covariance", r_, p, p);
+    detail::require_shape("UkfOptions", "initial_covariance", p0_, n, n);
+    const double dn = static_cast<double>(n);
+    lambda_ = options_.alpha * options_.alpha * (dn + options_.kappa) - dn;
+    if (!(dn + lambda_ > 0.0)) {
+      std::ostringstream got;
+      got << options_.kappa << " (n + lambda = " << dn + lambda_ << ")";
+      detail::invalid_option("UkfOptions", "kappa", "give n + lambda > 0", got.str());
+    }
+    wm0_ = lambda_ / (dn + lambda_);
+    wc0_ = wm0_ + 1.0 - options_.alpha * options_.alpha + options_.beta;
+    wi_ = 0.5 / (dn + lambda_);
+    reset();
+  }
+
+  void reset() override {
+    x_ = options_.initial_estimate;
+    p_ = p0_;
+    repairs_ = 0;
+  }
+
+  // How many times P was repaired (symmetrised and its diagonal raised) since reset().
+  int covariance_repairs() const { return repairs_; }
+
+  const ObserverStep& step(long k, double /*t*/, const Eigen::VectorXd& y,
+                           const Eigen::VectorXd& u) override {
+    const Eigen::Index n = model_.states(), p = model_.outputs();
+    step_.failure.clear();
+    step_.failure_message.clear();
+    step_.measurement_missing = !y.allFinite();
+    if (!step_.measurement_missing) {
+      if (sigma_points(k, "the measurement update")) {
+        ys_.resize(p, 2 * n + 1);
+        for (Eigen::Index i = 0; i < 2 * n + 1; ++i) {
+          ys_.col(i) = Eigen::VectorXd(model_.h(ModelVector<double, Model::kStates>(chi_.col(i))));
+        }
+        const Eigen::VectorXd y_mean = mean(ys_);
+        Eigen::MatrixXd s = r_, c = Eigen::MatrixXd::Zero(n, p);
+        for (Eigen::Index i = 0; i < 2 * n + 1; ++i) {
+          const Eigen::VectorXd dy = ys_.col(i) - y_mean;
+          const double w = i == 0 ? wc0_ : wi_;
+          s.noalias() += w * dy * dy.transpose();
+          c.noalias() += w * (chi_.col(i) - x_) * dy.transpose();
+        }
+        const Eigen::PartialPivLU<Eigen::MatrixXd> lu(s);
+        const Eigen::MatrixXd gain = lu.solve(c.transpose()).transpose();  // C S⁻¹ (S symmetric)
+        const Eigen::VectorXd updated = x_ + gain * (y - y_mean);
+        Eigen::MatrixXd covariance = p_ - gain * s * gain.transpose();
+        covariance = 0.5 * (covariance + covariance.transpose());
+        if (updated.allFinite() && covariance.allFinite()) {
+          x_ = updated;
+          p_ = covariance;
+        } else {
+          fail(k, "the measurement update", "kept the last finite estimate");
+        }
+      }
+    }
+    step_.estimate = x_;
+    if (sigma_points(k, "the prediction")) {
+      const ModelVector<double, Model::kInputs> uu(u);
+      for (Eigen::Index i = 0; i < 2 * n + 1; ++i) {
+        chi_.col(i) =
+            Eigen::VectorXd(model_.f(ModelVector<double, Model::kStates>(chi_.col(i)), uu, k));
+      }
+      const Eigen::VectorXd predicted = mean(chi_);
+      Eigen::MatrixXd covariance = q_;
+      for (Eigen::Index i = 0; i < 2 * n + 1; ++i) {
+        const Eigen::VectorXd dx = chi_.col(i) - predicted;
+        covariance.noalias() += (i == 0 ? wc0_ : wi_) * dx * dx.transpose();
+      }
+      if (predicted.allFinite() && covariance.allFinite()) {
+        x_ = predicted;
+        p_ = 0.5 * (covariance + covariance.transpose());
+      } else {
+        fail(k, "the prediction", "kept the last finite estimate; P restarts from P0");
+        p_ = p0_;
+      }
+    }
+    return step_;
+  }
+
+ private:
+  // χ = [x̂, x̂ + L, x̂ − L] from the Cholesky factor of (n + λ) P, repaired if need be; false
+  // (P restarted from P0, the step marked) when no repair gives a factor.
+  bool sigma_points(long k, const char* where) {
+    const Eigen::Index n = model_.states();
+    p_ = 0.5 * (p_ + p_.transpose());
+    Eigen::LLT<Eigen::MatrixXd> llt(p_);
+    if (llt.info() != Eigen::Success && p_.allFinite()) {
+      double jitter = 1e-12 * std::max(1.0, p_.diagonal().cwiseAbs().maxCoeff());
+      for (int attempt = 0; attempt < 10 && llt.info() != Eigen::Success; ++attempt) {
+        Eigen::MatrixXd raised = p_;
+        raised.diagonal().array() += jitter;
+        llt.compute(raised);
+        if (llt.info() == Eigen::Success) {
+          p_ = raised;
+          ++repairs_;
+        }
+        jitter *= 10.0;
+      }
+    }
+    if (llt.info() != Eigen::Success) {
+      std::ostringstream what;
+      what << "the covariance P before " << where;
+      fail(k, what.str().c_str(), "P restarts from P0");
+      p_ = p0_;
+      return false;
+    }
+    const Eigen::MatrixXd spread =
+        std::sqrt(static_cast<double>(n) + lambda_) * Eigen::MatrixXd(llt.matrixL());
+    chi_.resize(n, 2 * n + 1);
+    chi_.col(0) = x_;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      chi_.col(1 + i) = x_ + spread.col(i);
+      chi_.col(1 + n + i) = x_ - spread.col(i);
+    }
+    return true;
+  }
+
+  Eigen::VectorXd mean(const Eigen::MatrixXd& points) const {
+    return wm0_ * points.col(0) + wi_ * points.rightCols(points.cols() - 1).rowwise().sum();
+  }
+
+  void fail(long k, const char* what, const char* action) {
+    std::ostringstream os;
+    os << name() << ": " << what << " at sample k = " << k << " is not finite or not positive "
+       << "definite; " << action;
+    mark_non_finite_estimate(step_, os.str());
+  }
+
+  Model model_;
+  UkfOptions options_;
+  double lambda_ = 0.0, wm0_ = 0.0, wc0_ = 0.0, wi_ = 0.0;
+  Eigen::VectorXd x_;
+  Eigen::MatrixXd q_, r_, p0_, p_, chi_, ys_;
+  int repairs_ = 0;
+  ObserverStep step_;
+};
+
+}  // namespace nlobs
