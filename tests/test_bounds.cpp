@@ -278,6 +278,17 @@ TEST(Bounds, EnginesThatTakeNoBoundsSayWhichDo) {
                            "auto", "ceres", "nlopt"}) {
     EXPECT_TRUE(registry.create(spec)->accepts_bounds()) << spec;
   }
+  // A stage that refuses the box leaves auto and its stages as they were.
+  auto mixed =
+      EngineRegistry<Dynamic>::global().create("auto:order=newton/levenberg-marquardt:geodesic=1");
+  EXPECT_NE(test::message_of([&] { mixed->set_bounds(box); }).find("geodesic acceleration"),
+            std::string::npos);
+  EXPECT_TRUE(mixed->bounds().empty());
+  const auto* poly = dynamic_cast<const PolyalgorithmEngine<>*>(mixed.get());
+  ASSERT_NE(poly, nullptr);
+  for (const auto& stage : poly->stages()) {
+    EXPECT_TRUE(stage->bounds().empty()) << stage->label();
+  }
   auto geodesic = registry.create("levenberg-marquardt:geodesic=1");
   EXPECT_NE(test::message_of([&] { geodesic->set_bounds(box); }).find("geodesic acceleration"),
             std::string::npos);

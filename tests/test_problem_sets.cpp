@@ -181,6 +181,22 @@ TEST(ProblemSets, TheBoundedSetGivesItsBoxToTheEnginesThatTakeOne) {
   EXPECT_EQ(minpack_solved, 2);  // measured; unbounded, it leaves the box or F's domain
 }
 
+TEST(ProblemSets, AnEngineThatRefusesTheBoxIsARowNotTheEnd) {
+  register_once();
+  // x = 0.5 on x >= 0: levenberg-marquardt with geodesic acceleration refuses a box.
+  TestProblem p = root_test_problem("half", 1, [](const auto& x, auto& f) { f[0] = x[0] - 0.5; },
+                                    {{"one", Eigen::VectorXd::Constant(1, 1.0)}});
+  p.lower = Eigen::VectorXd::Constant(1, 0.0);
+  const ProblemSetEntry set{.name = "half",
+                            .problems = [p] { return std::vector<TestProblem>{p}; }};
+  const auto rows = reference::run_suite(set, build_problem_set(set),
+                                         {"levenberg-marquardt:geodesic=1", "newton"});
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].status, "invalid_input");
+  EXPECT_FALSE(rows[0].solved);
+  EXPECT_TRUE(rows[1].solved) << rows[1].status;
+}
+
 TEST(ProblemSets, AThrowingProblemOrEngineIsARowNotTheEnd) {
   register_once();
   const ProblemSelection s = select_problems("test-hostile", problem_set_registry());

@@ -262,7 +262,15 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
           // The problem's box reaches the engines that take bounds; the others run unbounded
           // and are judged alike (outside_bounds).
           if ((p.lower.size() > 0 || p.upper.size() > 0) && engine->accepts_bounds()) {
-            engine->set_bounds({p.lower, p.upper});
+            try {
+              engine->set_bounds({p.lower, p.upper});
+            } catch (const InvalidInput&) {  // levenberg-marquardt:geodesic=1, a user's engine
+              row.status = "invalid_input";  // the engine refused the box: it did not run
+              row.residual = std::numeric_limits<double>::infinity();
+              row.error = std::numeric_limits<double>::infinity();
+              rows.push_back(std::move(row));
+              continue;
+            }
           }
           row.ns = mean_ns_per_call(
               [&] {

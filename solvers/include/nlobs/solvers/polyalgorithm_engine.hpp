@@ -138,8 +138,18 @@ class PolyalgorithmEngine : public Engine<N> {
   }
 
  private:
+  // Every stage takes the box, or none does: a stage that refuses it (levenberg-marquardt with
+  // geodesic acceleration) puts the stages before it back to their own.
   void on_set_bounds() override {
-    for (auto& s : stages_) s->set_bounds(this->bounds_);
+    std::vector<BoxBounds> previous;
+    for (const auto& s : stages_) previous.push_back(s->bounds());
+    std::size_t k = 0;
+    try {
+      for (; k < stages_.size(); ++k) stages_[k]->set_bounds(this->bounds_);
+    } catch (...) {
+      for (std::size_t j = 0; j < k; ++j) stages_[j]->set_bounds(previous[j]);
+      throw;
+    }
   }
   std::vector<std::unique_ptr<Engine<N>>> stages_;
   std::vector<int> caps_;
