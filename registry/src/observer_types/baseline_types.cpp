@@ -1,6 +1,8 @@
 // The classic baselines on the discretised model (AD Jacobians through AnyModel): luenberger,
 // sliding_mode, ekf, and the backward differences finite_difference. Their specs are the
 // library's own options; the start estimate is filled when built.
+#include <vector>
+
 #include "builtin_observer_types.hpp"
 #include "nlobs/observers/baselines/baselines.hpp"
 #include "nlobs/observers/baselines/finite_difference_observer.hpp"
@@ -68,37 +70,49 @@ void add_sliding_mode(ObserverTypeRegistry& registry) {
       }}));
 }
 
+// The EKF's and the UKF's keys: the three covariances (Q, R, P0), then `extra`, then the
+// initial estimate and the design model.
+std::vector<KeyInfo> kalman_keys(std::vector<KeyInfo> extra) {
+  std::vector<KeyInfo> keys = {{"process_covariance", "Q (n x n)", "1e-6 I"},
+                               {"measurement_covariance", "R (p x p)", "1e-4 I"},
+                               {"initial_covariance", "P0 (n x n)", "I"}};
+  keys.insert(keys.end(), extra.begin(), extra.end());
+  keys.push_back(initial_key());
+  keys.push_back(design_model_key());
+  return keys;
+}
+
+// Q, R and P0 from a scenario entry (each optional) into EkfOptions or UkfOptions.
+template <typename Options>
+void read_covariances(JsonReader& o, Options& s) {
+  s.process_covariance = o.matrix("process_covariance").value_or(Eigen::MatrixXd());
+  s.measurement_covariance = o.matrix("measurement_covariance").value_or(Eigen::MatrixXd());
+  s.initial_covariance = o.matrix("initial_covariance").value_or(Eigen::MatrixXd());
+}
+
+// The covariances that were given, back to JSON.
+template <typename Options>
+void write_covariances(const Options& s, nlohmann::json& out) {
+  if (s.process_covariance.size()) out["process_covariance"] = matrix_json(s.process_covariance);
+  if (s.measurement_covariance.size()) {
+    out["measurement_covariance"] = matrix_json(s.measurement_covariance);
+  }
+  if (s.initial_covariance.size()) out["initial_covariance"] = matrix_json(s.initial_covariance);
+}
+
 void add_ekf(ObserverTypeRegistry& registry) {
   registry.add(observer_type_entry(ObserverTypeDefinition<EkfOptions>{
       .name = "ekf",
       .description = "extended Kalman filter, AD Jacobians",
       .condition = "",
-      .keys = {{"process_covariance", "Q (n x n)", "1e-6 I"},
-               {"measurement_covariance", "R (p x p)", "1e-4 I"},
-               {"initial_covariance", "P0 (n x n)", "I"},
-               initial_key(),
-               design_model_key()},
+      .keys = kalman_keys({}),
       .parse =
           [](JsonReader& o, const ModelInstance&) {
             EkfOptions s;
-            s.process_covariance = o.matrix("process_covariance").value_or(Eigen::MatrixXd());
-            s.measurement_covariance =
-                o.matrix("measurement_covariance").value_or(Eigen::MatrixXd());
-            s.initial_covariance = o.matrix("initial_covariance").value_or(Eigen::MatrixXd());
+            read_covariances(o, s);
             return s;
           },
-      .write =
-          [](const EkfOptions& s, nlohmann::json& out) {
-            if (s.process_covariance.size()) {
-              out["process_covariance"] = matrix_json(s.process_covariance);
-            }
-            if (s.measurement_covariance.size()) {
-              out["measurement_covariance"] = matrix_json(s.measurement_covariance);
-            }
-            if (s.initial_covariance.size()) {
-              out["initial_covariance"] = matrix_json(s.initial_covariance);
-            }
-          },
+      .write = [](const EkfOptions& s, nlohmann::json& out) { write_covariances(s, out); },
       .build = [](EkfOptions s, const ObserverBuild& b) -> std::unique_ptr<Observer> {
         s.initial_estimate = b.start;
         return std::make_unique<ExtendedKalmanFilter<AnyModel>>(b.design, std::move(s));
@@ -110,21 +124,13 @@ void add_ukf(ObserverTypeRegistry& registry) {
       .name = "ukf",
       .description = "unscented Kalman filter, scaled sigma points (no Jacobians)",
       .condition = "",
-      .keys = {{"process_covariance", "Q (n x n)", "1e-6 I"},
-               {"measurement_covariance", "R (p x p)", "1e-4 I"},
-               {"initial_covariance", "P0 (n x n)", "I"},
-               {"alpha", "sigma-point spread in (0, 1]", "1"},
-               {"beta", "distribution prior, >= 0", "2"},
-               {"kappa", "secondary scaling", "0"},
-               initial_key(),
-               design_model_key()},
+      .keys = kalman_keys({{"alpha", "sigma-point spread in (0, 1]", "1"},
+                           {"beta", "distribution prior, >= 0", "2"},
+                           {"kappa", "secondary scaling", "0"}}),
       .parse =
           [](JsonReader& o, const ModelInstance&) {
             UkfOptions s;
-            s.process_covariance = o.matrix("process_covariance").value_or(Eigen::MatrixXd());
-            s.measurement_covariance =
-                o.matrix("measurement_covariance").value_or(Eigen::MatrixXd());
-            s.initial_covariance = o.matrix("initial_covariance").value_or(Eigen::MatrixXd());
+            read_covariances(o, s);
             s.alpha = o.number("alpha").value_or(s.alpha);
             s.beta = o.number("beta").value_or(s.beta);
             s.kappa = o.number("kappa").value_or(s.kappa);
@@ -132,15 +138,7 @@ void add_ukf(ObserverTypeRegistry& registry) {
           },
       .write =
           [](const UkfOptions& s, nlohmann::json& out) {
-            if (s.process_covariance.size()) {
-              out["process_covariance"] = matrix_json(s.process_covariance);
-            }
-            if (s.measurement_covariance.size()) {
-              out["measurement_covariance"] = matrix_json(s.measurement_covariance);
-            }
-            if (s.initial_covariance.size()) {
-              out["initial_covariance"] = matrix_json(s.initial_covariance);
-            }
+            write_covariances(s, out);
             out["alpha"] = s.alpha;
             out["beta"] = s.beta;
             out["kappa"] = s.kappa;
