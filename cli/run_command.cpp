@@ -145,8 +145,9 @@ namespace {
 void print_table(const Scenario& s, const Measurements& data, const RunResult& r,
                  std::ostream& out) {
   char line[512];
-  out << "scenario " << s.name << ": " << data.steps() << " samples, noise sigma " << s.noise
-      << ", seed " << s.seed << "; 'after' counts samples k >= " << r.settle_index << "\n";
+  out << "scenario " << s.name << ": " << data.steps() << " samples, noise sigma " << s.noise;
+  if (s.process_noise > 0.0) out << ", process noise sigma " << s.process_noise;
+  out << ", seed " << s.seed << "; 'after' counts samples k >= " << r.settle_index << "\n";
   std::snprintf(line, sizeof line, "%-26s %-11s %-11s %-11s %8s %6s %6s %9s %10s  %s\n", "observer",
                 "MSE (all)", "MSE (after)", "paper MSE", "iter", "max", "first", "paper 1st",
                 "us/step", "failures");
@@ -289,6 +290,7 @@ nlohmann::json summary_json(const Scenario& s, const Measurements& data, const R
                    {"source", source}};
   if (!data.stop_message.empty()) j["stop_message"] = data.stop_message;
   if (s.settle_time >= 0.0) j["settle_time"] = s.settle_time;
+  if (s.process_noise > 0.0) j["process_noise_std"] = s.process_noise;
   if (!bounds.empty()) j["pi_bounds"] = bounds;
   if (!warnings.empty()) j["warnings"] = warnings;
   return j;
@@ -324,6 +326,7 @@ Measurements simulate_scenario(const Scenario& s, const AnyModel& model) {
   SimulationOptions sim;
   sim.steps = s.steps;
   sim.noise_std = s.noise;
+  sim.process_noise_std = s.process_noise;
   sim.seed = s.seed;
   sim.sample_time = model.sample_time() > 0 ? model.sample_time() : 1.0;
   sim.input = [&s, &model](long k) { return scenario_input(s, model, k); };

@@ -202,11 +202,26 @@ std::string plot_script(OutputDirectory& dir, const Measurements& data, const Ru
     << ",1\n";
   for (Eigen::Index i = 0; i < n; ++i) {
     g << "set ylabel 'x" << i + 1 << "'\n";
-    // The truth's range plus half of it on each side: an estimate's transient spikes (a PI
-    // bank's pole crossing) must not flatten the comparison; errors.png shows them in full.
+    // The truth's range, widened to the finite estimates after the settle index (an estimate
+    // that settles on a wrong state must show: the EKF's negative concentrations of
+    // mhe-batch-reactor) but by at most three times the truth's span, plus a margin: an
+    // estimate's transient spikes (a PI bank's pole crossing) and a diverging observer must
+    // not flatten the comparison; errors.png shows them in full.
     if (data.has_truth() && data.x.cols() > 0) {
-      const double lo = data.x.row(i).minCoeff(), hi = data.x.row(i).maxCoeff();
-      const double margin = std::max(0.5 * (hi - lo), 1e-3 * std::max(1.0, std::abs(hi)));
+      const double truth_lo = data.x.row(i).minCoeff(), truth_hi = data.x.row(i).maxCoeff();
+      const double reach =
+          3.0 * std::max(truth_hi - truth_lo, 1e-3 * std::max(1.0, std::abs(truth_hi)));
+      double lo = truth_lo, hi = truth_hi;
+      for (const Eigen::MatrixXd& e : r.estimates) {
+        for (Eigen::Index k = std::max<Eigen::Index>(r.settle_index, 0); k < e.cols(); ++k) {
+          const double v = e(i, k);
+          if (!std::isfinite(v)) continue;
+          lo = std::min(lo, std::max(v, truth_lo - reach));
+          hi = std::max(hi, std::min(v, truth_hi + reach));
+        }
+      }
+      const double margin =
+          std::max(0.5 * (truth_hi - truth_lo), 1e-3 * std::max(1.0, std::abs(truth_hi)));
       g << "set yrange [" << lo - margin << ":" << hi + margin << "]\n";
     }
     g << "plot ";

@@ -38,6 +38,7 @@ struct Scenario {
   Eigen::VectorXd x0, initial_guess;
   long steps = 400;
   double noise = 0.0;
+  double process_noise = 0.0;  // σ_w added to every state of the truth at every step
   std::uint64_t seed = 1;
   InputSpec input;
   std::vector<ObserverSpec> observers;

@@ -621,21 +621,12 @@ TEST(Harness, FirstFailureHoldsTheEnginesStatusAndMessage) {
 }
 
 // The simulation stops where the true state overflows instead of feeding NaN measurements.
-struct Exploding : ModelSizes<1, 0, 1> {
-  template <typename T>
-  State<T> f(const State<T>& x, const Input&, long) const {
-    return State<T>(x[0] * x[0] * 1e10);
-  }
-  template <typename T>
-  Output<T> h(const State<T>& x) const {
-    return Output<T>(x[0]);
-  }
-};
-
 TEST(Simulation, StopsWhereTheTrueStateIsNotFinite) {
   SimulationOptions so;
   so.steps = 100;
-  const Measurements data = simulate(Exploding{}, Eigen::VectorXd::Constant(1, 2.0), so);
+  test::Squaring exploding;
+  exploding.scale = 1e10;  // overflows after a few steps from x = 2
+  const Measurements data = simulate(exploding, Eigen::VectorXd::Constant(1, 2.0), so);
   EXPECT_LT(data.steps(), 100);
   EXPECT_GT(data.steps(), 0);
   EXPECT_TRUE(data.y.allFinite());

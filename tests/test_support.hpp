@@ -4,6 +4,7 @@
 #include <limits>
 #include <string>
 
+#include "nlobs/models/model.hpp"
 #include "nlobs/solvers/solvers.hpp"
 
 namespace nlobs::test {
@@ -62,5 +63,18 @@ inline RootProblem<2> circle_line() {
     return f;
   });
 }
+
+// x⁺ = scale · x², y = x: a model that overflows (scale 1e200: at the first step from |x| > 1).
+struct Squaring : ModelSizes<1, 0, 1> {
+  double scale = 1e200;
+  template <typename T>
+  State<T> f(const State<T>& x, const Input&, long) const {
+    return State<T>(x[0] * x[0] * scale);
+  }
+  template <typename T>
+  Output<T> h(const State<T>& x) const {
+    return Output<T>(x[0]);
+  }
+};
 
 }  // namespace nlobs::test

@@ -32,17 +32,7 @@ struct Linear3 : ModelSizes<3, 1, 2> {
   }
 };
 
-// x⁺ = 1e200 x²: overflows at once.
-struct Exploding : ModelSizes<1, 0, 1> {
-  template <typename T>
-  State<T> f(const State<T>& x, const Input&, long) const {
-    return State<T>(x[0] * x[0] * 1e200);
-  }
-  template <typename T>
-  Output<T> h(const State<T>& x) const {
-    return Output<T>(x[0]);
-  }
-};
+using Exploding = test::Squaring;  // x⁺ = 1e200 x²: overflows at once
 
 template <typename Options>
 Options covariances(Options o) {

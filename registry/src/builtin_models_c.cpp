@@ -1,6 +1,6 @@
 // The built-in models, registered as a user's are (register_model.hpp): the PI paper's lander
 // and unknown-input integrator, the modulating-function paper's two systems (their canonical
-// forms: nlobs/models/modulating_forms.hpp).
+// forms: nlobs/models/modulating_forms.hpp), and the batch reactor of the MHE literature.
 #include <stdexcept>
 
 #include "builtin_models.hpp"
@@ -68,6 +68,16 @@ void add_builtin_models_c(ModelRegistry& r) {
         if (!(m.p.length > 0.0)) throw std::invalid_argument("'length' must be > 0");
         return m;
       }}));
+  r.add(model_entry(ModelDefinition<BatchReactor>{
+      .name = "batch-reactor",
+      .description = "A <-> B + C, 2B <-> C; y = RT (cA + cB + cC) ([HR05]); RK4 T = 0.25",
+      .parameters = {{"k1", "A -> B + C", [](BatchReactor& m) -> double& { return m.p.k1; }},
+                     {"k2", "B + C -> A", [](BatchReactor& m) -> double& { return m.p.k2; }},
+                     {"k3", "2B -> C", [](BatchReactor& m) -> double& { return m.p.k3; }},
+                     {"k4", "C -> 2B", [](BatchReactor& m) -> double& { return m.p.k4; }},
+                     {"rt", "RT, y = RT (cA + cB + cC)",
+                      [](BatchReactor& m) -> double& { return m.p.rt; }}},
+      .default_step = 0.25}));
 }
 
 }  // namespace nlobs::detail

@@ -115,6 +115,27 @@ std::optional<Eigen::VectorXd> JsonReader::vector(const std::string& key) {
   return out;
 }
 
+std::optional<Eigen::VectorXd> JsonReader::bounds(const std::string& key, double unbounded) {
+  if (!has(key)) return std::nullopt;
+  const auto& v = get(key);
+  if (!v.is_array()) {
+    fail("'" + key + "' must be an array of numbers or null, got " + json_excerpt(v));
+  }
+  Eigen::VectorXd out(static_cast<Eigen::Index>(v.size()));
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (v[i].is_null()) {
+      out[static_cast<Eigen::Index>(i)] = unbounded;
+      continue;
+    }
+    if (!v[i].is_number()) {
+      fail("'" + key + "[" + std::to_string(i) + "]' must be a number or null (no bound), got " +
+           json_excerpt(v[i]));
+    }
+    out[static_cast<Eigen::Index>(i)] = v[i].get<double>();
+  }
+  return out;
+}
+
 std::optional<Eigen::MatrixXd> JsonReader::matrix(const std::string& key) {
   if (!has(key)) return std::nullopt;
   const auto& v = get(key);

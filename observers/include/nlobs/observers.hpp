@@ -12,6 +12,7 @@
 #include "nlobs/observers/core/observer.hpp"
 #include "nlobs/observers/core/simulation.hpp"
 #include "nlobs/observers/high_gain/high_gain_observer.hpp"
+#include "nlobs/observers/mhe/mhe_estimator.hpp"
 #include "nlobs/observers/modulating/modulating_function_observer.hpp"
 #include "nlobs/observers/mvt/mvt_observer.hpp"
 #include "nlobs/observers/pi/pi_bank.hpp"

@@ -1,6 +1,5 @@
 #include "nlobs/observers/baselines/baselines.hpp"
 
-#include <Eigen/Cholesky>
 #include <cmath>
 #include <sstream>
 
@@ -9,24 +8,8 @@
 namespace nlobs {
 namespace {
 
-// An optional covariance: empty (the default is used), or square, finite, symmetric and
-// positive semi-definite.
-void require_covariance(const char* owner, const char* field, const Eigen::MatrixXd& m) {
-  if (m.size() == 0) return;
-  std::ostringstream got;
-  got << m.rows() << "x" << m.cols();
-  // Square and finite first: the factorisation asserts (or reads out of bounds) otherwise.
-  const auto fail = [&](const char* condition, const char* what) {
-    got << what;
-    detail::invalid_option(owner, field, condition, got.str());
-  };
-  if (m.rows() != m.cols()) fail("be square", "");
-  if (!m.allFinite()) fail("be finite", ", not all entries finite");
-  if (!m.isApprox(m.transpose())) fail("be symmetric", ", not symmetric");
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(m);
-  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) {
-    fail("be positive semi-definite", ", a negative eigenvalue");
-  }
+void require_covariance(const char* who, const char* field, const Eigen::MatrixXd& m) {
+  detail::require_covariance(who, field, m, detail::Definiteness::kSemiDefinite);
 }
 
 }  // namespace

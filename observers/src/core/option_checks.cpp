@@ -1,5 +1,6 @@
 #include "nlobs/observers/core/option_checks.hpp"
 
+#include <Eigen/Cholesky>
 #include <array>
 #include <charconv>
 #include <cmath>
@@ -68,6 +69,37 @@ void require_shape(const char* who, const char* field, const Eigen::MatrixXd& m,
   want << "be a finite " << rows << "x" << cols << " matrix";
   got << m.rows() << "x" << m.cols() << (m.allFinite() ? "" : ", not all finite");
   invalid_option(who, field, want.str(), got.str());
+}
+
+void require_covariance(const char* who, const char* field, const Eigen::MatrixXd& m,
+                        Definiteness definiteness) {
+  if (m.size() == 0) return;
+  std::ostringstream got;
+  got << m.rows() << "x" << m.cols();
+  // Square and finite first: the factorisation asserts (or reads out of bounds) otherwise.
+  const auto fail = [&](const char* condition, const char* what) {
+    got << what;
+    invalid_option(who, field, condition, got.str());
+  };
+  if (m.rows() != m.cols()) fail("be square", "");
+  if (!m.allFinite()) fail("be finite", ", not all entries finite");
+  if (!m.isApprox(m.transpose())) fail("be symmetric", ", not symmetric");
+  if (definiteness == Definiteness::kDefinite) {
+    const Eigen::LLT<Eigen::MatrixXd> llt(m);
+    if (llt.info() != Eigen::Success) fail("be positive definite", ", not positive definite");
+    return;
+  }
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(m);
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) {
+    fail("be positive semi-definite", ", a negative eigenvalue");
+  }
+}
+
+Eigen::MatrixXd covariance_or_default(const char* who, const char* field, const Eigen::MatrixXd& m,
+                                      Eigen::Index size, double default_scale) {
+  if (m.size() == 0) return default_scale * Eigen::MatrixXd::Identity(size, size);
+  require_shape(who, field, m, size, size);
+  return m;
 }
 
 }  // namespace nlobs::detail

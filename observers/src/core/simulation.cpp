@@ -131,7 +131,9 @@ RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Ob
       if (s.summary && !s.summary->usable()) {
         if (s.summary->converged()) ++m.failures["unusable"];
         note_first([&] {
-          return s.summary->brief_report() + "; not used: " + s.summary->unusable_reason();
+          return s.summary->brief_report() +
+                 (s.used_unusable_answer ? "; used though " : "; not used: ") +
+                 s.summary->unusable_reason();
         });
       }
       if (s.measurement_missing) ++m.failures["missing_measurement"];

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "builtin_observer_types.hpp"
+#include "covariance_keys.hpp"
 #include "nlobs/observers/baselines/baselines.hpp"
 #include "nlobs/observers/baselines/finite_difference_observer.hpp"
 #include "nlobs/observers/baselines/unscented_kalman_filter.hpp"
@@ -68,36 +69,6 @@ void add_sliding_mode(ObserverTypeRegistry& registry) {
         s.initial_estimate = b.start;
         return std::make_unique<SlidingModeObserver<AnyModel>>(b.design, std::move(s));
       }}));
-}
-
-// The EKF's and the UKF's keys: the three covariances (Q, R, P0), then `extra`, then the
-// initial estimate and the design model.
-std::vector<KeyInfo> kalman_keys(std::vector<KeyInfo> extra) {
-  std::vector<KeyInfo> keys = {{"process_covariance", "Q (n x n)", "1e-6 I"},
-                               {"measurement_covariance", "R (p x p)", "1e-4 I"},
-                               {"initial_covariance", "P0 (n x n)", "I"}};
-  keys.insert(keys.end(), extra.begin(), extra.end());
-  keys.push_back(initial_key());
-  keys.push_back(design_model_key());
-  return keys;
-}
-
-// Q, R and P0 from a scenario entry (each optional) into EkfOptions or UkfOptions.
-template <typename Options>
-void read_covariances(JsonReader& o, Options& s) {
-  s.process_covariance = o.matrix("process_covariance").value_or(Eigen::MatrixXd());
-  s.measurement_covariance = o.matrix("measurement_covariance").value_or(Eigen::MatrixXd());
-  s.initial_covariance = o.matrix("initial_covariance").value_or(Eigen::MatrixXd());
-}
-
-// The covariances that were given, back to JSON.
-template <typename Options>
-void write_covariances(const Options& s, nlohmann::json& out) {
-  if (s.process_covariance.size()) out["process_covariance"] = matrix_json(s.process_covariance);
-  if (s.measurement_covariance.size()) {
-    out["measurement_covariance"] = matrix_json(s.measurement_covariance);
-  }
-  if (s.initial_covariance.size()) out["initial_covariance"] = matrix_json(s.initial_covariance);
 }
 
 void add_ekf(ObserverTypeRegistry& registry) {

@@ -9,7 +9,8 @@
 namespace nlobs::detail {
 
 void add_window_type(ObserverTypeRegistry& registry);
-void add_baseline_types(ObserverTypeRegistry& registry);  // luenberger, sliding_mode, ekf
+void add_baseline_types(ObserverTypeRegistry& registry);  // luenberger, sliding_mode, ekf, ukf
+void add_mhe_type(ObserverTypeRegistry& registry);
 void add_pi_bank_type(ObserverTypeRegistry& registry);
 void add_mvt_type(ObserverTypeRegistry& registry);
 void add_high_gain_type(ObserverTypeRegistry& registry);
@@ -20,6 +21,7 @@ void add_finite_difference_type(ObserverTypeRegistry& registry);
 inline void add_builtin_observer_types(ObserverTypeRegistry& registry) {
   add_window_type(registry);
   add_baseline_types(registry);
+  add_mhe_type(registry);
   add_pi_bank_type(registry);
   add_mvt_type(registry);
   add_high_gain_type(registry);

@@ -245,4 +245,26 @@ struct PendulumTimeVaryingFriction : ModelSizes<2, 0, 1> {
   }
 };
 
+// The gas-phase batch reactor of the moving-horizon estimation literature ([HR05]; [RM09],
+// Example 4.27), concentrations x = (c_A, c_B, c_C), y = RT (c_A + c_B + c_C), the total pressure:
+//   A ⇌ B + C (k1, k2),  2B ⇌ C (k3, k4),  r1 = k1 c_A − k2 c_B c_C,  r2 = k3 c_B² − k4 c_C,
+//   c_A' = −r1,  c_B' = r1 − 2 r2,  c_C' = r1 + r2.
+// Defined for every c (an estimator may try negative concentrations; the physics needs c ≥ 0).
+struct BatchReactorParameters {
+  double k1 = 0.5, k2 = 0.05, k3 = 0.2, k4 = 0.01, rt = 32.84;
+};
+struct BatchReactor : ModelSizes<3, 0, 1> {
+  BatchReactorParameters p{};
+  template <typename T>
+  State<T> vector_field(const State<T>& x, const Input&, double) const {
+    const T r1 = p.k1 * x[0] - p.k2 * x[1] * x[2];
+    const T r2 = p.k3 * x[1] * x[1] - p.k4 * x[2];
+    return State<T>(-r1, r1 - 2.0 * r2, r1 + r2);
+  }
+  template <typename T>
+  Output<T> h(const State<T>& x) const {
+    return Output<T>(p.rt * (x[0] + x[1] + x[2]));
+  }
+};
+
 }  // namespace nlobs

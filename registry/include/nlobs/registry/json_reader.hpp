@@ -41,6 +41,9 @@ class JsonReader {
   // An observer's name: a string, not empty (reports key their rows and files on it).
   std::optional<std::string> name(const std::string& key = "name");
   std::optional<Eigen::VectorXd> vector(const std::string& key);
+  // Bounds: an array of numbers where null is `unbounded` (−inf for lower, +inf for upper
+  // bounds: JSON has no infinity).
+  std::optional<Eigen::VectorXd> bounds(const std::string& key, double unbounded);
   // A matrix as an array of rows; a flat array is a column.
   std::optional<Eigen::MatrixXd> matrix(const std::string& key);
   std::optional<JsonReader> object(const std::string& key);

@@ -141,18 +141,11 @@ class ExtendedKalmanFilter final : public Observer {
     options.validate();
     info_.name = options.name;
     const Eigen::Index n = model_.states(), p = model_.outputs();
-    q_ = options.process_covariance.size()
-             ? options.process_covariance
-             : Eigen::MatrixXd(1e-6 * Eigen::MatrixXd::Identity(n, n));
-    r_ = options.measurement_covariance.size()
-             ? options.measurement_covariance
-             : Eigen::MatrixXd(1e-4 * Eigen::MatrixXd::Identity(p, p));
-    p0_ = options.initial_covariance.size() ? options.initial_covariance
-                                            : Eigen::MatrixXd(Eigen::MatrixXd::Identity(n, n));
+    const detail::Covariances c = detail::covariances_of("EkfOptions", options, n, p);
+    q_ = c.process;
+    r_ = c.measurement;
+    p0_ = c.initial;
     detail::require_size("EkfOptions", "initial_estimate", initial_, n);
-    detail::require_shape("EkfOptions", "process_covariance", q_, n, n);
-    detail::require_shape("EkfOptions", "measurement_covariance", r_, p, p);
-    detail::require_shape("EkfOptions", "initial_covariance", p0_, n, n);
     reset();
   }
   void reset() override {

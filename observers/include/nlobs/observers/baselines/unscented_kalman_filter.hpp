@@ -49,18 +49,11 @@ class UnscentedKalmanFilter final : public Observer {
       : model_(std::move(model)), options_(detail::validated(std::move(options))) {
     info_.name = options_.name;
     const Eigen::Index n = model_.states(), p = model_.outputs();
-    q_ = options_.process_covariance.size()
-             ? options_.process_covariance
-             : Eigen::MatrixXd(1e-6 * Eigen::MatrixXd::Identity(n, n));
-    r_ = options_.measurement_covariance.size()
-             ? options_.measurement_covariance
-             : Eigen::MatrixXd(1e-4 * Eigen::MatrixXd::Identity(p, p));
-    p0_ = options_.initial_covariance.size() ? options_.initial_covariance
-                                             : Eigen::MatrixXd(Eigen::MatrixXd::Identity(n, n));
+    const detail::Covariances c = detail::covariances_of("UkfOptions", options_, n, p);
+    q_ = c.process;
+    r_ = c.measurement;
+    p0_ = c.initial;
     detail::require_size("UkfOptions", "initial_estimate", options_.initial_estimate, n);
-    detail::require_shape("UkfOptions", "process_covariance", q_, n, n);
-    detail::require_shape("UkfOptions", "measurement_covariance", r_, p, p);
-    detail::require_shape("UkfOptions", "initial_covariance", p0_, n, n);
     const double dn = static_cast<double>(n);
     lambda_ = options_.alpha * options_.alpha * (dn + options_.kappa) - dn;
     if (!(dn + lambda_ > 0.0)) {

@@ -84,7 +84,11 @@ struct ObserverStep {
   bool ready = true;                 // false while a window fills (the estimate coasts on f)
   bool measurement_missing = false;  // y_k had a non-finite entry: skipped, estimate coasts
   std::optional<Summary> summary;    // the engine's summary when this step solved a window
-  Eigen::VectorXd signals;           // the values of ObserverInfo::signals at this step
+  // The observer took the answer although summary->usable() is false: a moving-horizon
+  // estimator's solve cut short (or its one real-time iteration) still lowered its cost from the
+  // warm start. Reports then say "used", not "not used".
+  bool used_unusable_answer = false;
+  Eigen::VectorXd signals;  // the values of ObserverInfo::signals at this step
   // Empty, or why this step kept the last good state ("non_finite", "non_uniform", …).
   std::string failure;
   std::string failure_message;  // what and where, for the report

@@ -39,4 +39,26 @@ void require_size(const char* who, const char* field, const Eigen::VectorXd& v, 
 void require_shape(const char* who, const char* field, const Eigen::MatrixXd& m, Eigen::Index rows,
                    Eigen::Index cols);
 
+// A covariance option: empty (a default is used), or square, finite, symmetric and positive
+// semi-definite (kSemiDefinite: the Kalman filters) or positive definite (kDefinite: the MHE
+// weights by its inverse). "… must be positive definite (got 2x2, not positive definite)".
+enum class Definiteness { kSemiDefinite, kDefinite };
+void require_covariance(const char* who, const char* field, const Eigen::MatrixXd& m,
+                        Definiteness definiteness);
+// The given covariance, or `default_scale` · I when empty; then its shape against the model.
+Eigen::MatrixXd covariance_or_default(const char* who, const char* field, const Eigen::MatrixXd& m,
+                                      Eigen::Index size, double default_scale);
+
+// Q, R and P0 of a Kalman-type observer's options (EkfOptions, UkfOptions, MheOptions), each the
+// given matrix or its default — 1e-6 I, 1e-4 I, I — checked against n states and p outputs.
+struct Covariances {
+  Eigen::MatrixXd process, measurement, initial;
+};
+template <typename Options>
+Covariances covariances_of(const char* who, const Options& o, Eigen::Index n, Eigen::Index p) {
+  return {covariance_or_default(who, "process_covariance", o.process_covariance, n, 1e-6),
+          covariance_or_default(who, "measurement_covariance", o.measurement_covariance, p, 1e-4),
+          covariance_or_default(who, "initial_covariance", o.initial_covariance, n, 1.0)};
+}
+
 }  // namespace nlobs::detail

@@ -36,6 +36,9 @@ struct Measurements {
 struct SimulationOptions {
   long steps = 400;
   double noise_std = 0.0;  // σ of additive Gaussian noise on every output
+  // σ_w of additive Gaussian noise on every state at every step, x⁺ = f(x, u, k) + w (the
+  // process noise of the MHE literature's examples); drawn after the sample's output noise.
+  double process_noise_std = 0.0;
   std::uint64_t seed = 1;
   // T of t_k = k·T. Unset: the model's sample_time() (AnyModel, when it is not 0 = unknown) or
   // step() (Discretized, SampledModel) where it has one, else 1 (samples that are indices).
@@ -69,6 +72,9 @@ Measurements simulate(const Model& model, const Eigen::VectorXd& x0, const Simul
   }
   if (!(o.noise_std >= 0.0) || !std::isfinite(o.noise_std)) {
     throw InvalidInput("simulate: noise_std must be finite and >= 0");
+  }
+  if (!(o.process_noise_std >= 0.0) || !std::isfinite(o.process_noise_std)) {
+    throw InvalidInput("simulate: process_noise_std must be finite and >= 0");
   }
   if (x0.size() != n || !x0.allFinite()) {
     std::ostringstream os;
@@ -119,6 +125,9 @@ Measurements simulate(const Model& model, const Eigen::VectorXd& x0, const Simul
     }
     data.y.col(k) = y;
     x = model.f(x, ModelVector<double, Model::kInputs>(u), k);
+    if (o.process_noise_std > 0.0) {
+      for (Eigen::Index i = 0; i < n; ++i) x[i] += o.process_noise_std * noise(rng);
+    }
   }
   return data;
 }

@@ -1,0 +1,445 @@
+#pragma once
+// Moving-horizon estimation ([RRM03]; [RM09], ch. 4) over any discrete model
+//   x_{i+1} = f(x_i, u_i, i) + w_i,   y_i = h(x_i) + v_i,   w ~ (0, Q), v ~ (0, R):
+// at sample k it minimises over the horizon's states z = (x_{k−N+1}, …, x_k)
+//   V(z) = ‖x_{k−N+1} − x̄‖²_{P⁻¹} + Σ_{i<k} ‖x_{i+1} − f(x_i, u_i, i)‖²_{Q⁻¹}
+//          + Σ_i ‖y_i − h(x_i)‖²_{R⁻¹}          subject to  l ≤ x_i ≤ u,
+// and reports x̂_k, the last state. Until k + 1 = N it solves the full-information problem on
+// the samples it has, with x̄ = x̄_0 and P = P_0 (MheOptions).
+//
+// The unknowns are the states, not x_{k−N+1} and the noises w_i: V is then a sum of terms each
+// in one state or two neighbours, so the Gauss–Newton matrix is block tridiagonal (solved in
+// O(N n³), block_tridiagonal.hpp) however unstable f is, and the bounds on the states — what the
+// literature's examples need (concentrations ≥ 0) — are a box. Bounds on w would be nonlinear
+// constraints in these unknowns: not offered.
+//
+// The arrival cost: when sample j = k − N leaves the horizon, x̄ and P become the EKF's
+// prediction from the filtered estimate x̂_{j|j} (the estimate this MHE reported at j), the
+// filtering update of [RRM03]:
+//   P⁺ = (P⁻¹ + Hᵀ R⁻¹ H)⁻¹,  x̄ ← f(x̂_{j|j}, u_j, j),  P ← F P⁺ Fᵀ + Q,
+// with H = ∂h/∂x, F = ∂f/∂x at x̂_{j|j} (forward-mode AD), R⁻¹ that of the outputs measured at j.
+// On a linear model this is the Kalman filter's prior, and the MHE's estimate is the Kalman
+// filter's at every step for any N (tested to 1e-9).
+//
+// The solver: Gauss–Newton on V with a projected backtracking line search (Armijo,
+// V(z_α) ≤ V(z) + 2σ ∇(V/2)ᵀ(z_α − z), σ = 1e-4, z_α = Π(z + α Δz), α halved up to 30 times);
+// with bounds, the projected Newton method of [Ber82]: states at a bound whose gradient points
+// out are held and the step solved for the others. Warm start: the previous solution shifted
+// by one sample, the new state predicted by f. real_time_iteration takes one iteration per
+// sample ([DBS05]). Each step's Summary: converged (‖Δz‖∞ ≤ step_tolerance (1 + ‖z‖∞), or the
+// full step's first-order decrease −2∇(V/2)ᵀΔz ≤ cost_tolerance · V), max_iterations, stagnated (no
+// decrease along the projected Newton nor the projected gradient path) or non_finite (V not finite
+// at the warm start: the step keeps the last estimate); residual_norm is the projected gradient
+// ‖∇(V/2)‖∞ at the last linearisation, objective V. The estimate is the lowest V found: a solve cut
+// short (and every real-time iteration) still lowered V from the warm start, so it is used
+// (ObserverStep::used_unusable_answer says so).
+//
+// A sample's outputs may be missing one by one (a non-finite entry): its term weighs the
+// measured outputs by the inverse of their own block of R; measurement_missing is set only
+// when all are missing. Hot path: with compile-time sizes nothing is allocated per step except
+// when a sample misses some of its outputs.
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "nlobs/models/model.hpp"
+#include "nlobs/observers/core/observer.hpp"
+#include "nlobs/observers/core/option_checks.hpp"
+#include "nlobs/observers/mhe/block_tridiagonal.hpp"
+#include "nlobs/observers/mhe/mhe_options.hpp"
+#include "nlobs/solvers/autodiff.hpp"
+#include "nlobs/solvers/summary.hpp"
+
+namespace nlobs {
+
+template <DiscreteModel Model>
+class MheEstimator final : public Observer {
+ public:
+  static constexpr int kStates = Model::kStates;
+  using State = ModelVector<double, Model::kStates>;
+  using Input = ModelVector<double, Model::kInputs>;
+  using Output = ModelVector<double, Model::kOutputs>;
+  using StateMatrix = Eigen::Matrix<double, Model::kStates, Model::kStates>;
+  using OutputMatrix = Eigen::Matrix<double, Model::kOutputs, Model::kOutputs>;
+  using OutputJacobian = Eigen::Matrix<double, Model::kOutputs, Model::kStates>;
+
+  MheEstimator(Model model, MheOptions options)
+      : model_(std::move(model)), options_(detail::validated(std::move(options))) {
+    const Eigen::Index n = model_.states(), p = model_.outputs();
+    detail::require_size("MheOptions", "initial_estimate", options_.initial_estimate, n);
+    if (options_.lower_bounds.size()) {
+      detail::require_size("MheOptions", "lower_bounds", options_.lower_bounds, n);
+    }
+    if (options_.upper_bounds.size()) {
+      detail::require_size("MheOptions", "upper_bounds", options_.upper_bounds, n);
+    }
+    const detail::Covariances c = detail::covariances_of("MheOptions", options_, n, p);
+    p0_ = c.initial;
+    q_ = c.process;
+    r_ = c.measurement;
+    q_inv_ = inverse(q_);
+    r_inv_ = inverse(r_);
+    p0_inv_ = inverse(p0_);
+    const double inf = std::numeric_limits<double>::infinity();
+    lower_ = options_.lower_bounds.size() ? State(options_.lower_bounds) : State::Constant(n, -inf);
+    upper_ = options_.upper_bounds.size() ? State(options_.upper_bounds) : State::Constant(n, inf);
+    iterations_ = options_.real_time_iteration ? 1 : static_cast<int>(options_.max_iterations);
+
+    const auto h = static_cast<std::size_t>(options_.horizon);
+    nodes_.reserve(h);
+    diag_.assign(h, StateMatrix::Zero(n, n));
+    sub_.assign(h, StateMatrix::Zero(n, n));
+    grad_.assign(h, State::Zero(n));
+    direction_.assign(h, State::Zero(n));
+    trial_.assign(h, State::Zero(n));
+    f_jac_.assign(h, StateMatrix::Zero(n, n));
+    h_jac_.assign(h, OutputJacobian::Zero(p, n));
+    w_res_.assign(h, State::Zero(n));
+    y_res_.assign(h, Output::Zero(p));
+    solver_.reserve(options_.horizon, n);
+
+    info_.name = options_.name;
+    info_.engine = kEngine;
+    info_.signals = {{"cost", SignalKind::kDiagnostic}};
+    step_.signals = Eigen::VectorXd::Zero(1);
+    reset();
+  }
+
+  void reset() override {
+    nodes_.clear();
+    prior_ = options_.initial_estimate;
+    prior_cov_ = p0_;
+    prior_inv_ = p0_inv_;
+    estimate_ = prior_;
+  }
+
+  const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
+                           const Eigen::VectorXd& u) override {
+    check_sizes(k, y, u);
+    step_.failure.clear();
+    step_.failure_message.clear();
+    step_.measurement_missing = !y.array().isFinite().any();
+    // The new state's first guess: f of the last one (before the oldest sample may leave).
+    State guess = nodes_.empty() ? prior_ : predict(nodes_.back());
+    if (!guess.allFinite()) guess = nodes_.empty() ? prior_ : nodes_.back().x;
+    if (nodes_.size() == static_cast<std::size_t>(options_.horizon)) {
+      drop_oldest(k);
+      std::rotate(nodes_.begin(), nodes_.begin() + 1, nodes_.end());
+    } else {
+      nodes_.emplace_back();
+    }
+    Node& node = nodes_.back();
+    node.k = k;
+    node.t = t;
+    node.u = Input(u);
+    set_measurement(node, y);
+    node.x = guess.cwiseMax(lower_).cwiseMin(upper_);
+    solve(k);
+    node.filtered = estimate_;
+    step_.estimate = estimate_;
+    return step_;
+  }
+
+  // The arrival cost's x̄ and P (the prior on the horizon's first state).
+  const State& arrival_mean() const { return prior_; }
+  const StateMatrix& arrival_covariance() const { return prior_cov_; }
+  // The horizon's estimates x̂_{k−M+1|k}, …, x̂_{k|k} (M ≤ N samples so far), oldest first, one
+  // per column.
+  Eigen::MatrixXd horizon_estimates() const {
+    Eigen::MatrixXd out(model_.states(), static_cast<Eigen::Index>(nodes_.size()));
+    for (std::size_t i = 0; i < nodes_.size(); ++i)
+      out.col(static_cast<Eigen::Index>(i)) = nodes_[i].x;
+    return out;
+  }
+
+ private:
+  static constexpr const char* kEngine = "gauss-newton";
+  static constexpr double kSufficientDecrease = 1e-4;
+  static constexpr int kMaxBacktracks = 30;
+
+  struct Node {
+    long k = 0;
+    double t = 0.0;
+    Output y;            // the measured outputs; 0 where missing
+    OutputMatrix r_inv;  // R⁻¹ of the outputs measured; zero rows and columns where missing
+    Input u;
+    State x;         // the horizon's current estimate of this sample's state
+    State filtered;  // x̂_{i|i}: the estimate reported when this sample was the last
+  };
+
+  // M⁻¹ of a symmetric positive definite M (validated options, or P = F P⁺ Fᵀ + Q).
+  template <typename Matrix>
+  static Matrix inverse(const Matrix& m) {
+    Matrix out = Matrix::Identity(m.rows(), m.cols());
+    m.llt().solveInPlace(out);
+    return out;
+  }
+
+  void check_sizes(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) const {
+    if (y.size() == model_.outputs() && u.size() == model_.inputs()) return;
+    std::ostringstream os;
+    os << name() << ": the sample k = " << k << " has " << y.size() << " outputs and " << u.size()
+       << " inputs; the model has " << model_.outputs() << " and " << model_.inputs();
+    throw InvalidInput(os.str());
+  }
+
+  void set_measurement(Node& node, const Eigen::VectorXd& y) const {
+    const Eigen::Index p = model_.outputs();
+    const auto present = y.array().isFinite();
+    node.y = Output(present.select(y.array(), 0.0).matrix());
+    if (present.all()) {
+      node.r_inv = r_inv_;
+      return;
+    }
+    node.r_inv = OutputMatrix::Zero(p, p);
+    std::vector<Eigen::Index> rows;
+    for (Eigen::Index i = 0; i < p; ++i) {
+      if (present[i]) rows.push_back(i);
+    }
+    if (rows.empty()) return;
+    const Eigen::MatrixXd r_measured = r_(rows, rows);
+    const Eigen::MatrixXd inv = inverse(r_measured);
+    node.r_inv(rows, rows) = inv;
+  }
+
+  State predict(const Node& node) const { return State(model_.f(node.x, node.u, node.k)); }
+
+  void jacobians(const Node& node, bool with_f, StateMatrix& fj, OutputJacobian& hj) const {
+    const Input& u = node.u;
+    const long k = node.k;
+    if (with_f) {
+      auto f = [this, &u, k](const auto& v) {
+        using T = typename std::decay_t<decltype(v)>::Scalar;
+        return ModelVector<T, kStates>(model_.f(ModelVector<T, kStates>(v), u, k));
+      };
+      autodiff_jacobian<kStates, kStates>(f, node.x, fj);
+    }
+    auto h = [this](const auto& v) {
+      using T = typename std::decay_t<decltype(v)>::Scalar;
+      return ModelVector<T, Model::kOutputs>(model_.h(ModelVector<T, kStates>(v)));
+    };
+    autodiff_jacobian<kStates, Model::kOutputs>(h, node.x, hj);
+  }
+
+  // The filtering update of the arrival cost along the sample that leaves the horizon.
+  void drop_oldest(long k) {
+    const Node& old = nodes_.front();
+    const Eigen::Index n = model_.states();
+    StateMatrix fj(n, n);
+    OutputJacobian hj(model_.outputs(), n);
+    Node at = old;
+    at.x = old.filtered;
+    jacobians(at, true, fj, hj);
+    const StateMatrix information = prior_inv_ + hj.transpose() * old.r_inv * hj;
+    const StateMatrix updated = inverse(information);
+    StateMatrix covariance = fj * updated * fj.transpose() + q_;
+    covariance = 0.5 * (covariance + covariance.transpose());
+    const State mean = predict(at);
+    const Eigen::LLT<StateMatrix> llt(covariance);
+    if (!mean.allFinite() || !covariance.allFinite() || llt.info() != Eigen::Success) {
+      std::ostringstream os;
+      os << name() << ": the arrival cost's update along sample k = " << old.k << " (at k = " << k
+         << ") is not finite or not positive definite; x̄ and P kept";
+      mark_non_finite_estimate(step_, os.str());
+      return;
+    }
+    prior_ = mean;
+    prior_cov_ = covariance;
+    prior_inv_ = llt.solve(StateMatrix::Identity(n, n));
+  }
+
+  bool inside_domain(const State& x) const { return domain_violation_of(model_, x).empty(); }
+
+  // V at the states xs[0..M−1] (+inf when a term is not finite or a state leaves the model's
+  // domain).
+  double cost(const std::vector<State>& xs) const {
+    const std::size_t m = nodes_.size();
+    const State e0 = xs[0] - prior_;
+    double v = e0.dot(prior_inv_ * e0);
+    for (std::size_t i = 0; i < m; ++i) {
+      if (!inside_domain(xs[i])) return std::numeric_limits<double>::infinity();
+      const Output e = nodes_[i].y - Output(model_.h(xs[i]));
+      v += e.dot(nodes_[i].r_inv * e);
+      if (i + 1 < m) {
+        const State w = xs[i + 1] - State(model_.f(xs[i], nodes_[i].u, nodes_[i].k));
+        v += w.dot(q_inv_ * w);
+      }
+    }
+    return std::isfinite(v) ? v : std::numeric_limits<double>::infinity();
+  }
+
+  // The Gauss–Newton system at the current states: diag_, sub_ (H) and grad_ (∇(V/2)).
+  void linearise() {
+    const std::size_t m = nodes_.size();
+    for (std::size_t i = 0; i < m; ++i) {
+      const Node& node = nodes_[i];
+      jacobians(node, i + 1 < m, f_jac_[i], h_jac_[i]);
+      y_res_[i] = node.y - Output(model_.h(node.x));
+      const Output ry = node.r_inv * y_res_[i];
+      diag_[i].noalias() = h_jac_[i].transpose() * (node.r_inv * h_jac_[i]);
+      grad_[i].noalias() = -h_jac_[i].transpose() * ry;
+    }
+    diag_[0] += prior_inv_;
+    grad_[0].noalias() += prior_inv_ * (nodes_[0].x - prior_);
+    for (std::size_t i = 0; i + 1 < m; ++i) {
+      w_res_[i] = nodes_[i + 1].x - predict(nodes_[i]);
+      const State qw = q_inv_ * w_res_[i];
+      sub_[i].noalias() = -q_inv_ * f_jac_[i];
+      diag_[i].noalias() -= f_jac_[i].transpose() * sub_[i];
+      diag_[i + 1] += q_inv_;
+      grad_[i].noalias() -= f_jac_[i].transpose() * qw;
+      grad_[i + 1] += qw;
+    }
+  }
+
+  // Holds the states at a bound whose gradient points out of the box ([Ber82]): their rows and
+  // columns of H become the identity's, their gradient 0, so that the step leaves them. Returns
+  // the projected gradient's ‖·‖∞.
+  double hold_active_bounds() {
+    const std::size_t m = nodes_.size();
+    double projected = 0.0;
+    for (std::size_t i = 0; i < m; ++i) {
+      for (Eigen::Index c = 0; c < model_.states(); ++c) {
+        const double x = nodes_[i].x[c], g = grad_[i][c];
+        if ((x <= lower_[c] && g > 0.0) || (x >= upper_[c] && g < 0.0)) {
+          diag_[i].row(c).setZero();
+          diag_[i].col(c).setZero();
+          diag_[i](c, c) = 1.0;
+          grad_[i][c] = 0.0;
+          if (i + 1 < m) sub_[i].col(c).setZero();
+          if (i > 0) sub_[i - 1].row(c).setZero();
+        } else {
+          projected = std::max(projected, std::abs(g));
+        }
+      }
+    }
+    return projected;
+  }
+
+  // trial_ = Π(x + α d); returns ∇(V/2)ᵀ(trial − x) and the step's ‖·‖∞.
+  std::pair<double, double> project_step(double alpha) {
+    double slope = 0.0, step = 0.0;
+    for (std::size_t i = 0; i < nodes_.size(); ++i) {
+      trial_[i] = (nodes_[i].x + alpha * direction_[i]).cwiseMax(lower_).cwiseMin(upper_);
+      const State s = trial_[i] - nodes_[i].x;
+      slope += grad_[i].dot(s);
+      step = std::max(step, s.cwiseAbs().maxCoeff());
+    }
+    return {slope, step};
+  }
+
+  // Backtracks along Π(x + α d) from α = 1; true (trial_ holding the point, `value` its V) when
+  // a point decreases V enough.
+  bool line_search(double& value, double& step) {
+    double alpha = 1.0;
+    for (int b = 0; b <= kMaxBacktracks; ++b, alpha *= 0.5) {
+      const auto [slope, s] = project_step(alpha);
+      if (!(slope < 0.0)) return false;
+      const double trial_value = cost(trial_);
+      ++evaluations_;
+      if (trial_value <= value + 2.0 * kSufficientDecrease * slope) {
+        value = trial_value;
+        step = s;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  double states_norm() const {
+    double norm = 0.0;
+    for (const Node& node : nodes_) norm = std::max(norm, node.x.cwiseAbs().maxCoeff());
+    return norm;
+  }
+
+  void solve(long k) {
+    const std::size_t m = nodes_.size();
+    Summary summary;
+    summary.engine = kEngine;
+    evaluations_ = 0;
+    for (std::size_t i = 0; i < m; ++i) trial_[i] = nodes_[i].x;
+    double value = cost(trial_);
+    ++evaluations_;
+    summary.status = Status::kMaxIterations;
+    if (!std::isfinite(value)) {
+      summary.status = Status::kNonFinite;
+      std::ostringstream os;
+      os << name() << ": the cost V at sample k = " << k << " is not finite at the warm start "
+         << "(the model overflows or leaves its domain); kept the last estimate";
+      mark_non_finite_estimate(step_, os.str());
+      summary.message = step_.failure_message;
+    }
+    int iteration = 0;
+    while (summary.status == Status::kMaxIterations && iteration < iterations_) {
+      linearise();
+      ++iteration;
+      summary.residual_norm = hold_active_bounds();
+      for (std::size_t i = 0; i < m; ++i) direction_[i] = -grad_[i];
+      if (!solver_.factor(diag_, sub_, m)) {  // only by rounding: P, Q are definite
+        summary.status = Status::kSingularJacobian;
+        summary.message = "the Gauss-Newton matrix is not positive definite";
+        break;
+      }
+      solver_.solve(direction_, m);
+      const double tolerance = options_.step_tolerance * (1.0 + states_norm());
+      const auto [slope, full_step] = project_step(1.0);
+      if (full_step <= tolerance || -2.0 * slope <= options_.cost_tolerance * value) {
+        summary.status = Status::kConverged;
+        summary.step_norm = full_step;
+        break;
+      }
+      double step = 0.0;
+      bool moved = line_search(value, step);
+      if (!moved) {  // the projected Newton path failed: the projected gradient, scaled by H's
+                     // diagonal
+        for (std::size_t i = 0; i < m; ++i) {
+          direction_[i] = -grad_[i].cwiseQuotient(diag_[i].diagonal());
+        }
+        moved = line_search(value, step);
+      }
+      if (!moved) {
+        summary.status = Status::kStagnated;
+        summary.message = "no decrease of the cost along the projected Newton or gradient path";
+        break;
+      }
+      for (std::size_t i = 0; i < m; ++i) nodes_[i].x = trial_[i];
+      summary.step_norm = step;
+      if (step <= tolerance) summary.status = Status::kConverged;
+    }
+    summary.iterations = iteration;
+    summary.jacobian_evaluations = iteration;
+    summary.function_evaluations = evaluations_;
+    summary.objective = value;
+    if (summary.status != Status::kNonFinite) estimate_ = nodes_.back().x;
+    summary.record_answer(estimate_, StopCriteria{}, true);
+    step_.used_unusable_answer = summary.status != Status::kNonFinite && !summary.usable();
+    step_.signals[0] = value;
+    step_.summary = std::move(summary);
+  }
+
+  Model model_;
+  MheOptions options_;
+  StateMatrix p0_, p0_inv_, q_, q_inv_;
+  OutputMatrix r_, r_inv_;
+  State lower_, upper_;
+  int iterations_ = 1;
+  // The arrival cost: x̄, P and P⁻¹.
+  State prior_;
+  StateMatrix prior_cov_, prior_inv_;
+  State estimate_;
+  std::vector<Node> nodes_;  // the horizon's samples, oldest first
+  // Gauss–Newton workspace, one entry per sample of the horizon.
+  std::vector<StateMatrix> diag_, sub_, f_jac_;
+  std::vector<OutputJacobian> h_jac_;
+  std::vector<State> grad_, direction_, trial_, w_res_;
+  std::vector<Output> y_res_;
+  detail::BlockTridiagonalCholesky<Model::kStates> solver_;
+  int evaluations_ = 0;
+  ObserverStep step_;
+};
+
+}  // namespace nlobs
