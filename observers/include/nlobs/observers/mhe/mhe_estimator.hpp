@@ -387,7 +387,10 @@ class MheEstimator final : public Observer {
       solver_.solve(direction_, m);
       const double tolerance = options_.step_tolerance * (1.0 + states_norm());
       const auto [slope, full_step] = project_step(1.0);
-      if (full_step <= tolerance || -2.0 * slope <= options_.cost_tolerance * value) {
+      // A projected step that does not descend (slope ≥ 0) is not a converged one: the line
+      // search below refuses it and the projected gradient is tried.
+      if (full_step <= tolerance ||
+          (slope < 0.0 && -2.0 * slope <= options_.cost_tolerance * value)) {
         summary.status = Status::kConverged;
         summary.step_norm = full_step;
         break;
