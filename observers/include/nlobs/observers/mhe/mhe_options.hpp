@@ -23,7 +23,7 @@ struct MheOptions {
   long max_iterations = 100;
   // One Gauss–Newton iteration per sample, warm-started by shifting ([DBS05]'s real-time
   // iteration): max_iterations is then 1 and a step is reported converged only if it met
-  // step_tolerance.
+  // step_tolerance or cost_tolerance (otherwise max_iterations, and used all the same).
   bool real_time_iteration = false;
   // Converged when the step is small: ‖Δz‖∞ ≤ step_tolerance · (1 + ‖z‖∞), z the window's
   // states; > 0.
