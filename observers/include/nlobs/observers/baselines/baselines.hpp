@@ -11,9 +11,9 @@
 #include <string>
 
 #include "nlobs/models/model.hpp"
+#include "nlobs/observers/core/discrete_jacobians.hpp"
 #include "nlobs/observers/core/observer.hpp"
 #include "nlobs/observers/core/option_checks.hpp"
-#include "nlobs/solvers/autodiff.hpp"
 #include "nlobs/solvers/status.hpp"
 
 namespace nlobs {
@@ -196,24 +196,14 @@ class ExtendedKalmanFilter final : public Observer {
  private:
   void jacobian_f(const Eigen::VectorXd& x, const Eigen::VectorXd& u, long k,
                   Eigen::MatrixXd& j) const {
-    const ModelVector<double, Model::kInputs> uu(u);
-    auto f = [this, &uu, k](const auto& v) {
-      using T = typename std::decay_t<decltype(v)>::Scalar;
-      return ModelVector<T, Model::kStates>(model_.f(ModelVector<T, Model::kStates>(v), uu, k));
-    };
-    Matrix<Model::kStates, Model::kStates> jac(x.size(), x.size());
-    autodiff_jacobian<Model::kStates, Model::kStates>(f, ModelVector<double, Model::kStates>(x),
-                                                      jac);
+    Matrix<Model::kStates, Model::kStates> jac;
+    state_jacobian(model_, ModelVector<double, Model::kStates>(x),
+                   ModelVector<double, Model::kInputs>(u), k, jac);
     j = jac;
   }
   void jacobian_h(const Eigen::VectorXd& x, Eigen::MatrixXd& j) const {
-    auto h = [this](const auto& v) {
-      using T = typename std::decay_t<decltype(v)>::Scalar;
-      return ModelVector<T, Model::kOutputs>(model_.h(ModelVector<T, Model::kStates>(v)));
-    };
-    Matrix<Model::kOutputs, Model::kStates> jac(model_.outputs(), x.size());
-    autodiff_jacobian<Model::kStates, Model::kOutputs>(h, ModelVector<double, Model::kStates>(x),
-                                                       jac);
+    Matrix<Model::kOutputs, Model::kStates> jac;
+    output_jacobian(model_, ModelVector<double, Model::kStates>(x), jac);
     j = jac;
   }
 

@@ -47,11 +47,11 @@
 #include <vector>
 
 #include "nlobs/models/model.hpp"
+#include "nlobs/observers/core/discrete_jacobians.hpp"
 #include "nlobs/observers/core/observer.hpp"
 #include "nlobs/observers/core/option_checks.hpp"
 #include "nlobs/observers/mhe/block_tridiagonal.hpp"
 #include "nlobs/observers/mhe/mhe_options.hpp"
-#include "nlobs/solvers/autodiff.hpp"
 #include "nlobs/solvers/summary.hpp"
 
 namespace nlobs {
@@ -208,37 +208,19 @@ class MheEstimator final : public Observer {
 
   State predict(const Node& node) const { return State(model_.f(node.x, node.u, node.k)); }
 
-  void jacobians(const Node& node, bool with_f, StateMatrix& fj, OutputJacobian& hj) const {
-    const Input& u = node.u;
-    const long k = node.k;
-    if (with_f) {
-      auto f = [this, &u, k](const auto& v) {
-        using T = typename std::decay_t<decltype(v)>::Scalar;
-        return ModelVector<T, kStates>(model_.f(ModelVector<T, kStates>(v), u, k));
-      };
-      autodiff_jacobian<kStates, kStates>(f, node.x, fj);
-    }
-    auto h = [this](const auto& v) {
-      using T = typename std::decay_t<decltype(v)>::Scalar;
-      return ModelVector<T, Model::kOutputs>(model_.h(ModelVector<T, kStates>(v)));
-    };
-    autodiff_jacobian<kStates, Model::kOutputs>(h, node.x, hj);
-  }
-
   // The filtering update of the arrival cost along the sample that leaves the horizon.
   void drop_oldest(long k) {
     const Node& old = nodes_.front();
     const Eigen::Index n = model_.states();
     StateMatrix fj(n, n);
     OutputJacobian hj(model_.outputs(), n);
-    Node at = old;
-    at.x = old.filtered;
-    jacobians(at, true, fj, hj);
+    state_jacobian(model_, old.filtered, old.u, old.k, fj);
+    output_jacobian(model_, old.filtered, hj);
     const StateMatrix information = prior_inv_ + hj.transpose() * old.r_inv * hj;
     const StateMatrix updated = inverse(information);
     StateMatrix covariance = fj * updated * fj.transpose() + q_;
     covariance = 0.5 * (covariance + covariance.transpose());
-    const State mean = predict(at);
+    const State mean = model_.f(old.filtered, old.u, old.k);
     const Eigen::LLT<StateMatrix> llt(covariance);
     if (!mean.allFinite() || !covariance.allFinite() || llt.info() != Eigen::Success) {
       std::ostringstream os;
@@ -277,7 +259,8 @@ class MheEstimator final : public Observer {
     const std::size_t m = nodes_.size();
     for (std::size_t i = 0; i < m; ++i) {
       const Node& node = nodes_[i];
-      jacobians(node, i + 1 < m, f_jac_[i], h_jac_[i]);
+      if (i + 1 < m) state_jacobian(model_, node.x, node.u, node.k, f_jac_[i]);
+      output_jacobian(model_, node.x, h_jac_[i]);
       y_res_[i] = node.y - Output(model_.h(node.x));
       const Output ry = node.r_inv * y_res_[i];
       diag_[i].noalias() = h_jac_[i].transpose() * (node.r_inv * h_jac_[i]);
