@@ -334,6 +334,31 @@ TEST(Mhe, AModelThatOverflowsIsNamedAndTheEstimateStaysFinite) {
   EXPECT_TRUE(named);
 }
 
+// Hostile samples on a model nlobs does not ship: an output of 1e300 (V overflows) and a NaN
+// input (f is NaN). The step says non_finite_estimate, the estimate stays the last finite one,
+// and once both samples have left the horizon (N = 5) the ordinary samples are solved again.
+TEST(Mhe, HugeOutputsAndNanInputsAreNamedNotPropagated) {
+  MheEstimator<Linear3> mhe(Linear3{}, linear_options(5));
+  const Eigen::VectorXd u = Eigen::VectorXd::Zero(1);
+  for (long k = 0; k < 8; ++k) mhe.step(k, 0.0, Eigen::Vector2d(0.3, 0.1), u);
+  const Eigen::VectorXd before = mhe.step(8, 0.0, Eigen::Vector2d(0.3, 0.1), u).estimate;
+  const ObserverStep& huge = mhe.step(9, 0.0, Eigen::Vector2d(1e300, 0.1), u);
+  EXPECT_EQ(huge.failure, "non_finite_estimate") << huge.failure_message;
+  EXPECT_TRUE(huge.estimate.allFinite());
+  EXPECT_EQ(huge.estimate, before);
+  const ObserverStep& nan_input =
+      mhe.step(10, 0.0, Eigen::Vector2d(0.3, 0.1), Eigen::VectorXd::Constant(1, kNaN));
+  EXPECT_TRUE(nan_input.estimate.allFinite());
+  for (long k = 11; k < 40; ++k) {
+    const ObserverStep& s = mhe.step(k, 0.0, Eigen::Vector2d(0.3, 0.1), u);
+    EXPECT_TRUE(s.estimate.allFinite()) << "k = " << k;
+    if (k >= 16) {
+      EXPECT_TRUE(s.failure.empty()) << "k = " << k << ": " << s.failure_message;
+      EXPECT_TRUE(s.summary->converged()) << "k = " << k;
+    }
+  }
+}
+
 TEST(Mhe, BadOptionsAreNamed) {
   const auto message = [](MheOptions o) {
     try {
