@@ -173,13 +173,13 @@ TEST(Allocations, WindowEstimatorStepAllocatesNothing) {
       Eigen::VectorXd y(1);
       for (long k = 0; k < 10; ++k) {  // the first windows: Ψ chosen, workspaces sized
         y = data.y.col(k);
-        estimator.step(k, static_cast<double>(k), y, no_input);
+        estimator.step(k, data.t[k], y, no_input);
       }
       long solves = 0;
       const long before = g_allocations.load();
       for (long k = 10; k < data.steps(); ++k) {
         y = data.y.col(k);
-        solves += estimator.step(k, static_cast<double>(k), y, no_input).summary.has_value();
+        solves += estimator.step(k, data.t[k], y, no_input).summary.has_value();
       }
       EXPECT_EQ(g_allocations.load() - before, 0) << engine << " psi " << to_string(gain);
       EXPECT_EQ(solves, data.steps() - 10);

@@ -13,6 +13,7 @@
 #include <random>
 #include <string>
 
+#include "linear_gaussian.hpp"
 #include "nlobs/models/discretization.hpp"
 #include "nlobs/models/modified_chua.hpp"
 #include "nlobs/models/systems.hpp"
@@ -28,20 +29,7 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// x⁺ = A x + B u, y = C x: a model nlobs does not ship, with two outputs.
-struct Linear3 : ModelSizes<3, 1, 2> {
-  Eigen::Matrix3d a{{0.95, 0.1, 0.0}, {-0.1, 0.9, 0.05}, {0.0, 0.02, 0.99}};
-  Eigen::Vector3d b{0.0, 1.0, 0.5};
-  Eigen::Matrix<double, 2, 3> c{{1.0, 0.0, 1.0}, {0.0, 1.0, 0.0}};
-  template <typename T>
-  State<T> f(const State<T>& x, const Input& u, long) const {
-    return a.cast<T>() * x + (b * u[0]).cast<T>();
-  }
-  template <typename T>
-  Output<T> h(const State<T>& x) const {
-    return c.cast<T>() * x;
-  }
-};
+using test::Linear3;
 
 // A constant x ≥ 0 measured with noise: x⁺ = x, y = x.
 struct Constant1 : ModelSizes<1, 0, 1> {
@@ -57,10 +45,10 @@ struct Constant1 : ModelSizes<1, 0, 1> {
 
 using Exploding = test::Squaring;  // x⁺ = 1e200 x²: overflows at once
 
-const Eigen::Matrix3d kQ = 1e-3 * Eigen::Matrix3d::Identity();
-const Eigen::Matrix2d kR{{1e-2, 2e-3}, {2e-3, 5e-3}};
-const Eigen::Matrix3d kP0{{1.0, 0.1, 0.0}, {0.1, 2.0, 0.0}, {0.0, 0.0, 0.5}};
-const Eigen::Vector3d kPrior(0.5, -0.2, 0.1);
+const Eigen::Matrix3d kQ = test::kLinearQ;
+const Eigen::Matrix2d kR = test::kLinearR;
+const Eigen::Matrix3d kP0 = test::kLinearP0;
+const Eigen::Vector3d kPrior = test::kLinearPrior;
 
 MheOptions linear_options(long horizon) {
   MheOptions o;
@@ -72,32 +60,7 @@ MheOptions linear_options(long horizon) {
   return o;
 }
 
-// The Kalman filter, update with the measured outputs of y then predict, written out here as a
-// reference independent of the library's EKF.
-struct KalmanReference {
-  Linear3 model;
-  Eigen::Vector3d x = kPrior;
-  Eigen::Matrix3d p = kP0;
-  Eigen::Vector3d step(const Eigen::Vector2d& y, double u) {
-    std::vector<Eigen::Index> rows;
-    for (Eigen::Index i = 0; i < 2; ++i) {
-      if (std::isfinite(y[i])) rows.push_back(i);
-    }
-    if (!rows.empty()) {
-      const Eigen::MatrixXd c = model.c(rows, Eigen::all);
-      const Eigen::MatrixXd r = kR(rows, rows);
-      const Eigen::VectorXd ym = y(rows);
-      const Eigen::MatrixXd s = c * p * c.transpose() + r;
-      const Eigen::MatrixXd k = p * c.transpose() * s.inverse();
-      x += k * (ym - c * x);
-      p = (Eigen::Matrix3d::Identity() - k * c) * p;
-    }
-    const Eigen::Vector3d filtered = x;
-    x = model.a * x + model.b * u;
-    p = model.a * p * model.a.transpose() + kQ;
-    return filtered;
-  }
-};
+using test::KalmanReference;
 
 // A noisy run of Linear3; `missing(k)` blanks outputs of sample k.
 template <typename Missing>
@@ -148,8 +111,9 @@ TEST(Mhe, ItIsTheLibrarysEkfOnALinearModelToo) {
     const Eigen::VectorXd u = Eigen::VectorXd::Constant(1, 0.3);
     const Eigen::VectorXd y = Eigen::Vector2d(std::cos(0.2 * static_cast<double>(k)),
                                               0.1 * static_cast<double>(k));  // any data
-    const Eigen::VectorXd e = ekf.step(k, 0.0, y, u).estimate;
-    worst = std::max(worst, (mhe.step(k, 0.0, y, u).estimate - e).norm() / std::max(1.0, e.norm()));
+    const Eigen::VectorXd e = ekf.step(k, static_cast<double>(k), y, u).estimate;
+    worst = std::max(worst, (mhe.step(k, static_cast<double>(k), y, u).estimate - e).norm() /
+                                std::max(1.0, e.norm()));
   }
   EXPECT_LT(worst, 1e-9);
 }
@@ -187,9 +151,9 @@ TEST(Mhe, BoundsHoldAtEveryStateWhereTheUnboundedEstimateLeavesThem) {
   int converged = 0;
   for (long k = 0; k < 300; ++k) {
     const Eigen::VectorXd y = Eigen::VectorXd::Constant(1, 0.02 + noise(rng));
-    const double unbounded = free.step(k, 0.0, y, {}).estimate[0];
+    const double unbounded = free.step(k, static_cast<double>(k), y, {}).estimate[0];
     free_lowest = std::min(free_lowest, unbounded);
-    const ObserverStep& s = bounded.step(k, 0.0, y, {});
+    const ObserverStep& s = bounded.step(k, static_cast<double>(k), y, {});
     ASSERT_GE(bounded.horizon_estimates().minCoeff(), 0.0) << "k = " << k;
     converged += s.summary->converged();
     if (k >= 100) {
@@ -219,7 +183,8 @@ TEST(Mhe, TracksTheModifiedChuaFromAWrongStart) {
     double last = 0.0;
     int converged = 0;
     for (long k = 0; k < 3000; ++k) {
-      const ObserverStep& s = mhe.step(k, 0.0, Eigen::VectorXd(model.h(x)), u);
+      const ObserverStep& s =
+          mhe.step(k, static_cast<double>(k) * model.step(), Eigen::VectorXd(model.h(x)), u);
       ASSERT_TRUE(s.estimate.allFinite()) << "k = " << k;
       converged += s.summary->converged();
       last = (s.estimate - x).norm();
@@ -327,7 +292,8 @@ TEST(Mhe, AModelThatOverflowsIsNamedAndTheEstimateStaysFinite) {
   MheEstimator<Exploding> mhe(Exploding{}, o);
   bool named = false;
   for (long k = 0; k < 6; ++k) {
-    const ObserverStep& s = mhe.step(k, 0.0, Eigen::VectorXd::Constant(1, 3.0), {});
+    const ObserverStep& s =
+        mhe.step(k, static_cast<double>(k), Eigen::VectorXd::Constant(1, 3.0), {});
     EXPECT_TRUE(s.estimate.allFinite()) << "k = " << k;
     named = named || s.failure == "non_finite_estimate";
   }
@@ -340,17 +306,17 @@ TEST(Mhe, AModelThatOverflowsIsNamedAndTheEstimateStaysFinite) {
 TEST(Mhe, HugeOutputsAndNanInputsAreNamedNotPropagated) {
   MheEstimator<Linear3> mhe(Linear3{}, linear_options(5));
   const Eigen::VectorXd u = Eigen::VectorXd::Zero(1);
-  for (long k = 0; k < 8; ++k) mhe.step(k, 0.0, Eigen::Vector2d(0.3, 0.1), u);
-  const Eigen::VectorXd before = mhe.step(8, 0.0, Eigen::Vector2d(0.3, 0.1), u).estimate;
-  const ObserverStep& huge = mhe.step(9, 0.0, Eigen::Vector2d(1e300, 0.1), u);
+  for (long k = 0; k < 8; ++k) mhe.step(k, static_cast<double>(k), Eigen::Vector2d(0.3, 0.1), u);
+  const Eigen::VectorXd before = mhe.step(8, 8.0, Eigen::Vector2d(0.3, 0.1), u).estimate;
+  const ObserverStep& huge = mhe.step(9, 9.0, Eigen::Vector2d(1e300, 0.1), u);
   EXPECT_EQ(huge.failure, "non_finite_estimate") << huge.failure_message;
   EXPECT_TRUE(huge.estimate.allFinite());
   EXPECT_EQ(huge.estimate, before);
   const ObserverStep& nan_input =
-      mhe.step(10, 0.0, Eigen::Vector2d(0.3, 0.1), Eigen::VectorXd::Constant(1, kNaN));
+      mhe.step(10, 10.0, Eigen::Vector2d(0.3, 0.1), Eigen::VectorXd::Constant(1, kNaN));
   EXPECT_TRUE(nan_input.estimate.allFinite());
   for (long k = 11; k < 40; ++k) {
-    const ObserverStep& s = mhe.step(k, 0.0, Eigen::Vector2d(0.3, 0.1), u);
+    const ObserverStep& s = mhe.step(k, static_cast<double>(k), Eigen::Vector2d(0.3, 0.1), u);
     EXPECT_TRUE(s.estimate.allFinite()) << "k = " << k;
     if (k >= 16) {
       EXPECT_TRUE(s.failure.empty()) << "k = " << k << ": " << s.failure_message;
@@ -465,7 +431,8 @@ TEST(Mhe, IsAnObserverTypeOfTheRegistry) {
   EXPECT_EQ(observer->name(), "mhe bounded");
   Eigen::VectorXd x = Eigen::Vector3d(1.0, 2.0, 20.0);
   for (long k = 0; k < 200; ++k) {
-    const ObserverStep& s = observer->step(k, 0.0, model.discrete.h(x), Eigen::VectorXd());
+    const ObserverStep& s = observer->step(k, static_cast<double>(k) * model.discrete.sample_time(),
+                                           model.discrete.h(x), Eigen::VectorXd());
     ASSERT_TRUE(s.estimate.allFinite());
     EXPECT_GE(s.estimate[2], 0.0);
     x = model.discrete.f(x, Eigen::VectorXd(), k);

@@ -914,6 +914,74 @@ TEST(RunModulating, ScenariosRoundTripAndBadSpecsNameTheProblem) {
   EXPECT_NE(error_of(f.string()).find("window"), std::string::npos);
 }
 
+// Recorded data with irregular times, a dropped stretch and cells left empty, on a model with
+// two outputs: the EKF, UKF and MHE integrate over each actual interval and update with the
+// outputs a row has, and end near the truth (simulated here by the model's own flow); the
+// Luenberger observer refuses the rows off its grid, by name, and says so in summary.json.
+TEST(RunData, IrregularTimesAndPartlyMissingOutputsRun) {
+  const Discretized<ChaoticNoLinear> model(ChaoticNoLinear{}, 0.01, Scheme::kRk4);
+  const fs::path data = scratch("irregular.csv");
+  Eigen::Vector3d x(1.0, 0.5, 0.2);
+  double t = 0.0;
+  std::vector<double> times;
+  std::vector<Eigen::Vector3d> truth;
+  {
+    std::ofstream csv(data);
+    csv << "t,y1,y2\n" << std::setprecision(17);
+    for (int k = 0; k < 400; ++k) {
+      const Eigen::Vector2d y = model.h(x);
+      times.push_back(t);
+      truth.push_back(x);
+      csv << t << ',';
+      if (k % 4 != 1) csv << y[0];  // empty cells: outputs not measured in that row
+      csv << ',';
+      if (k % 5 != 2) csv << y[1];
+      csv << '\n';
+      // On and off the grid, with a gap of 0.05 s once.
+      const double dt = k == 200 ? 0.05 : 0.01 * (1.0 + 0.5 * std::sin(1.3 * k));
+      x = model.flow(x, Discretized<ChaoticNoLinear>::Input(), t, dt);
+      t += dt;
+    }
+  }
+  const fs::path f = scratch("irregular.json");
+  write(f, R"({"name": "irregular", "model": {"name": "chaotic", "step": 0.01},
+    "x0": [1.0, 0.5, 0.2], "initial_guess": [1.2, 0.4, 0.0], "steps": 400, "observers": [
+    {"type": "ekf", "process_covariance": [[1e-8, 0, 0], [0, 1e-8, 0], [0, 0, 1e-8]]},
+    {"type": "ukf", "process_covariance": [[1e-8, 0, 0], [0, 1e-8, 0], [0, 0, 1e-8]]},
+    {"type": "mhe", "horizon": 8, "process_covariance": [[1e-8, 0, 0], [0, 1e-8, 0], [0, 0, 1e-8]]},
+    {"type": "luenberger", "gain": [[0.5, 0], [0, 0.5], [0, 0]]}]})");
+  const fs::path dir = scratch("irregular-out");
+  std::ostringstream out, err;
+  run_scenario(f.string(), {.out_dir = dir.string(), .data_file = data.string()}, out, err);
+  std::ifstream in(dir / "summary.json");
+  const auto summary = nlohmann::json::parse(in);
+  const auto records = csv_records(dir / "trajectories.csv");
+  ASSERT_EQ(records.size(), 401u);
+  const std::vector<std::string>& header = records[0];
+  for (const auto& o : summary["observers"]) {
+    const std::string name = o["name"];
+    if (name == "luenberger") {
+      EXPECT_GT(o["failures"].value("non_uniform", 0), 100) << o.dump();
+      EXPECT_NE(o.value("first_failure", "").find("constant gain"), std::string::npos) << o.dump();
+      continue;
+    }
+    EXPECT_FALSE(o["failures"].contains("non_uniform")) << o.dump();
+    EXPECT_FALSE(o["failures"].contains("non_finite_estimate")) << o.dump();
+    const auto column = std::find(header.begin(), header.end(), name + ".x1") - header.begin();
+    ASSERT_LT(column + 2, static_cast<long>(header.size())) << name;
+    for (int k : {300, 399}) {
+      const auto& row = records[static_cast<std::size_t>(k) + 1];
+      EXPECT_NEAR(std::stod(row[0]), times[static_cast<std::size_t>(k)],
+                  1e-9);  // written with 12 digits
+      for (int i = 0; i < 3; ++i) {
+        EXPECT_NEAR(std::stod(row[static_cast<std::size_t>(column + i)]),
+                    truth[static_cast<std::size_t>(k)][i], 2e-3)
+            << name << " x" << i + 1 << " at k = " << k;
+      }
+    }
+  }
+}
+
 // Recorded data with one sample off the grid: refused (named, state kept) or resampled.
 TEST(RunModulating, NonUniformFileIsRefusedOrResampled) {
   const fs::path data = scratch("mf-nonuniform.csv");

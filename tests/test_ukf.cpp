@@ -9,6 +9,7 @@
 #include <random>
 #include <string>
 
+#include "linear_gaussian.hpp"
 #include "nlobs/models/modified_chua.hpp"
 #include "nlobs/observers/baselines/baselines.hpp"
 #include "nlobs/observers/baselines/unscented_kalman_filter.hpp"
@@ -18,29 +19,13 @@
 namespace nlobs {
 namespace {
 
-// x⁺ = A x + B u, y = C x: a model nlobs does not ship, with two outputs.
-struct Linear3 : ModelSizes<3, 1, 2> {
-  Eigen::Matrix3d a{{0.95, 0.1, 0.0}, {-0.1, 0.9, 0.05}, {0.0, 0.02, 0.99}};
-  Eigen::Vector3d b{0.0, 1.0, 0.5};
-  template <typename T>
-  State<T> f(const State<T>& x, const Input& u, long) const {
-    return a.cast<T>() * x + (b * u[0]).cast<T>();
-  }
-  template <typename T>
-  Output<T> h(const State<T>& x) const {
-    return Output<T>(x[0] + x[2], x[1]);
-  }
-};
+using test::Linear3;
 
 using Exploding = test::Squaring;  // x⁺ = 1e200 x²: overflows at once
 
 template <typename Options>
 Options covariances(Options o) {
-  o.initial_estimate = Eigen::Vector3d(0.5, -0.2, 0.1);
-  o.process_covariance = 1e-3 * Eigen::Matrix3d::Identity();
-  o.measurement_covariance = Eigen::Matrix2d{{1e-2, 2e-3}, {2e-3, 5e-3}};
-  o.initial_covariance = Eigen::Matrix3d{{1.0, 0.1, 0.0}, {0.1, 2.0, 0.0}, {0.0, 0.0, 0.5}};
-  return o;
+  return test::linear_statistics(std::move(o));
 }
 
 TEST(Ukf, OnALinearGaussianModelItIsTheKalmanFilter) {
@@ -60,8 +45,8 @@ TEST(Ukf, OnALinearGaussianModelItIsTheKalmanFilter) {
           Eigen::VectorXd::Constant(1, std::sin(0.1 * static_cast<double>(k)));
       Eigen::VectorXd y = model.h(x);
       y += Eigen::Vector2d(noise(rng), noise(rng));
-      const Eigen::VectorXd e = kalman.step(k, 0.0, y, u).estimate;
-      const Eigen::VectorXd v = ukf.step(k, 0.0, y, u).estimate;
+      const Eigen::VectorXd e = kalman.step(k, static_cast<double>(k), y, u).estimate;
+      const Eigen::VectorXd v = ukf.step(k, static_cast<double>(k), y, u).estimate;
       worst = std::max(worst, (v - e).norm() / std::max(1.0, e.norm()));
       x = model.f(x, Linear3::Input(u), k) + Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
     }
@@ -83,7 +68,8 @@ TEST(Ukf, TracksTheModifiedChuaFromAWrongStart) {
   const Eigen::VectorXd u(0);
   double last = 0.0;
   for (long k = 0; k < 3000; ++k) {
-    const auto& s = ukf.step(k, 0.0, Eigen::VectorXd(model.h(x)), u);
+    const auto& s =
+        ukf.step(k, static_cast<double>(k) * model.step(), Eigen::VectorXd(model.h(x)), u);
     EXPECT_TRUE(s.estimate.allFinite());
     last = (s.estimate - x).norm();
     x = model.f(x, Model::Input(u), k);
@@ -136,27 +122,41 @@ TEST(Ukf, AnIndefiniteCovarianceRestartsFromP0AndSaysSo) {
   UkfOptions o;
   o.initial_estimate = Eigen::VectorXd::Constant(1, 3.0);
   UnscentedKalmanFilter<Exploding> ukf(Exploding{}, o);
-  const auto& s = ukf.step(0, 0.0, Eigen::VectorXd::Constant(1, 3.0), Eigen::VectorXd(0));
+  EXPECT_TRUE(
+      ukf.step(0, 0.0, Eigen::VectorXd::Constant(1, 3.0), Eigen::VectorXd(0)).failure.empty());
+  const auto& s = ukf.step(1, 1.0, Eigen::VectorXd::Constant(1, 3.0), Eigen::VectorXd(0));
   EXPECT_EQ(s.failure, "non_finite_estimate");
-  EXPECT_NE(s.failure_message.find("ukf: the prediction at sample k = 0"), std::string::npos)
+  EXPECT_NE(s.failure_message.find("ukf: the prediction at sample k = 1"), std::string::npos)
       << s.failure_message;
   EXPECT_TRUE(s.estimate.allFinite());
-  const auto& next = ukf.step(1, 0.0, Eigen::VectorXd::Constant(1, 3.0), Eigen::VectorXd(0));
+  const auto& next = ukf.step(2, 2.0, Eigen::VectorXd::Constant(1, 3.0), Eigen::VectorXd(0));
   EXPECT_TRUE(next.estimate.allFinite());
 }
 
-TEST(Ukf, AMissingMeasurementIsSkipped) {
+// A sample may carry only some outputs: the UKF and the EKF update with those (their rows of h
+// and their block of R), as the Kalman filter written out does; none measured is a missing
+// sample.
+TEST(Ukf, APartlyMeasuredSampleUpdatesWithTheOutputsItHas) {
   const Linear3 model;
   UnscentedKalmanFilter<Linear3> ukf(model, covariances(UkfOptions{}));
-  ExtendedKalmanFilter<Linear3> kalman(model, covariances(EkfOptions{}));
+  ExtendedKalmanFilter<Linear3> ekf(model, covariances(EkfOptions{}));
+  test::KalmanReference kalman;
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  for (long k = 0; k < 20; ++k) {
-    const Eigen::VectorXd y =
-        k % 3 == 1 ? Eigen::Vector2d(nan, 0.0) : Eigen::Vector2d(0.1 * static_cast<double>(k), 1.0);
-    const auto& s = ukf.step(k, 0.0, y, Eigen::VectorXd::Zero(1));
-    EXPECT_EQ(s.measurement_missing, k % 3 == 1);
-    const Eigen::VectorXd e = kalman.step(k, 0.0, y, Eigen::VectorXd::Zero(1)).estimate;
-    EXPECT_LT((s.estimate - e).norm(), 1e-9 * std::max(1.0, e.norm())) << k;
+  for (long k = 0; k < 30; ++k) {
+    const double t = static_cast<double>(k);
+    Eigen::Vector2d y(std::cos(0.3 * t), 0.1 * t);
+    if (k % 3 == 1) y[0] = nan;
+    if (k % 5 == 2) y[1] = nan;
+    if (k == 20) y.setConstant(nan);
+    const bool none = !y.array().isFinite().any();  // k = 7, 20, 22
+    const Eigen::Vector3d reference = kalman.step(y, 0.2);
+    const Eigen::VectorXd u = Eigen::VectorXd::Constant(1, 0.2);
+    const auto& s = ukf.step(k, t, y, u);
+    EXPECT_EQ(s.measurement_missing, none) << k;
+    EXPECT_LT((s.estimate - reference).norm(), 1e-9 * std::max(1.0, reference.norm())) << k;
+    const auto& e = ekf.step(k, t, y, u);
+    EXPECT_EQ(e.measurement_missing, none) << k;
+    EXPECT_LT((e.estimate - reference).norm(), 1e-9 * std::max(1.0, reference.norm())) << k;
   }
 }
 

@@ -2,6 +2,8 @@
 // Fixed-step discretisations x⁺ = f(x, u, k) of a continuous model, generic in the scalar
 // (so window estimators can differentiate them): forward Euler (the fixed-point paper's) and
 // classic RK4. Adaptive and stiff integration go through Boost.Odeint (odeint_discretization.hpp).
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 #include <string>
 
@@ -64,16 +66,33 @@ class Discretized : public SampledModel<Model> {
 
   Scheme scheme() const { return scheme_; }
 
+  // x⁺ at t_{k+1} = (k + 1) h: the flow over one step from t_k = k h.
   template <typename T>
   State<T> f(const State<T>& x, const Input& u, long k) const {
+    return flow(x, u, static_cast<double>(k) * this->step_, this->step_);
+  }
+
+  // x(t + dt) from x(t), u held: ⌈dt / h⌉ steps of the scheme of equal length dt / ⌈dt / h⌉ ≤ h
+  // (one step of h when dt = h, so that f is this flow on the grid). dt ≥ 0.
+  template <typename T>
+  State<T> flow(const State<T>& x, const Input& u, double t, double dt) const {
     const Model& m = this->model_;
-    const double t = static_cast<double>(k) * this->step_, h = this->step_;
-    if (scheme_ == Scheme::kEuler) return x + h * m.vector_field(x, u, t);
-    const State<T> k1 = m.vector_field(x, u, t);
-    const State<T> k2 = m.vector_field(State<T>(x + (h / 2) * k1), u, t + h / 2);
-    const State<T> k3 = m.vector_field(State<T>(x + (h / 2) * k2), u, t + h / 2);
-    const State<T> k4 = m.vector_field(State<T>(x + h * k3), u, t + h);
-    return x + (h / 6) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+    // A dt within rounding of a multiple of h takes that many steps (no sliver of a step).
+    const long steps = std::max(1L, static_cast<long>(std::ceil(dt / this->step_ - 1e-9)));
+    const double h = dt / static_cast<double>(steps);
+    State<T> state = x;
+    for (long s = 0; s < steps; ++s, t += h) {
+      if (scheme_ == Scheme::kEuler) {
+        state = State<T>(state + h * m.vector_field(state, u, t));
+        continue;
+      }
+      const State<T> k1 = m.vector_field(state, u, t);
+      const State<T> k2 = m.vector_field(State<T>(state + (h / 2) * k1), u, t + h / 2);
+      const State<T> k3 = m.vector_field(State<T>(state + (h / 2) * k2), u, t + h / 2);
+      const State<T> k4 = m.vector_field(State<T>(state + h * k3), u, t + h);
+      state = State<T>(state + (h / 6) * (k1 + 2.0 * k2 + 2.0 * k3 + k4));
+    }
+    return state;
   }
 
  private:

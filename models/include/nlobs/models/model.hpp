@@ -12,6 +12,13 @@
 //     a model defined in discrete time)
 //     template <class T> State<T>  f(const State<T>& x, const Input& u, long k) const;
 //     template <class T> Output<T> h(const State<T>& x) const;
+//   and, optionally, what observers of samples with times use:
+//     double sample_time() const;  (or step())  T, the time between samples k and k + 1
+//     template <class T> State<T>  flow(const State<T>& x, const Input& u, double t,
+//                                       double dt) const;   x(t + dt) from x(t), u held
+//   A model with a flow (the discretisations of a continuous model) integrates over any
+//   interval, so it takes irregular samples; one without (a map defined in discrete time) has a
+//   fixed step, and observers refuse a sample off its grid (observers/core/sample_clock.hpp).
 //
 // Both may declare a domain: `std::string domain_violation(const State<double>& x) const`
 // returns an empty string inside and a message naming the state and the bound outside (the
@@ -63,6 +70,38 @@ std::string domain_violation_of(const M& model, const ModelVector<double, M::kSt
     return model.domain_violation(x);
   } else {
     return {};
+  }
+}
+
+// A discrete model that integrates over any interval: flow(x, u, t, dt).
+template <typename M>
+concept IntervalModel = DiscreteModel<M> &&
+    requires(const M m, const ModelVector<double, M::kStates>& x,
+             const ModelVector<double, M::kInputs>& u) {
+  {m.flow(x, u, 0.0, 0.0)};
+};
+
+// T, the time between samples k and k + 1 a discrete model declares (sample_time() or step());
+// 0 when it declares none.
+template <DiscreteModel M>
+double sample_time_of(const M& model) {
+  if constexpr (requires { model.sample_time(); }) {
+    return static_cast<double>(model.sample_time());
+  } else if constexpr (requires { model.step(); }) {
+    return static_cast<double>(model.step());
+  } else {
+    return 0.0;
+  }
+}
+
+// Whether the model integrates over any interval: it has a flow (a model chosen at run time
+// says so with has_flow()).
+template <DiscreteModel M>
+bool has_interval_flow(const M& model) {
+  if constexpr (requires { model.has_flow(); }) {
+    return model.has_flow();
+  } else {
+    return IntervalModel<M>;
   }
 }
 

@@ -4,6 +4,7 @@
 // and relative tolerances as options. Evaluated in double only — estimators that need ∂f use
 // finite differences on it, or the fixed-step Discretized for AD. For stiff systems, the
 // Rosenbrock stepper arrives with the high-gain observer (issue 6), which needs it.
+#include <algorithm>
 #include <boost/numeric/odeint.hpp>
 #include <cmath>
 #include <sstream>
@@ -40,21 +41,27 @@ class OdeintDiscretized : public SampledModel<Model> {
 
   template <typename T>
   State<T> f(const State<T>& x, const Input& u, long k) const {
+    return flow(x, u, static_cast<double>(k) * this->step_, this->step_);
+  }
+
+  // x(t + dt) from x(t), u held, dt ≥ 0 (x itself for dt = 0).
+  template <typename T>
+  State<T> flow(const State<T>& x, const Input& u, double t, double dt) const {
     static_assert(std::is_same_v<T, double>,
                   "OdeintDiscretized is evaluated in double only (use Discretized for AD)");
     namespace odeint = boost::numeric::odeint;
     using Buffer = std::vector<double>;
+    if (!(dt > 0.0)) return x;
     Buffer state(x.data(), x.data() + x.size());
-    const auto rhs = [this, &u](const Buffer& s, Buffer& ds, double t) {
+    const auto rhs = [this, &u](const Buffer& s, Buffer& ds, double time) {
       const State<double> xs =
           Eigen::Map<const State<double>>(s.data(), static_cast<Eigen::Index>(s.size()));
-      const State<double> d = this->model_.vector_field(xs, u, t);
+      const State<double> d = this->model_.vector_field(xs, u, time);
       ds.assign(d.data(), d.data() + d.size());
     };
-    const double t0 = static_cast<double>(k) * this->step_;
     odeint::integrate_adaptive(odeint::make_controlled<odeint::runge_kutta_dopri5<Buffer>>(
                                    options_.absolute_tolerance, options_.relative_tolerance),
-                               rhs, state, t0, t0 + this->step_, this->step_ / 10.0);
+                               rhs, state, t, t + dt, std::min(dt, this->step_) / 10.0);
     return Eigen::Map<const State<double>>(state.data(), x.size());
   }
 

@@ -2,6 +2,12 @@
 // The classic observers the window estimators are compared with ([MGFF23]), for any discrete
 // model x⁺ = f(x, u, k), y = h(x). Each reports x̂_k from the samples up to k − 1 (Luenberger,
 // sliding mode: eq. 89 form, x̂_{k+1} = f(x̂_k) + correction(y_k)) or up to k (EKF: filtered).
+// Samples are placed by their times (SampleClock): a gap on the model's grid is that many
+// steps without a measurement; an interval off the grid is integrated by the EKF (a model with
+// a flow, Q scaled by the interval) and refused by Luenberger and sliding mode, whose constant
+// gains are designed for the step T (failure "non_uniform"). A sample may carry only some
+// outputs: the EKF updates with those measured; Luenberger and sliding mode correct with the
+// measured entries of y − h(x̂) (the others count 0).
 // Each is built as X(model, XOptions): the options hold the name, the initial estimate and the
 // gains; XOptions::validate() (called by the constructor) checks what the options alone can
 // tell, the constructor the sizes against the model.
@@ -14,6 +20,7 @@
 #include "nlobs/observers/core/discrete_jacobians.hpp"
 #include "nlobs/observers/core/observer.hpp"
 #include "nlobs/observers/core/option_checks.hpp"
+#include "nlobs/observers/core/sample_clock.hpp"
 #include "nlobs/solvers/status.hpp"
 
 namespace nlobs {
@@ -37,6 +44,17 @@ struct SlidingModeOptions {
   void validate() const;
 };
 
+// Why Luenberger and sliding mode refuse a sample off the model's grid.
+inline constexpr const char* kConstantGain = "its constant gain is designed for the step T";
+
+// y − h(x) with 0 where y was not measured.
+template <DiscreteModel Model>
+Eigen::VectorXd measured_error(const Model& model, const Eigen::VectorXd& x,
+                               const Eigen::VectorXd& y) {
+  const Eigen::VectorXd e = y - Eigen::VectorXd(model.h(ModelVector<double, Model::kStates>(x)));
+  return y.array().isFinite().select(e, 0.0);
+}
+
 // x̂⁺ = f(x̂, u, k) + L (y − h(x̂)), constant gain L (n × p). A next estimate that is not finite
 // (an unstable gain, a model that overflows) is not taken: the step says so, x̂ stays.
 template <DiscreteModel Model>
@@ -51,30 +69,39 @@ class LuenbergerObserver final : public Observer {
     info_.name = options_.name;
     reset();
   }
-  void reset() override { x_ = options_.initial_estimate; }
-  const ObserverStep& step(long k, double /*t*/, const Eigen::VectorXd& y,
+  void reset() override {
+    x_ = options_.initial_estimate;
+    clock_.reset();
+  }
+  const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
                            const Eigen::VectorXd& u) override {
-    step_.estimate = x_;
+    require_sample_sizes(name(), k, y, u, model_.outputs(), model_.inputs());
     step_.failure.clear();
     step_.failure_message.clear();
-    step_.measurement_missing = !y.allFinite();
-    Eigen::VectorXd next = f(x_, u, k);
-    if (!step_.measurement_missing) next += options_.gain * (y - h(x_));
-    accept_finite(next, x_, step_, name(), k);  // an unstable gain L overflows: say so
+    step_.measurement_missing = !y.array().isFinite().any();
+    if (clock_.place(name(), k, t, step_)) {
+      // x̂ at t_k from x̂_{k−1}: f plus the last sample's correction, then f alone over a gap.
+      Eigen::VectorXd next = x_;
+      for (long j = 0; j < clock_.moves(); ++j) {
+        next = advance(model_, State(next), Input(last_u_), clock_.move(j));
+        if (j == 0) next += correction_;
+      }
+      clock_.commit();
+      accept_finite(next, x_, step_, name(), k);  // an unstable gain L overflows: say so
+      last_u_ = u;
+      correction_ = options_.gain * measured_error(model_, x_, y);
+    }
+    step_.estimate = x_;
     return step_;
   }
 
  private:
-  Eigen::VectorXd f(const Eigen::VectorXd& x, const Eigen::VectorXd& u, long k) const {
-    return model_.f(ModelVector<double, Model::kStates>(x), ModelVector<double, Model::kInputs>(u),
-                    k);
-  }
-  Eigen::VectorXd h(const Eigen::VectorXd& x) const {
-    return model_.h(ModelVector<double, Model::kStates>(x));
-  }
+  using State = ModelVector<double, Model::kStates>;
+  using Input = ModelVector<double, Model::kInputs>;
   Model model_;
   LuenbergerOptions options_;
-  Eigen::VectorXd x_;
+  SampleClock clock_ = SampleClock::of(model_, kConstantGain, false);
+  Eigen::VectorXd x_, last_u_, correction_;
   ObserverStep step_;
 };
 
@@ -92,34 +119,49 @@ class SlidingModeObserver final : public Observer {
     info_.name = options_.name;
     reset();
   }
-  void reset() override { x_ = options_.initial_estimate; }
-  const ObserverStep& step(long k, double /*t*/, const Eigen::VectorXd& y,
+  void reset() override {
+    x_ = options_.initial_estimate;
+    clock_.reset();
+  }
+  const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
                            const Eigen::VectorXd& u) override {
-    step_.estimate = x_;
+    require_sample_sizes(name(), k, y, u, model_.outputs(), model_.inputs());
     step_.failure.clear();
     step_.failure_message.clear();
-    step_.measurement_missing = !y.allFinite();
-    Eigen::VectorXd next = model_.f(ModelVector<double, Model::kStates>(x_),
-                                    ModelVector<double, Model::kInputs>(u), k);
-    if (!step_.measurement_missing) {
-      const Eigen::VectorXd e =
-          y - Eigen::VectorXd(model_.h(ModelVector<double, Model::kStates>(x_)));
-      next += options_.q * e + options_.r * (e / options_.gamma).cwiseMax(-1.0).cwiseMin(1.0);
+    step_.measurement_missing = !y.array().isFinite().any();
+    if (clock_.place(name(), k, t, step_)) {
+      Eigen::VectorXd next = x_;
+      for (long j = 0; j < clock_.moves(); ++j) {
+        next = advance(model_, State(next), Input(last_u_), clock_.move(j));
+        if (j == 0) next += correction_;
+      }
+      clock_.commit();
+      accept_finite(next, x_, step_, name(), k);
+      last_u_ = u;
+      const Eigen::VectorXd e = measured_error(model_, x_, y);
+      correction_ = options_.q * e + options_.r * (e / options_.gamma).cwiseMax(-1.0).cwiseMin(1.0);
     }
-    accept_finite(next, x_, step_, name(), k);
+    step_.estimate = x_;
     return step_;
   }
 
  private:
+  using State = ModelVector<double, Model::kStates>;
+  using Input = ModelVector<double, Model::kInputs>;
   Model model_;
   SlidingModeOptions options_;
-  Eigen::VectorXd x_;
+  SampleClock clock_ = SampleClock::of(model_, kConstantGain, false);
+  Eigen::VectorXd x_, last_u_, correction_;
   ObserverStep step_;
 };
 
-// Extended Kalman filter with Jacobians of f and h by forward-mode AD (ceres::Jet):
-//   update with y_k:  K = P Hᵀ (H P Hᵀ + R)⁻¹, x̂ ← x̂ + K (y − h(x̂)), P ← (I − K H) P (I − K H)ᵀ + K
-//   R Kᵀ report x̂_k, then predict: x̂ ← f(x̂, u_k, k), P ← F P Fᵀ + Q.
+// Extended Kalman filter with Jacobians of f and h by forward-mode AD (ceres::Jet). At sample k,
+// first predict from the last sample's time along each move of the model (SampleClock: one
+// step T each, or the flow over an interval off the grid, Q weighted by its length / T):
+//   x̂ ← f(x̂, u_{k−1}),  P ← F P Fᵀ + w Q;
+// then update with the outputs measured at k (H, R and y restricted to them):
+//   K = P Hᵀ (H P Hᵀ + R)⁻¹, x̂ ← x̂ + K (y − h(x̂)), P ← (I − K H) P (I − K H)ᵀ + K R Kᵀ,
+// and report x̂_k. A second sample at the same instant is a second update.
 // An update or prediction that is not finite is not taken (the step says so): the estimate
 // keeps its last finite value, and a non-finite predicted covariance restarts from P0.
 struct EkfOptions {
@@ -151,60 +193,75 @@ class ExtendedKalmanFilter final : public Observer {
   void reset() override {
     x_ = initial_;
     p_ = p0_;
+    clock_.reset();
   }
-  const ObserverStep& step(long k, double /*t*/, const Eigen::VectorXd& y,
+  const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
                            const Eigen::VectorXd& u) override {
-    const Eigen::Index n = model_.states();
+    require_sample_sizes(name(), k, y, u, model_.outputs(), model_.inputs());
     step_.failure.clear();
     step_.failure_message.clear();
-    step_.measurement_missing = !y.allFinite();
-    if (!step_.measurement_missing) {
-      Eigen::MatrixXd hj;
-      jacobian_h(x_, hj);
-      const Eigen::MatrixXd s = hj * p_ * hj.transpose() + r_;
-      const Eigen::MatrixXd gain = p_ * hj.transpose() * s.inverse();
-      const Eigen::VectorXd innovation =
-          y - Eigen::VectorXd(model_.h(ModelVector<double, Model::kStates>(x_)));
-      const Eigen::VectorXd updated = x_ + gain * innovation;
-      const Eigen::MatrixXd ikh = Eigen::MatrixXd::Identity(n, n) - gain * hj;
-      const Eigen::MatrixXd covariance =
-          ikh * p_ * ikh.transpose() + gain * r_ * gain.transpose();  // Joseph form
-      if (updated.allFinite() && covariance.allFinite()) {
-        x_ = updated;
-        p_ = covariance;
-      } else {
-        predicted_failure(k, "the measurement update", "kept the last finite estimate");
-      }
+    step_.measurement_missing = !y.array().isFinite().any();
+    if (!clock_.place(name(), k, t, step_)) {
+      step_.estimate = x_;
+      return step_;
     }
+    for (long j = 0; j < clock_.moves(); ++j) {
+      if (!predict(k, clock_.move(j))) break;
+    }
+    clock_.commit();
+    last_u_ = u;
+    if (!step_.measurement_missing) update(k, y);
     step_.estimate = x_;
-    Eigen::MatrixXd fj;
-    jacobian_f(x_, u, k, fj);
-    const Eigen::VectorXd predicted = model_.f(ModelVector<double, Model::kStates>(x_),
-                                               ModelVector<double, Model::kInputs>(u), k);
-    const Eigen::MatrixXd covariance = fj * p_ * fj.transpose() + q_;
-    if (accept_finite(predicted, x_, step_, name(), k, "the predicted state")) {
-      if (covariance.allFinite()) {
-        p_ = covariance;
-      } else {  // restart the covariance from P0 so that the filter can re-acquire
-        predicted_failure(k, "the predicted covariance P", "P restarts from P0");
-        p_ = p0_;
-      }
-    }
     return step_;
   }
 
  private:
-  void jacobian_f(const Eigen::VectorXd& x, const Eigen::VectorXd& u, long k,
-                  Eigen::MatrixXd& j) const {
-    Matrix<Model::kStates, Model::kStates> jac;
-    state_jacobian(model_, ModelVector<double, Model::kStates>(x),
-                   ModelVector<double, Model::kInputs>(u), k, jac);
-    j = jac;
+  using State = ModelVector<double, Model::kStates>;
+  using Input = ModelVector<double, Model::kInputs>;
+
+  // x̂ ← f(x̂, u_{k−1}), P ← F P Fᵀ + w Q along one move; false when it was not taken.
+  bool predict(long k, const ModelStep& move) {
+    Matrix<Model::kStates, Model::kStates> fj;
+    const State x(x_);
+    const Input u(last_u_);
+    state_jacobian(model_, x, u, move, fj);
+    const Eigen::VectorXd predicted = advance(model_, x, u, move);
+    const Eigen::MatrixXd covariance = fj * p_ * fj.transpose() + move.weight * q_;
+    if (!accept_finite(predicted, x_, step_, name(), k, "the predicted state")) return false;
+    if (covariance.allFinite()) {
+      p_ = covariance;
+      return true;
+    }
+    predicted_failure(k, "the predicted covariance P", "P restarts from P0");
+    p_ = p0_;  // so that the filter can re-acquire
+    return false;
   }
-  void jacobian_h(const Eigen::VectorXd& x, Eigen::MatrixXd& j) const {
+
+  // The update with the outputs measured in y (all of them, or the finite entries).
+  void update(long k, const Eigen::VectorXd& y) {
+    const Eigen::Index n = model_.states();
     Matrix<Model::kOutputs, Model::kStates> jac;
-    output_jacobian(model_, ModelVector<double, Model::kStates>(x), jac);
-    j = jac;
+    output_jacobian(model_, State(x_), jac);
+    Eigen::MatrixXd hj = jac, r = r_;
+    Eigen::VectorXd innovation = y - Eigen::VectorXd(model_.h(State(x_)));
+    if (!y.allFinite()) {
+      const std::vector<Eigen::Index> rows = measured_outputs(y);
+      hj = Eigen::MatrixXd(hj(rows, Eigen::all));
+      r = Eigen::MatrixXd(r_(rows, rows));
+      innovation = Eigen::VectorXd(innovation(rows));
+    }
+    const Eigen::MatrixXd s = hj * p_ * hj.transpose() + r;
+    const Eigen::MatrixXd gain = p_ * hj.transpose() * s.inverse();
+    const Eigen::VectorXd updated = x_ + gain * innovation;
+    const Eigen::MatrixXd ikh = Eigen::MatrixXd::Identity(n, n) - gain * hj;
+    const Eigen::MatrixXd covariance =
+        ikh * p_ * ikh.transpose() + gain * r * gain.transpose();  // Joseph form
+    if (updated.allFinite() && covariance.allFinite()) {
+      x_ = updated;
+      p_ = covariance;
+    } else {
+      predicted_failure(k, "the measurement update", "kept the last finite estimate");
+    }
   }
 
   void predicted_failure(long k, const char* what, const char* action) {
@@ -214,7 +271,8 @@ class ExtendedKalmanFilter final : public Observer {
   }
 
   Model model_;
-  Eigen::VectorXd initial_, x_;
+  SampleClock clock_ = SampleClock::of(model_, "", true);
+  Eigen::VectorXd initial_, x_, last_u_;
   Eigen::MatrixXd q_, r_, p0_, p_;
   ObserverStep step_;
 };

@@ -3,27 +3,32 @@
 // discrete model x⁺ = f(x, u, k), y = h(x) — a baseline beside the EKF that needs no Jacobian:
 //   λ = α²(n + κ) − n,  χ_0 = x̂,  χ_{±i} = x̂ ± (L)_i,  L Lᵀ = (n + λ) P  (Cholesky),
 //   W_0^m = λ/(n + λ),  W_0^c = W_0^m + 1 − α² + β,  W_{±i} = 1/(2(n + λ)).
-// Update with y_k:  Y_i = h(χ_i), ŷ = Σ W^m Y_i, S = Σ W^c (Y_i − ŷ)(Y_i − ŷ)ᵀ + R,
+// At sample k, first predict from the last sample's time along each move of the model
+// (SampleClock: one step T each, or the flow over an interval off the grid, Q weighted by its
+// length / T): χ_i ← f(χ_i, u_{k−1}), x̂ = Σ W^m χ_i, P = Σ W^c (χ_i − x̂)(..)ᵀ + w Q;
+// then update with the outputs measured at k (h, R and y restricted to them):
+//   Y_i = h(χ_i), ŷ = Σ W^m Y_i, S = Σ W^c (Y_i − ŷ)(Y_i − ŷ)ᵀ + R,
 //   C = Σ W^c (χ_i − x̂)(Y_i − ŷ)ᵀ, K = C S⁻¹, x̂ ← x̂ + K (y − ŷ), P ← P − K S Kᵀ;
-// report x̂_k; then predict: χ_i ← f(χ_i, u_k, k), x̂ = Σ W^m χ_i, P = Σ W^c (χ_i − x̂)(..)ᵀ + Q.
-// On a linear model it is the Kalman filter (tested).
+// and report x̂_k. On a linear model it is the Kalman filter (tested).
 //
 // A P that the Cholesky factorisation refuses (rounding, or a negative W_0^c with α < 1) is
 // repaired, never thrown about: symmetrised, then its diagonal raised by
 // δ = 1e-12 · max(1, max_i |P_ii|), ten times more per try, up to 10 tries (covariance_repairs()
 // counts them). When that fails, or a step is not finite, the step is not taken: x̂ keeps its
 // last finite value, P restarts from P0, and the step says so (failure non_finite_estimate).
-// A measurement with a non-finite entry is skipped (measurement_missing).
+// A sample's non-finite entries are outputs not measured; measurement_missing when none is.
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "nlobs/models/model.hpp"
 #include "nlobs/observers/core/observer.hpp"
 #include "nlobs/observers/core/option_checks.hpp"
+#include "nlobs/observers/core/sample_clock.hpp"
 
 namespace nlobs {
 
@@ -71,69 +76,98 @@ class UnscentedKalmanFilter final : public Observer {
     x_ = options_.initial_estimate;
     p_ = p0_;
     repairs_ = 0;
+    clock_.reset();
   }
 
   // How many times P was repaired (symmetrised and its diagonal raised) since reset().
   int covariance_repairs() const { return repairs_; }
 
-  const ObserverStep& step(long k, double /*t*/, const Eigen::VectorXd& y,
+  const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
                            const Eigen::VectorXd& u) override {
-    const Eigen::Index n = model_.states(), p = model_.outputs();
+    require_sample_sizes(name(), k, y, u, model_.outputs(), model_.inputs());
     step_.failure.clear();
     step_.failure_message.clear();
-    step_.measurement_missing = !y.allFinite();
-    if (!step_.measurement_missing) {
-      if (sigma_points(k, "the measurement update")) {
-        ys_.resize(p, 2 * n + 1);
-        for (Eigen::Index i = 0; i < 2 * n + 1; ++i) {
-          ys_.col(i) = Eigen::VectorXd(model_.h(ModelVector<double, Model::kStates>(chi_.col(i))));
-        }
-        const Eigen::VectorXd y_mean = mean(ys_);
-        Eigen::MatrixXd s = r_, c = Eigen::MatrixXd::Zero(n, p);
-        for (Eigen::Index i = 0; i < 2 * n + 1; ++i) {
-          const Eigen::VectorXd dy = ys_.col(i) - y_mean;
-          const double w = i == 0 ? wc0_ : wi_;
-          s.noalias() += w * dy * dy.transpose();
-          c.noalias() += w * (chi_.col(i) - x_) * dy.transpose();
-        }
-        const Eigen::PartialPivLU<Eigen::MatrixXd> lu(s);
-        const Eigen::MatrixXd gain = lu.solve(c.transpose()).transpose();  // C S⁻¹ (S symmetric)
-        const Eigen::VectorXd updated = x_ + gain * (y - y_mean);
-        Eigen::MatrixXd covariance = p_ - gain * s * gain.transpose();
-        covariance = 0.5 * (covariance + covariance.transpose());
-        if (updated.allFinite() && covariance.allFinite()) {
-          x_ = updated;
-          p_ = covariance;
-        } else {
-          fail(k, "the measurement update", "kept the last finite estimate");
-        }
-      }
+    step_.measurement_missing = !y.array().isFinite().any();
+    if (!clock_.place(name(), k, t, step_)) {
+      step_.estimate = x_;
+      return step_;
     }
+    for (long j = 0; j < clock_.moves(); ++j) {
+      if (!predict(k, clock_.move(j))) break;
+    }
+    clock_.commit();
+    last_u_ = u;
+    if (!step_.measurement_missing) update(k, y);
     step_.estimate = x_;
-    if (sigma_points(k, "the prediction")) {
-      const ModelVector<double, Model::kInputs> uu(u);
-      for (Eigen::Index i = 0; i < 2 * n + 1; ++i) {
-        chi_.col(i) =
-            Eigen::VectorXd(model_.f(ModelVector<double, Model::kStates>(chi_.col(i)), uu, k));
-      }
-      const Eigen::VectorXd predicted = mean(chi_);
-      Eigen::MatrixXd covariance = q_;
-      for (Eigen::Index i = 0; i < 2 * n + 1; ++i) {
-        const Eigen::VectorXd dx = chi_.col(i) - predicted;
-        covariance.noalias() += (i == 0 ? wc0_ : wi_) * dx * dx.transpose();
-      }
-      if (predicted.allFinite() && covariance.allFinite()) {
-        x_ = predicted;
-        p_ = 0.5 * (covariance + covariance.transpose());
-      } else {
-        fail(k, "the prediction", "kept the last finite estimate; P restarts from P0");
-        p_ = p0_;
-      }
-    }
     return step_;
   }
 
  private:
+  using State = ModelVector<double, Model::kStates>;
+
+  // The sigma points through one move; false when the step was not taken.
+  bool predict(long k, const ModelStep& move) {
+    const Eigen::Index n = model_.states();
+    if (!sigma_points(k, "the prediction")) return false;
+    const ModelVector<double, Model::kInputs> u(last_u_);
+    for (Eigen::Index i = 0; i < 2 * n + 1; ++i) {
+      chi_.col(i) = Eigen::VectorXd(advance(model_, State(chi_.col(i)), u, move));
+    }
+    const Eigen::VectorXd predicted = mean(chi_);
+    Eigen::MatrixXd covariance = move.weight * q_;
+    for (Eigen::Index i = 0; i < 2 * n + 1; ++i) {
+      const Eigen::VectorXd dx = chi_.col(i) - predicted;
+      covariance.noalias() += (i == 0 ? wc0_ : wi_) * dx * dx.transpose();
+    }
+    if (predicted.allFinite() && covariance.allFinite()) {
+      x_ = predicted;
+      p_ = 0.5 * (covariance + covariance.transpose());
+      return true;
+    }
+    fail(k, "the prediction", "kept the last finite estimate; P restarts from P0");
+    p_ = p0_;
+    return false;
+  }
+
+  // The update with the outputs measured in y (all of them, or the finite entries).
+  void update(long k, const Eigen::VectorXd& y) {
+    const Eigen::Index n = model_.states();
+    if (!sigma_points(k, "the measurement update")) return;
+    std::vector<Eigen::Index> rows;
+    if (!y.allFinite()) rows = measured_outputs(y);
+    const Eigen::Index p = rows.empty() ? model_.outputs() : static_cast<Eigen::Index>(rows.size());
+    ys_.resize(p, 2 * n + 1);
+    for (Eigen::Index i = 0; i < 2 * n + 1; ++i) {
+      const Eigen::VectorXd yi = model_.h(State(chi_.col(i)));
+      if (rows.empty()) {
+        ys_.col(i) = yi;
+      } else {
+        ys_.col(i) = yi(rows);
+      }
+    }
+    const Eigen::VectorXd y_mean = mean(ys_);
+    Eigen::MatrixXd s = rows.empty() ? r_ : Eigen::MatrixXd(r_(rows, rows));
+    Eigen::MatrixXd c = Eigen::MatrixXd::Zero(n, p);
+    for (Eigen::Index i = 0; i < 2 * n + 1; ++i) {
+      const Eigen::VectorXd dy = ys_.col(i) - y_mean;
+      const double w = i == 0 ? wc0_ : wi_;
+      s.noalias() += w * dy * dy.transpose();
+      c.noalias() += w * (chi_.col(i) - x_) * dy.transpose();
+    }
+    const Eigen::VectorXd measured = rows.empty() ? y : Eigen::VectorXd(y(rows));
+    const Eigen::PartialPivLU<Eigen::MatrixXd> lu(s);
+    const Eigen::MatrixXd gain = lu.solve(c.transpose()).transpose();  // C S⁻¹ (S symmetric)
+    const Eigen::VectorXd updated = x_ + gain * (measured - y_mean);
+    Eigen::MatrixXd covariance = p_ - gain * s * gain.transpose();
+    covariance = 0.5 * (covariance + covariance.transpose());
+    if (updated.allFinite() && covariance.allFinite()) {
+      x_ = updated;
+      p_ = covariance;
+    } else {
+      fail(k, "the measurement update", "kept the last finite estimate");
+    }
+  }
+
   // χ = [x̂, x̂ + L, x̂ − L] from the Cholesky factor of (n + λ) P, repaired if need be; false
   // (P restarted from P0, the step marked) when no repair gives a factor.
   bool sigma_points(long k, const char* where) {
@@ -184,6 +218,8 @@ class UnscentedKalmanFilter final : public Observer {
 
   Model model_;
   UkfOptions options_;
+  SampleClock clock_ = SampleClock::of(model_, "", true);
+  Eigen::VectorXd last_u_;
   double lambda_ = 0.0, wm0_ = 0.0, wc0_ = 0.0, wi_ = 0.0;
   Eigen::VectorXd x_;
   Eigen::MatrixXd q_, r_, p0_, p_, chi_, ys_;

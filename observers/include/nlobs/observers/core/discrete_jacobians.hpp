@@ -1,22 +1,24 @@
 #pragma once
-// The Jacobians of a discrete model x⁺ = f(x, u, k), y = h(x) with respect to x, by forward-mode
-// AD (ceres::Jet through autodiff_jacobian): what the EKF linearises with and the MHE's
-// Gauss–Newton and arrival cost use. Fixed sizes allocate nothing.
+// The Jacobians of a discrete model's move x⁺ = f(x, u, k) (or its flow over an interval,
+// ModelStep) and of y = h(x) with respect to x, by forward-mode AD (ceres::Jet through
+// autodiff_jacobian): what the EKF linearises with and the MHE's Gauss–Newton and arrival cost use.
+// Fixed sizes allocate nothing.
 #include <type_traits>
 
 #include "nlobs/models/model.hpp"
+#include "nlobs/observers/core/model_step.hpp"
 #include "nlobs/solvers/autodiff.hpp"
 
 namespace nlobs {
 
-// F = ∂f/∂x at (x, u, k); `jacobian` is resized to n × n.
+// F = ∂x⁺/∂x of the move s at (x, u); `jacobian` is resized to n × n.
 template <DiscreteModel Model>
 void state_jacobian(const Model& model, const ModelVector<double, Model::kStates>& x,
-                    const ModelVector<double, Model::kInputs>& u, long k,
+                    const ModelVector<double, Model::kInputs>& u, const ModelStep& s,
                     Matrix<Model::kStates, Model::kStates>& jacobian) {
-  auto f = [&model, &u, k](const auto& v) {
+  auto f = [&model, &u, &s](const auto& v) {
     using T = typename std::decay_t<decltype(v)>::Scalar;
-    return ModelVector<T, Model::kStates>(model.f(ModelVector<T, Model::kStates>(v), u, k));
+    return advance(model, ModelVector<T, Model::kStates>(v), u, s);
   };
   jacobian.resize(x.size(), x.size());
   autodiff_jacobian<Model::kStates, Model::kStates>(f, x, jacobian);

@@ -9,6 +9,7 @@
 // the signals published beside x̂ — is one ObserverInfo, set by the constructor (a window
 // estimator adds to its warnings what a run finds; reset() clears those).
 #include <Eigen/Core>
+#include <cmath>
 #include <cstddef>
 #include <optional>
 #include <sstream>
@@ -16,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "nlobs/common/invalid_input.hpp"
 #include "nlobs/solvers/summary.hpp"
 
 namespace nlobs {
@@ -103,11 +105,13 @@ class Observer {
 
   virtual void reset() = 0;  // back to the initial estimate, empty window
   // Sample k (0, 1, 2, … in order) taken at time t. A non-finite entry of y is a missing
-  // measurement. Discrete-time observers (window estimators, Luenberger, sliding mode, EKF) run
-  // on k and ignore t; the sampled-data ones (MVT, high-gain, PI bank, backward differences,
-  // modulating functions) place the sample by t on their uniform grid t_0 + m·T (t_0 the first
-  // sample's time; skipped grid points are a gap) and refuse one off it (failure "non_uniform")
-  // or with a non-finite t ("non_finite").
+  // measurement of that output. Every observer places the sample by t: the sampled-data ones
+  // (MVT, high-gain, PI bank, backward differences, modulating functions) on their uniform grid
+  // t_0 + m·T (t_0 the first sample's time; skipped grid points are a gap) and refuse one off it
+  // (failure "non_uniform") or with a non-finite t ("non_finite"); the discrete-time ones move
+  // their model from the last sample's time to t (SampleClock, sample_clock.hpp: a gap on the
+  // model's grid is that many steps, an interval off it is integrated by a model with a flow
+  // for the Kalman-type observers and refused by the others).
   virtual const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
                                    const Eigen::VectorXd& u) = 0;
   // For observers that estimate in other coordinates (signals of kind kEmbeddedEstimate or
@@ -127,6 +131,26 @@ class Observer {
 
   ObserverInfo info_;  // filled by the constructor (see ObserverInfo::warnings)
 };
+
+// Throws InvalidInput naming `who` and k when sample k's y or u does not have the model's sizes.
+inline void require_sample_sizes(const std::string& who, long k, const Eigen::VectorXd& y,
+                                 const Eigen::VectorXd& u, Eigen::Index outputs,
+                                 Eigen::Index inputs) {
+  if (y.size() == outputs && u.size() == inputs) return;
+  std::ostringstream os;
+  os << who << ": the sample k = " << k << " has " << y.size() << " outputs and " << u.size()
+     << " inputs; the model has " << outputs << " and " << inputs;
+  throw InvalidInput(os.str());
+}
+
+// The entries of y that were measured (finite), in order: a sample may carry only some outputs.
+inline std::vector<Eigen::Index> measured_outputs(const Eigen::VectorXd& y) {
+  std::vector<Eigen::Index> rows;
+  for (Eigen::Index i = 0; i < y.size(); ++i) {
+    if (std::isfinite(y[i])) rows.push_back(i);
+  }
+  return rows;
+}
 
 // Marks a step whose estimate (or what it is computed from) was not finite and was not taken.
 inline void mark_non_finite_estimate(ObserverStep& step, std::string message) {

@@ -35,15 +35,10 @@
 
 #include "nlobs/common/invalid_input.hpp"
 #include "nlobs/observers/core/observer.hpp"
+#include "nlobs/observers/core/sample_clock.hpp"
 #include "nlobs/observers/core/sample_interpolator.hpp"
 
 namespace nlobs {
-
-// Half-width, in grid steps, of "on the grid" at time t for a grid step T: recorded times carry
-// their decimal rounding, a few ulps of t relative to T.
-inline double grid_tolerance(double t, double step) {
-  return 1e-6 + 4.0 * std::numeric_limits<double>::epsilon() * std::abs(t) / step;
-}
 
 // A sample's place on a uniform grid: its index m and time t_0 + m·T.
 struct GridPoint {

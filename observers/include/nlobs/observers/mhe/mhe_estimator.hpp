@@ -25,7 +25,7 @@
 // V(z_α) ≤ V(z) + 2σ ∇(V/2)ᵀ(z_α − z), σ = 1e-4, z_α = Π(z + α Δz), α halved up to 30 times);
 // with bounds, the projected Newton method of [Ber82]: states at a bound whose gradient points
 // out are held and the step solved for the others. Warm start: the previous solution shifted
-// by one sample, the new state predicted by f. real_time_iteration takes one iteration per
+// by one sample, the new state predicted by the model. real_time_iteration takes one iteration per
 // sample ([DBS05]). Each step's Summary: converged (‖Δz‖∞ ≤ step_tolerance (1 + ‖z‖∞), or the
 // full step's first-order decrease −2∇(V/2)ᵀΔz ≤ cost_tolerance · V), max_iterations, stagnated (no
 // decrease along the projected Newton nor the projected gradient path) or non_finite (V not finite
@@ -36,12 +36,29 @@
 //
 // A sample's outputs may be missing one by one (a non-finite entry): its term weighs the
 // measured outputs by the inverse of their own block of R; measurement_missing is set only
-// when all are missing. Hot path: with compile-time sizes nothing is allocated per step except
-// when a sample misses some of its outputs.
+// when all are missing.
+//
+// Samples with times (SampleClock): a gap on the model's grid brings one node per skipped grid
+// point, without a measurement (the horizon is N grid points then); an interval off the grid is
+// one move of the model's flow, its noise weight · Q (weight = interval / T). A sample at the
+// last one's instant adds its outputs to that node (one measured there already: failure
+// "duplicate_measurement"). A late sample — its time before the last one's — goes into the
+// horizon: into the node of its instant, or as a new node between its neighbours (the flow over
+// both parts of their interval; a fixed-step model refuses one off its grid, "non_uniform"),
+// the oldest node leaving if the horizon overflows; then the estimates x̂_{j|j} of the nodes
+// from it on are re-solved on the horizon up to each (the arrival cost of later steps
+// linearises at them) and the whole horizon is solved. The answer is the one the same samples
+// in order give, exactly on a linear model (tested); on a nonlinear one, until the late
+// sample leaves the horizon (x̂_{j|j} of the samples after it then come from a horizon that
+// starts later than in order). A sample older than the horizon's first is dropped (failure
+// "late_measurement_dropped"), counted in late_measurements_dropped() and one warning. Hot path:
+// with compile-time sizes nothing is allocated per step except when a sample misses some of its
+// outputs.
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -50,6 +67,7 @@
 #include "nlobs/observers/core/discrete_jacobians.hpp"
 #include "nlobs/observers/core/observer.hpp"
 #include "nlobs/observers/core/option_checks.hpp"
+#include "nlobs/observers/core/sample_clock.hpp"
 #include "nlobs/observers/mhe/block_tridiagonal.hpp"
 #include "nlobs/observers/mhe/mhe_options.hpp"
 #include "nlobs/solvers/summary.hpp"
@@ -90,7 +108,7 @@ class MheEstimator final : public Observer {
     iterations_ = options_.real_time_iteration ? 1 : static_cast<int>(options_.max_iterations);
 
     const auto h = static_cast<std::size_t>(options_.horizon);
-    nodes_.reserve(h);
+    nodes_.reserve(h + 1);  // a late sample is inserted before the oldest leaves
     diag_.assign(h, StateMatrix::Zero(n, n));
     sub_.assign(h, StateMatrix::Zero(n, n));
     grad_.assign(h, State::Zero(n));
@@ -101,6 +119,7 @@ class MheEstimator final : public Observer {
     w_res_.assign(h, State::Zero(n));
     y_res_.assign(h, Output::Zero(p));
     solver_.reserve(options_.horizon, n);
+    missing_ = Eigen::VectorXd::Constant(p, kMissing);
 
     info_.name = options_.name;
     info_.engine = kEngine;
@@ -111,38 +130,53 @@ class MheEstimator final : public Observer {
 
   void reset() override {
     nodes_.clear();
+    clock_.reset();
     prior_ = options_.initial_estimate;
     prior_cov_ = p0_;
     prior_inv_ = p0_inv_;
     estimate_ = prior_;
+    late_dropped_ = 0;
+    info_.warnings.clear();
   }
 
   const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
                            const Eigen::VectorXd& u) override {
-    check_sizes(k, y, u);
+    require_sample_sizes(name(), k, y, u, model_.outputs(), model_.inputs());
     step_.failure.clear();
     step_.failure_message.clear();
     step_.measurement_missing = !y.array().isFinite().any();
-    // The new state's first guess: f of the last one (before the oldest sample may leave).
-    State guess = nodes_.empty() ? prior_ : predict(nodes_.back());
-    if (!guess.allFinite()) guess = nodes_.empty() ? prior_ : nodes_.back().x;
-    if (nodes_.size() == static_cast<std::size_t>(options_.horizon)) {
-      drop_oldest(k);
-      std::rotate(nodes_.begin(), nodes_.begin() + 1, nodes_.end());
-    } else {
-      nodes_.emplace_back();
+    step_.summary.reset();
+    step_.used_unusable_answer = false;
+    if (!nodes_.empty() && t < clock_.time() - same_instant()) {
+      late(k, t, y, u);
+    } else if (clock_.place(name(), k, t, step_)) {
+      if (clock_.moves() == 0 && !nodes_.empty()) {  // a second sample of the last instant
+        if (merge(nodes_.size() - 1, k, t, y)) {
+          clock_.commit();
+          report(solve(k, nodes_.size()));
+        }
+      } else {
+        // One node per move: a gap on the model's grid brings nodes without a measurement.
+        const long moves = std::max(1L, clock_.moves());
+        for (long j = 0; j < moves; ++j) {
+          const auto move = clock_.moves() ? std::optional(clock_.move(j)) : std::nullopt;
+          if (j + 1 < moves) {
+            append(k, move, t, missing_, Eigen::VectorXd(nodes_.back().u));
+          } else {
+            append(k, move, t, y, u);
+          }
+          report(solve(k, nodes_.size()));
+        }
+        clock_.commit();
+      }
     }
-    Node& node = nodes_.back();
-    node.k = k;
-    node.t = t;
-    node.u = Input(u);
-    set_measurement(node, y);
-    node.x = guess.cwiseMax(lower_).cwiseMin(upper_);
-    solve(k);
-    node.filtered = estimate_;
     step_.estimate = estimate_;
     return step_;
   }
+
+  // Late measurements older than the horizon's first sample, dropped since reset() (each a step
+  // with failure "late_measurement_dropped", and counted in one of info().warnings).
+  long late_measurements_dropped() const { return late_dropped_; }
 
   // The arrival cost's x̄ and P (the prior on the horizon's first state).
   const State& arrival_mean() const { return prior_; }
@@ -165,11 +199,14 @@ class MheEstimator final : public Observer {
     long k = 0;
     double t = 0.0;
     Output y;            // the measured outputs; 0 where missing
+    Output measured;     // 1 where y was measured, 0 where missing
     OutputMatrix r_inv;  // R⁻¹ of the outputs measured; zero rows and columns where missing
-    Input u;
-    State x;         // the horizon's current estimate of this sample's state
-    State filtered;  // x̂_{i|i}: the estimate reported when this sample was the last
+    Input u;             // held from t to the next sample's time
+    ModelStep next;      // the model's move to the next sample (w weighted by next.weight)
+    State x;             // the horizon's current estimate of this sample's state
+    State filtered;      // x̂_{i|i}: the estimate from the samples up to this one
   };
+  static constexpr double kMissing = std::numeric_limits<double>::quiet_NaN();
 
   // M⁻¹ of a symmetric positive definite M (validated options, or P = F P⁺ Fᵀ + Q).
   template <typename Matrix>
@@ -179,34 +216,204 @@ class MheEstimator final : public Observer {
     return out;
   }
 
-  void check_sizes(long k, const Eigen::VectorXd& y, const Eigen::VectorXd& u) const {
-    if (y.size() == model_.outputs() && u.size() == model_.inputs()) return;
-    std::ostringstream os;
-    os << name() << ": the sample k = " << k << " has " << y.size() << " outputs and " << u.size()
-       << " inputs; the model has " << model_.outputs() << " and " << model_.inputs();
-    throw InvalidInput(os.str());
+  // "The same instant" for sample times: within the rounding of recorded times.
+  double same_instant() const {
+    const double step = clock_.sample_time();
+    return step > 0.0 ? grid_tolerance(std::abs(clock_.time()), step) * step : 0.0;
   }
 
+  // The node's y, mask and R⁻¹ from y (non-finite entries: not measured).
   void set_measurement(Node& node, const Eigen::VectorXd& y) const {
     const Eigen::Index p = model_.outputs();
     const auto present = y.array().isFinite();
     node.y = Output(present.select(y.array(), 0.0).matrix());
+    node.measured = Output(present.template cast<double>().matrix());
     if (present.all()) {
       node.r_inv = r_inv_;
       return;
     }
     node.r_inv = OutputMatrix::Zero(p, p);
-    std::vector<Eigen::Index> rows;
-    for (Eigen::Index i = 0; i < p; ++i) {
-      if (present[i]) rows.push_back(i);
-    }
+    const std::vector<Eigen::Index> rows = measured_outputs(y);
     if (rows.empty()) return;
     const Eigen::MatrixXd r_measured = r_(rows, rows);
     const Eigen::MatrixXd inv = inverse(r_measured);
     node.r_inv(rows, rows) = inv;
   }
 
-  State predict(const Node& node) const { return State(model_.f(node.x, node.u, node.k)); }
+  // Sample k's outputs into node i of the same instant; false (the step's failure
+  // "duplicate_measurement") when one of them was measured there already.
+  bool merge(std::size_t i, long k, double t, const Eigen::VectorXd& y) {
+    Node& node = nodes_[i];
+    Eigen::VectorXd merged = node.y;
+    for (Eigen::Index c = 0; c < y.size(); ++c) {
+      if (!(node.measured[c] > 0.0)) merged[c] = kMissing;
+    }
+    for (Eigen::Index c = 0; c < y.size(); ++c) {
+      if (!std::isfinite(y[c])) continue;
+      if (node.measured[c] > 0.0) {
+        std::ostringstream os;
+        os << name() << ": sample k = " << k << " at t = " << t << " measures output " << c + 1
+           << ", which the sample at t = " << node.t << " (k = " << node.k
+           << ") measured already; ignored";
+        step_.failure = "duplicate_measurement";
+        step_.failure_message = os.str();
+        return false;
+      }
+      merged[c] = y[c];
+    }
+    set_measurement(node, merged);
+    return true;
+  }
+
+  // A new last node at the end of `move` (the first sample: none) holding y and u; the oldest
+  // leaves when the horizon is full.
+  void append(long k, const std::optional<ModelStep>& move, double t, const Eigen::VectorXd& y,
+              const Eigen::VectorXd& u) {
+    State guess = prior_;
+    if (move) {
+      Node& last = nodes_.back();
+      last.next = *move;
+      guess = advance(model_, last.x, last.u, *move);
+      if (!guess.allFinite()) guess = last.x;
+      t = move->time + move->length;
+    }
+    if (nodes_.size() == static_cast<std::size_t>(options_.horizon)) {
+      drop_oldest(k);
+      std::rotate(nodes_.begin(), nodes_.begin() + 1, nodes_.end());
+    } else {
+      nodes_.emplace_back();
+    }
+    Node& node = nodes_.back();
+    node.k = k;
+    node.t = t;
+    node.u = Input(u);
+    node.next = ModelStep{};
+    set_measurement(node, y);
+    node.x = guess.cwiseMax(lower_).cwiseMin(upper_);
+  }
+
+  // A sample older than the last one: merged into the node of its instant, or inserted between
+  // its neighbours (the model's flow over the two parts of their interval), and the horizon
+  // re-solved; older than the horizon, dropped and counted.
+  void late(long k, double t, const Eigen::VectorXd& y, const Eigen::VectorXd& u) {
+    const double tolerance = same_instant();
+    std::ostringstream os;
+    os << name() << ": the late sample k = " << k << " at t = " << t;
+    if (t < nodes_.front().t - tolerance) {
+      ++late_dropped_;
+      os << " is older than the horizon's first sample (t = " << nodes_.front().t << "); dropped";
+      step_.failure = "late_measurement_dropped";
+      step_.failure_message = os.str();
+      std::ostringstream warning;
+      warning << late_dropped_ << " late measurement(s) older than the horizon dropped (the "
+              << "first: " << (late_dropped_ == 1 ? os.str() : first_late_) << ")";
+      if (late_dropped_ == 1) {
+        first_late_ = os.str();
+        info_.warnings.push_back(warning.str());
+      } else {
+        info_.warnings.back() = warning.str();
+      }
+      return;
+    }
+    std::size_t i = 0;
+    while (i + 1 < nodes_.size() && nodes_[i + 1].t <= t + tolerance) ++i;
+    std::size_t from = i;
+    if (std::abs(nodes_[i].t - t) <= tolerance) {
+      if (!merge(i, k, t, y)) return;
+    } else {
+      if (!has_interval_flow(model_)) {
+        os << " falls between the samples at t = " << nodes_[i].t << " and " << nodes_[i + 1].t
+           << "; the model has a fixed step (no flow over an interval): refused";
+        step_.failure = "non_uniform";
+        step_.failure_message = os.str();
+        return;
+      }
+      insert_after(i, k, t, y, u);
+      from = i + 1;
+      while (nodes_.size() > static_cast<std::size_t>(options_.horizon)) {
+        drop_oldest(k);
+        nodes_.erase(nodes_.begin());
+        if (from > 0) --from;
+      }
+    }
+    // The estimates x̂_{j|j} of the samples from the late one on change: each is re-solved on
+    // the horizon up to it (what the arrival cost of the later steps linearises at).
+    for (std::size_t j = from; j + 1 < nodes_.size(); ++j) {
+      const Summary replay = solve(k, j + 1);
+      if (replay.status != Status::kNonFinite) nodes_[j].filtered = nodes_[j].x;
+    }
+    report(solve(k, nodes_.size()));
+  }
+
+  // A node at t between nodes i and i + 1: each part of the interval between them is what
+  // SampleClock makes of it in order — a multiple m of T is m steps (with m − 1 nodes without a
+  // measurement between), any other length one flow.
+  void insert_after(std::size_t i, long k, double t, const Eigen::VectorXd& y,
+                    const Eigen::VectorXd& u) {
+    const double step = clock_.sample_time();
+    std::vector<Node> inserted;
+    // Nodes from `from` (exclusive) to `to` (exclusive) held with input `held`, then one at `to`
+    // when `last` says so.
+    auto part = [&](double from, double to, const Input& held) {
+      const double length = to - from;
+      const double m = std::round(length / step);
+      if (m >= 2.0 && std::abs(length / step - m) <= grid_tolerance(std::abs(to), step)) {
+        for (long j = 1; j < static_cast<long>(m); ++j) {
+          Node gap;
+          gap.k = k;
+          gap.t = from + static_cast<double>(j) * step;
+          gap.u = held;
+          set_measurement(gap, missing_);
+          inserted.push_back(gap);
+        }
+      }
+    };
+    part(nodes_[i].t, t, nodes_[i].u);
+    Node node;
+    node.k = k;
+    node.t = t;
+    node.u = Input(u);
+    set_measurement(node, y);
+    inserted.push_back(node);
+    part(t, nodes_[i + 1].t, node.u);
+    // The moves: from each node to the next, over what lies between them.
+    const auto flow = [step](double from, double to) {
+      ModelStep s;
+      s.flow = true;
+      s.time = from;
+      s.length = to - from;
+      s.weight = s.length / step;
+      return s;
+    };
+    const auto is_grid_step = [step](double length) {
+      return std::abs(length / step - 1.0) <= grid_tolerance(length, step);
+    };
+    Node* previous = &nodes_[i];
+    for (Node& n : inserted) {
+      previous->next = flow(previous->t, n.t);
+      if (is_grid_step(previous->next.length)) previous->next.weight = 1.0;
+      const State guess = advance(model_, previous->x, previous->u, previous->next);
+      n.x = (guess.allFinite() ? guess : previous->x).cwiseMax(lower_).cwiseMin(upper_);
+      n.filtered = n.x;
+      previous = &n;
+    }
+    previous->next = flow(previous->t, nodes_[i + 1].t);
+    if (is_grid_step(previous->next.length)) previous->next.weight = 1.0;
+    nodes_.insert(nodes_.begin() + static_cast<std::ptrdiff_t>(i + 1), inserted.begin(),
+                  inserted.end());
+  }
+
+  // The step's estimate, summary and signal from the solve of the whole horizon.
+  void report(Summary summary) {
+    if (summary.status != Status::kNonFinite) estimate_ = nodes_.back().x;
+    summary.record_answer(estimate_, StopCriteria{}, true);
+    step_.used_unusable_answer = summary.status != Status::kNonFinite && !summary.usable();
+    step_.signals[0] = summary.objective.value_or(std::numeric_limits<double>::quiet_NaN());
+    step_.summary = std::move(summary);
+    nodes_.back().filtered = estimate_;
+  }
+
+  State predict(const Node& node) const { return advance(model_, node.x, node.u, node.next); }
 
   // The filtering update of the arrival cost along the sample that leaves the horizon.
   void drop_oldest(long k) {
@@ -214,13 +421,13 @@ class MheEstimator final : public Observer {
     const Eigen::Index n = model_.states();
     StateMatrix fj(n, n);
     OutputJacobian hj(model_.outputs(), n);
-    state_jacobian(model_, old.filtered, old.u, old.k, fj);
+    state_jacobian(model_, old.filtered, old.u, old.next, fj);
     output_jacobian(model_, old.filtered, hj);
     const StateMatrix information = prior_inv_ + hj.transpose() * old.r_inv * hj;
     const StateMatrix updated = inverse(information);
-    StateMatrix covariance = fj * updated * fj.transpose() + q_;
+    StateMatrix covariance = fj * updated * fj.transpose() + old.next.weight * q_;
     covariance = 0.5 * (covariance + covariance.transpose());
-    const State mean = model_.f(old.filtered, old.u, old.k);
+    const State mean = advance(model_, old.filtered, old.u, old.next);
     const Eigen::LLT<StateMatrix> llt(covariance);
     if (!mean.allFinite() || !covariance.allFinite() || llt.info() != Eigen::Success) {
       std::ostringstream os;
@@ -236,10 +443,10 @@ class MheEstimator final : public Observer {
 
   bool inside_domain(const State& x) const { return domain_violation_of(model_, x).empty(); }
 
-  // V at the states xs[0..M−1] (+inf when a term is not finite or a state leaves the model's
-  // domain).
+  // V at the states xs[0..M−1] of the problem's first M = active_ nodes (+inf when a term is not
+  // finite or a state leaves the model's domain).
   double cost(const std::vector<State>& xs) const {
-    const std::size_t m = nodes_.size();
+    const std::size_t m = active_;
     const State e0 = xs[0] - prior_;
     double v = e0.dot(prior_inv_ * e0);
     for (std::size_t i = 0; i < m; ++i) {
@@ -247,8 +454,8 @@ class MheEstimator final : public Observer {
       const Output e = nodes_[i].y - Output(model_.h(xs[i]));
       v += e.dot(nodes_[i].r_inv * e);
       if (i + 1 < m) {
-        const State w = xs[i + 1] - State(model_.f(xs[i], nodes_[i].u, nodes_[i].k));
-        v += w.dot(q_inv_ * w);
+        const State w = xs[i + 1] - advance(model_, xs[i], nodes_[i].u, nodes_[i].next);
+        v += w.dot(q_inv_ * w) / nodes_[i].next.weight;
       }
     }
     return std::isfinite(v) ? v : std::numeric_limits<double>::infinity();
@@ -256,10 +463,10 @@ class MheEstimator final : public Observer {
 
   // The Gauss–Newton system at the current states: diag_, sub_ (H) and grad_ (∇(V/2)).
   void linearise() {
-    const std::size_t m = nodes_.size();
+    const std::size_t m = active_;
     for (std::size_t i = 0; i < m; ++i) {
       const Node& node = nodes_[i];
-      if (i + 1 < m) state_jacobian(model_, node.x, node.u, node.k, f_jac_[i]);
+      if (i + 1 < m) state_jacobian(model_, node.x, node.u, node.next, f_jac_[i]);
       output_jacobian(model_, node.x, h_jac_[i]);
       y_res_[i] = node.y - Output(model_.h(node.x));
       const Output ry = node.r_inv * y_res_[i];
@@ -269,11 +476,13 @@ class MheEstimator final : public Observer {
     diag_[0] += prior_inv_;
     grad_[0].noalias() += prior_inv_ * (nodes_[0].x - prior_);
     for (std::size_t i = 0; i + 1 < m; ++i) {
+      // The move's noise is weight · Q (an interval off the grid): its inverse weighs the term.
+      const double scale = 1.0 / nodes_[i].next.weight;
       w_res_[i] = nodes_[i + 1].x - predict(nodes_[i]);
-      const State qw = q_inv_ * w_res_[i];
-      sub_[i].noalias() = -q_inv_ * f_jac_[i];
+      const State qw = scale * (q_inv_ * w_res_[i]);
+      sub_[i].noalias() = -scale * (q_inv_ * f_jac_[i]);
       diag_[i].noalias() -= f_jac_[i].transpose() * sub_[i];
-      diag_[i + 1] += q_inv_;
+      diag_[i + 1] += scale * q_inv_;
       grad_[i].noalias() -= f_jac_[i].transpose() * qw;
       grad_[i + 1] += qw;
     }
@@ -283,7 +492,7 @@ class MheEstimator final : public Observer {
   // columns of H become the identity's, their gradient 0, so that the step leaves them. Returns
   // the projected gradient's ‖·‖∞.
   double hold_active_bounds() {
-    const std::size_t m = nodes_.size();
+    const std::size_t m = active_;
     double projected = 0.0;
     for (std::size_t i = 0; i < m; ++i) {
       for (Eigen::Index c = 0; c < model_.states(); ++c) {
@@ -306,7 +515,7 @@ class MheEstimator final : public Observer {
   // trial_ = Π(x + α d); returns ∇(V/2)ᵀ(trial − x) and the step's ‖·‖∞.
   std::pair<double, double> project_step(double alpha) {
     double slope = 0.0, step = 0.0;
-    for (std::size_t i = 0; i < nodes_.size(); ++i) {
+    for (std::size_t i = 0; i < active_; ++i) {
       trial_[i] = (nodes_[i].x + alpha * direction_[i]).cwiseMax(lower_).cwiseMin(upper_);
       const State s = trial_[i] - nodes_[i].x;
       slope += grad_[i].dot(s);
@@ -335,12 +544,16 @@ class MheEstimator final : public Observer {
 
   double states_norm() const {
     double norm = 0.0;
-    for (const Node& node : nodes_) norm = std::max(norm, node.x.cwiseAbs().maxCoeff());
+    for (std::size_t i = 0; i < active_; ++i) {
+      norm = std::max(norm, nodes_[i].x.cwiseAbs().maxCoeff());
+    }
     return norm;
   }
 
-  void solve(long k) {
-    const std::size_t m = nodes_.size();
+  // Minimises V over the first m nodes (their states left at the answer) and returns the
+  // Summary, V in its objective; a V not finite at the warm start marks the step.
+  Summary solve(long k, std::size_t m) {
+    active_ = m;
     Summary summary;
     summary.engine = kEngine;
     evaluations_ = 0;
@@ -400,11 +613,7 @@ class MheEstimator final : public Observer {
     summary.jacobian_evaluations = iteration;
     summary.function_evaluations = evaluations_;
     summary.objective = value;
-    if (summary.status != Status::kNonFinite) estimate_ = nodes_.back().x;
-    summary.record_answer(estimate_, StopCriteria{}, true);
-    step_.used_unusable_answer = summary.status != Status::kNonFinite && !summary.usable();
-    step_.signals[0] = value;
-    step_.summary = std::move(summary);
+    return summary;
   }
 
   Model model_;
@@ -425,6 +634,11 @@ class MheEstimator final : public Observer {
   std::vector<Output> y_res_;
   detail::BlockTridiagonalCholesky<Model::kStates> solver_;
   int evaluations_ = 0;
+  std::size_t active_ = 0;  // the nodes of the problem being solved (the first active_)
+  SampleClock clock_ = SampleClock::of(model_, "", true);
+  Eigen::VectorXd missing_;  // y of a gap's node: no output measured
+  long late_dropped_ = 0;
+  std::string first_late_;  // the first late measurement dropped, for the warning
   ObserverStep step_;
 };
 

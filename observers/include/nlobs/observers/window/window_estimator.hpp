@@ -10,12 +10,14 @@
 // estimate coasts on the model, x̂[k] = f(x̂[k−1], u[k−1], k−1), from the initial guess at
 // k = 0; the next solve starts from the coasted estimate of its first sample (never from the
 // answer of a failed solve), so a run that fails is retried at every sample and recovers once
-// the data allow. After a missing sample the window refills from scratch. The estimate is
-// never non-finite: a coasting step that overflows keeps the last finite estimate and marks
-// the step (failure "non_finite_estimate").
-// Warm start of a solve that follows a usable one: the previous solution w* (the paper's
-// choice) or its propagation f(w*) to the next window's first sample (measured better; the
-// default, docs/observers.md). The engine's Summary of each solve is exposed per step.
+// the data allow. After a missing sample the window refills from scratch. Samples are placed
+// by their time on the model's grid (SampleClock): a skipped grid point is a missing sample, a
+// sample off the grid is refused (failure "non_uniform": the window map assumes the grid). The
+// estimate is never non-finite: a coasting step that overflows keeps the last finite estimate and
+// marks the step (failure "non_finite_estimate"). Warm start of a solve that follows a usable one:
+// the previous solution w* (the paper's choice) or its propagation f(w*) to the next window's first
+// sample (measured better; the default, docs/observers.md). The engine's Summary of each solve is
+// exposed per step.
 //
 //   auto estimator = make_window_estimator(model, "newton:tol=1e-10", options);  // by spec, or
 //   WindowEstimator<Model> estimator(model, options, std::make_unique<CeresEngine<3>>(...));
@@ -27,6 +29,7 @@
 #include <string_view>
 
 #include "nlobs/observers/core/observer.hpp"
+#include "nlobs/observers/core/sample_clock.hpp"
 #include "nlobs/observers/window/output_window.hpp"
 #include "nlobs/observers/window/window_problems.hpp"
 #include "nlobs/solvers/engine.hpp"
@@ -109,8 +112,9 @@ class WindowEstimator final : public Observer {
   }
 
   void require_least_squares_engine() const;
-  // The estimate kept for the window's first sample k − N + 1, coasted on the model.
-  State coasted_guess(long k) const;
+  // The estimate kept for the window's first sample k − N + 1 (k the model index), coasted on
+  // the model; `moved`: k is not the first sample.
+  State coasted_guess(long k, bool moved) const;
   Summary solve_window(Engine<N>& engine, State& w, long k);
   Summary solve_once(Engine<N>& engine, State& w);
   void choose_gain(const Engine<N>& engine, const State& w, long k);
@@ -129,6 +133,7 @@ class WindowEstimator final : public Observer {
   std::unique_ptr<RootProblem<N, Dynamic>> root_;
   bool square_ = true;
   ObserverStep step_;
+  SampleClock clock_;
   State coast_, next_guess_;
   Eigen::VectorXd last_u_;
   std::vector<State> history_;  // estimates of the last N samples, by k mod N
@@ -165,7 +170,9 @@ WindowEstimator<Model>::WindowEstimator(Model model, WindowEstimatorOptions opti
                                         std::unique_ptr<Engine<N>> engine)
     : options_(std::move(options)),
       engine_(std::move(engine)),
-      state_(std::make_unique<Shared>(std::move(model), window_length(model, options_))) {
+      state_(std::make_unique<Shared>(std::move(model), window_length(model, options_))),
+      clock_(SampleClock::of(state_->window.model(), "the window map assumes samples on the grid",
+                             false)) {
   if (!engine_) throw InvalidInput("WindowEstimator: no engine");
   spec_ = engine_->label();
   const Eigen::Index n = state_->window.states();
@@ -208,6 +215,7 @@ WindowEstimator<Model>::WindowEstimator(Model model, WindowEstimatorOptions opti
 template <DiscreteModel Model>
 void WindowEstimator<Model>::reset() {
   state_->window.clear();
+  clock_.reset();
   step_ = ObserverStep{};
   coast_ = initial_guess_;
   history_.assign(static_cast<size_t>(state_->window.length()), initial_guess_);
@@ -228,26 +236,43 @@ void WindowEstimator<Model>::reset() {
 }
 
 template <DiscreteModel Model>
-const ObserverStep& WindowEstimator<Model>::step(long k, double /*t*/, const Eigen::VectorXd& y,
+const ObserverStep& WindowEstimator<Model>::step(long k, double t, const Eigen::VectorXd& y,
                                                  const Eigen::VectorXd& u) {
   const OutputWindow<Model>& window = state_->window;
   const Eigen::Index length = window.length();
+  require_sample_sizes(name(), k, y, u, window.model().outputs(), window.model().inputs());
   step_.summary.reset();
   step_.failure.clear();
   step_.failure_message.clear();
   step_.measurement_missing = !y.allFinite();
+  if (!clock_.place(name(), k, t, step_)) {  // off the grid: the window map assumes it
+    step_.estimate = coast_;
+    return step_;
+  }
+  const long moves = clock_.moves();
+  clock_.commit();
+  const long index = clock_.index();  // the model's index of this sample
+  if (moves > 1) {  // a gap: the skipped samples are missing ones; coast over all but the last
+    state_->window.clear();
+    have_solution_ = false;
+    for (long j = index - moves; j + 1 < index; ++j) {
+      const State next = window.model().f(coast_, typename OutputWindow<Model>::Input(last_u_), j);
+      accept_finite(next, coast_, step_, name(), k,
+                    "the state coasted on the model from the last estimate");
+    }
+  }
   if (step_.measurement_missing) {
     state_->window.clear();  // consecutive samples only: refill after the gap
     have_solution_ = false;
   } else {
-    state_->window.push(k, y, u);
+    state_->window.push(index, y, u);
   }
   step_.ready = window.full();
   bool solved = false;
   if (step_.ready) {
     // Guess for w = x̂[k−N+1]: the warm start after a usable solve, else the estimate kept
     // for that sample (coasted on the model; for N = 1 that is f(x̂[k−1]), not yet kept).
-    State w = have_solution_ ? next_guess_ : coasted_guess(k);
+    State w = have_solution_ ? next_guess_ : coasted_guess(index, moves > 0);
     have_solution_ = false;
     Engine<N>& engine = (first_engine_ && !solved_once_) ? *first_engine_ : *engine_;
     solved_once_ = true;
@@ -269,23 +294,23 @@ const ObserverStep& WindowEstimator<Model>::step(long k, double /*t*/, const Eig
     }
   }
   // Otherwise x̂[k] comes from the model, f(x̂[k−1], u[k−1], k−1), from the guess at k = 0.
-  if (!solved && k > 0) {
+  if (!solved && moves > 0) {
     const State next =
-        window.model().f(coast_, typename OutputWindow<Model>::Input(last_u_), k - 1);
+        window.model().f(coast_, typename OutputWindow<Model>::Input(last_u_), index - 1);
     accept_finite(next, coast_, step_, name(), k,
                   "the state coasted on the model from the last estimate");
   }
   last_u_ = u;
-  history_[static_cast<size_t>(k % length)] = coast_;
+  history_[static_cast<size_t>(index % length)] = coast_;
   step_.estimate = coast_;
   return step_;
 }
 
 template <DiscreteModel Model>
-auto WindowEstimator<Model>::coasted_guess(long k) const -> State {
+auto WindowEstimator<Model>::coasted_guess(long k, bool moved) const -> State {
   const Eigen::Index length = state_->window.length();
   if (length > 1) return history_[static_cast<size_t>((k + 1) % length)];
-  if (k == 0) return initial_guess_;
+  if (!moved) return initial_guess_;
   const State next =
       state_->window.model().f(coast_, typename OutputWindow<Model>::Input(last_u_), k - 1);
   return next.allFinite() ? next : coast_;
