@@ -58,8 +58,12 @@ void split_cells(std::string_view line, std::vector<std::string_view>& cells) {
 
 class Reader {
  public:
-  Reader(const std::string& name, Eigen::Index outputs, Eigen::Index inputs)
-      : name_(name), p_(outputs), m_(inputs), columns_(static_cast<std::size_t>(1 + p_ + m_)) {}
+  Reader(const std::string& name, Eigen::Index outputs, Eigen::Index inputs, bool late_rows)
+      : name_(name),
+        p_(outputs),
+        m_(inputs),
+        columns_(static_cast<std::size_t>(1 + p_ + m_)),
+        late_rows_(late_rows) {}
 
   void line(std::string_view text, long number) {
     number_ = number;
@@ -147,11 +151,11 @@ class Reader {
              (output ? " (a missing measurement is an empty cell or nan)" : ""));
       }
     }
-    if (!times_.empty() && !(values_[0] > times_.back())) {
+    if (!late_rows_ && !times_.empty() && !(values_[0] > times_.back())) {
       std::ostringstream os;
       os.precision(17);
       os << "time " << values_[0] << " does not come after the previous row's " << times_.back()
-         << ": times must increase";
+         << ": times must increase (--allow-late passes late rows to the observers)";
       fail(os.str());
     }
   }
@@ -159,6 +163,7 @@ class Reader {
   const std::string& name_;
   const Eigen::Index p_, m_;
   const std::size_t columns_;
+  const bool late_rows_;  // a time may come before the previous row's (--allow-late)
   long number_ = 0;
   bool seen_line_ = false;
   std::vector<std::string_view> cells_;
@@ -171,8 +176,8 @@ class Reader {
 }  // namespace
 
 Measurements parse_measurements_csv(std::istream& in, const std::string& name, Eigen::Index outputs,
-                                    Eigen::Index inputs) {
-  Reader reader(name, outputs, inputs);
+                                    Eigen::Index inputs, bool late_rows) {
+  Reader reader(name, outputs, inputs, late_rows);
   std::string line;
   for (long number = 1; std::getline(in, line); ++number) reader.line(line, number);
   if (in.bad()) throw std::invalid_argument(name + ": read error");
@@ -180,9 +185,9 @@ Measurements parse_measurements_csv(std::istream& in, const std::string& name, E
 }
 
 Measurements read_measurements_csv(const std::string& file, Eigen::Index outputs,
-                                   Eigen::Index inputs) {
+                                   Eigen::Index inputs, bool late_rows) {
   std::ifstream in = open_input_file(file, "data file");
-  return parse_measurements_csv(in, file, outputs, inputs);
+  return parse_measurements_csv(in, file, outputs, inputs, late_rows);
 }
 
 }  // namespace nlobs::cli

@@ -8,7 +8,9 @@
 //   error naming the cell;
 // * y cells: a number, or a missing measurement written as an empty cell (the last one too) or
 //   `nan`; an infinite or out-of-range value (`inf`, `1e400`) is an error;
-// * t and u cells: finite numbers; times strictly increase.
+// * t and u cells: finite numbers; times strictly increase, unless `late_rows` (--allow-late):
+//   then a row may come at or before an earlier time, and goes to the observers in file order
+//   (the MHE takes a late measurement into its horizon; the others refuse it, by name).
 #include <Eigen/Core>
 #include <iosfwd>
 #include <string>
@@ -20,10 +22,10 @@ namespace nlobs::cli {
 // Reads `in` (named `name` in messages) for a model with `outputs` outputs and `inputs` inputs.
 // Throws std::invalid_argument naming name:line and what was wrong; nothing is returned then.
 Measurements parse_measurements_csv(std::istream& in, const std::string& name, Eigen::Index outputs,
-                                    Eigen::Index inputs);
+                                    Eigen::Index inputs, bool late_rows = false);
 
 // The same from a file; a missing file, a directory or an unreadable file is named as such.
 Measurements read_measurements_csv(const std::string& file, Eigen::Index outputs,
-                                   Eigen::Index inputs);
+                                   Eigen::Index inputs, bool late_rows = false);
 
 }  // namespace nlobs::cli

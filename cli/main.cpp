@@ -166,8 +166,13 @@ int main(int argc, char** argv) {
   run->add_option("--plot-timeout", run_options.plot_timeout,
                   "Seconds gnuplot may take before the plots are skipped (default 120)")
       ->check(finite_in(1e-3, 86400.0, "SECONDS in 0.001..86400"));
-  run->add_option("--data", run_options.data_file,
-                  "Observe recorded measurements (CSV: t, y1..yp[, u1..um]) instead of simulating");
+  CLI::Option* data_opt = run->add_option(
+      "--data", run_options.data_file,
+      "Observe recorded measurements (CSV: t, y1..yp[, u1..um]) instead of simulating");
+  run->add_flag("--allow-late", run_options.allow_late,
+                "With --data: rows may come late (a time before an earlier row's); the MHE "
+                "takes them into its horizon, other observers refuse them by name")
+      ->needs(data_opt);
 
   // nlobs list
   CLI::App* list = app.add_subcommand("list", "List models, engines, observers, scenarios");

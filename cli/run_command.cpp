@@ -510,7 +510,8 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
     if (!data.stop_message.empty()) err << "nlobs: simulation " << data.stop_message << '\n';
     if (data.steps() == 0) throw std::runtime_error("the simulation produced no samples");
   } else {
-    data = read_measurements_csv(options.data_file, model.outputs(), model.inputs());
+    data = read_measurements_csv(options.data_file, model.outputs(), model.inputs(),
+                                 options.allow_late);
     source = options.data_file;
   }
 

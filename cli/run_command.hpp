@@ -14,6 +14,8 @@ struct RunOptions {
   std::optional<std::uint64_t> seed{};
   std::string out_dir{};    // empty: no files
   std::string data_file{};  // empty: simulate
+  // The data file's times may go back (late rows, passed to the observers in file order).
+  bool allow_late = false;
   // "theta=0.05,0.1,0.2": run the scenario's high_gain observers once per value on the same
   // data; "horizon=…" / "sample_period=…": the modulating observers (all observers run);
   // "PARAMETER=…": a model parameter, re-simulated per value. Prints and writes (with --out)

@@ -982,6 +982,72 @@ TEST(RunData, IrregularTimesAndPartlyMissingOutputsRun) {
   }
 }
 
+// --allow-late: a row that comes after later rows (a slow sensor). The MHE takes it into its
+// horizon and gives the estimates of the same rows in order; the EKF refuses it by name; without
+// the flag the file is an error that names the row and the flag.
+TEST(RunData, LateRowsReachTheMheWithAllowLate) {
+  const Discretized<BatchReactor> model(BatchReactor{}, 0.25, Scheme::kRk4);
+  Eigen::Vector3d x(0.5, 0.05, 0.0);
+  std::vector<std::string> rows;
+  for (int k = 0; k < 50; ++k) {
+    std::ostringstream row;
+    row << std::setprecision(17) << 0.25 * k << ','
+        << model.h(x)[0] + 0.25 * std::sin(7.0 * k);  // a deterministic "noise"
+    rows.push_back(row.str());
+    x = model.f(x, Discretized<BatchReactor>::Input(), k);
+  }
+  const fs::path in_order = scratch("in-order.csv"), late = scratch("late.csv");
+  {
+    std::ofstream a(in_order), b(late);
+    a << "t,y1\n";
+    b << "t,y1\n";
+    for (int k = 0; k < 50; ++k) {
+      a << rows[static_cast<std::size_t>(k)] << '\n';
+      if (k == 30) continue;
+      b << rows[static_cast<std::size_t>(k)] << '\n';
+      if (k == 32) b << rows[30] << '\n';  // row 30 arrives after row 32
+    }
+  }
+  const fs::path f = scratch("late.json");
+  write(f, R"({"name": "late", "model": {"name": "batch-reactor"}, "x0": [0.5, 0.05, 0],
+    "initial_guess": [1, 0, 4], "steps": 50, "observers": [
+    {"type": "ekf", "initial_covariance": [[0.25, 0, 0], [0, 0.25, 0], [0, 0, 0.25]],
+     "process_covariance": [[1e-6, 0, 0], [0, 1e-6, 0], [0, 0, 1e-6]],
+     "measurement_covariance": [[0.0625]]},
+    {"type": "mhe", "horizon": 10, "lower_bounds": [0, 0, 0],
+     "initial_covariance": [[0.25, 0, 0], [0, 0.25, 0], [0, 0, 0.25]],
+     "process_covariance": [[1e-6, 0, 0], [0, 1e-6, 0], [0, 0, 1e-6]],
+     "measurement_covariance": [[0.0625]]}]})");
+  EXPECT_NE(error_of(f.string(), {.data_file = late.string()}).find("--allow-late"),
+            std::string::npos);
+  const fs::path dir_a = scratch("in-order-out"), dir_b = scratch("late-out");
+  std::ostringstream out, err;
+  run_scenario(f.string(), {.out_dir = dir_a.string(), .data_file = in_order.string()}, out, err);
+  run_scenario(f.string(),
+               {.out_dir = dir_b.string(), .data_file = late.string(), .allow_late = true}, out,
+               err);
+  std::ifstream in(dir_b / "summary.json");
+  const auto summary = nlohmann::json::parse(in);
+  EXPECT_EQ(summary["observers"][0]["failures"].value("non_uniform", 0), 1)
+      << summary["observers"][0].dump();
+  EXPECT_NE(summary["observers"][0].value("first_failure", "").find("does not come after"),
+            std::string::npos);
+  EXPECT_TRUE(summary["observers"][1]["failures"].empty()) << summary["observers"][1].dump();
+  const auto a = csv_records(dir_a / "trajectories.csv"),
+             b = csv_records(dir_b / "trajectories.csv");
+  ASSERT_EQ(a.size(), b.size());
+  const auto column = std::find(a[0].begin(), a[0].end(), "mhe.x1") - a[0].begin();
+  ASSERT_LT(column + 2, static_cast<long>(a[0].size()));
+  // File row 33 of the late run is sample 30, the last one taken with every row up to 32: from
+  // there the MHE's estimates are those in order while sample 30 is in the horizon (N = 10).
+  for (std::size_t row = 33; row <= 40; ++row) {
+    for (int i = 0; i < 3; ++i) {
+      const std::size_t c = static_cast<std::size_t>(column + i);
+      EXPECT_NEAR(std::stod(b[row][c]), std::stod(a[row][c]), 1e-7) << "row " << row;
+    }
+  }
+}
+
 // Recorded data with one sample off the grid: refused (named, state kept) or resampled.
 TEST(RunModulating, NonUniformFileIsRefusedOrResampled) {
   const fs::path data = scratch("mf-nonuniform.csv");
