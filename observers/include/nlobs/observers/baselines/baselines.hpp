@@ -20,6 +20,7 @@
 #include "nlobs/observers/core/discrete_jacobians.hpp"
 #include "nlobs/observers/core/observer.hpp"
 #include "nlobs/observers/core/option_checks.hpp"
+#include "nlobs/observers/core/predict_update_observer.hpp"
 #include "nlobs/observers/core/sample_clock.hpp"
 #include "nlobs/solvers/status.hpp"
 
@@ -58,101 +59,91 @@ Eigen::VectorXd measured_error(const Model& model, const Eigen::VectorXd& x,
 // x̂⁺ = f(x̂, u, k) + L (y − h(x̂)), constant gain L (n × p). A next estimate that is not finite
 // (an unstable gain, a model that overflows) is not taken: the step says so, x̂ stays.
 template <DiscreteModel Model>
-class LuenbergerObserver final : public Observer {
+class LuenbergerObserver final
+    : public detail::PredictUpdateObserver<Model, LuenbergerObserver<Model>> {
+  using Base = detail::PredictUpdateObserver<Model, LuenbergerObserver<Model>>;
+  friend Base;
+
  public:
   LuenbergerObserver(Model model, LuenbergerOptions options)
-      : model_(std::move(model)), options_(detail::validated(std::move(options))) {
-    detail::require_shape("LuenbergerOptions", "gain", options_.gain, model_.states(),
-                          model_.outputs());
+      : Base(std::move(model), kConstantGain, false),
+        options_(detail::validated(std::move(options))) {
+    detail::require_shape("LuenbergerOptions", "gain", options_.gain, this->model_.states(),
+                          this->model_.outputs());
     detail::require_size("LuenbergerOptions", "initial_estimate", options_.initial_estimate,
-                         model_.states());
-    info_.name = options_.name;
+                         this->model_.states());
+    this->info_.name = options_.name;
     reset();
   }
   void reset() override {
     x_ = options_.initial_estimate;
-    clock_.reset();
-  }
-  const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
-                           const Eigen::VectorXd& u) override {
-    require_sample_sizes(name(), k, y, u, model_.outputs(), model_.inputs());
-    step_.failure.clear();
-    step_.failure_message.clear();
-    step_.measurement_missing = !y.array().isFinite().any();
-    if (clock_.place(name(), k, t, step_)) {
-      // x̂ at t_k from x̂_{k−1}: f plus the last sample's correction, then f alone over a gap.
-      Eigen::VectorXd next = x_;
-      for (long j = 0; j < clock_.moves(); ++j) {
-        next = advance(model_, State(next), Input(last_u_), clock_.move(j));
-        if (j == 0) next += correction_;
-      }
-      clock_.commit();
-      accept_finite(next, x_, step_, name(), k);  // an unstable gain L overflows: say so
-      last_u_ = u;
-      correction_ = options_.gain * measured_error(model_, x_, y);
-    }
-    step_.estimate = x_;
-    return step_;
+    pending_ = false;
+    this->reset_clock();
   }
 
  private:
+  // x̂ along the move from x̂_{k−1}: f, plus the last sample's correction on the first move.
+  bool predict(long k, const ModelStep& move) {
+    Eigen::VectorXd next = advance(this->model_, State(x_), this->held_input(), move);
+    if (pending_) next += correction_;
+    pending_ = false;
+    return accept_finite(next, x_, this->step_, this->name(), k);  // an unstable L overflows
+  }
+  void update(long, const Eigen::VectorXd& y) {
+    correction_ = options_.gain * measured_error(this->model_, x_, y);
+    pending_ = true;
+  }
+  const Eigen::VectorXd& estimate() const { return x_; }
+
   using State = ModelVector<double, Model::kStates>;
-  using Input = ModelVector<double, Model::kInputs>;
-  Model model_;
   LuenbergerOptions options_;
-  SampleClock clock_ = SampleClock::of(model_, kConstantGain, false);
-  Eigen::VectorXd x_, last_u_, correction_;
-  ObserverStep step_;
+  Eigen::VectorXd x_, correction_;
+  bool pending_ = false;  // correction_ waits for the next sample's first move
 };
 
 // x̂⁺ = f(x̂, u, k) + Q e + R sat(e / γ), e = y − h(x̂), sat = clamp to [−1, 1] per entry
 // (Q, R: n × p gains; γ > 0 the boundary layer).
 template <DiscreteModel Model>
-class SlidingModeObserver final : public Observer {
+class SlidingModeObserver final
+    : public detail::PredictUpdateObserver<Model, SlidingModeObserver<Model>> {
+  using Base = detail::PredictUpdateObserver<Model, SlidingModeObserver<Model>>;
+  friend Base;
+
  public:
   SlidingModeObserver(Model model, SlidingModeOptions options)
-      : model_(std::move(model)), options_(detail::validated(std::move(options))) {
-    const Eigen::Index n = model_.states(), p = model_.outputs();
+      : Base(std::move(model), kConstantGain, false),
+        options_(detail::validated(std::move(options))) {
+    const Eigen::Index n = this->model_.states(), p = this->model_.outputs();
     detail::require_shape("SlidingModeOptions", "q", options_.q, n, p);
     detail::require_shape("SlidingModeOptions", "r", options_.r, n, p);
     detail::require_size("SlidingModeOptions", "initial_estimate", options_.initial_estimate, n);
-    info_.name = options_.name;
+    this->info_.name = options_.name;
     reset();
   }
   void reset() override {
     x_ = options_.initial_estimate;
-    clock_.reset();
-  }
-  const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
-                           const Eigen::VectorXd& u) override {
-    require_sample_sizes(name(), k, y, u, model_.outputs(), model_.inputs());
-    step_.failure.clear();
-    step_.failure_message.clear();
-    step_.measurement_missing = !y.array().isFinite().any();
-    if (clock_.place(name(), k, t, step_)) {
-      Eigen::VectorXd next = x_;
-      for (long j = 0; j < clock_.moves(); ++j) {
-        next = advance(model_, State(next), Input(last_u_), clock_.move(j));
-        if (j == 0) next += correction_;
-      }
-      clock_.commit();
-      accept_finite(next, x_, step_, name(), k);
-      last_u_ = u;
-      const Eigen::VectorXd e = measured_error(model_, x_, y);
-      correction_ = options_.q * e + options_.r * (e / options_.gamma).cwiseMax(-1.0).cwiseMin(1.0);
-    }
-    step_.estimate = x_;
-    return step_;
+    pending_ = false;
+    this->reset_clock();
   }
 
  private:
+  bool predict(long k, const ModelStep& move) {
+    Eigen::VectorXd next = advance(this->model_, State(x_), this->held_input(), move);
+    if (pending_) next += correction_;
+    pending_ = false;
+    return accept_finite(next, x_, this->step_, this->name(), k);
+  }
+  void update(long, const Eigen::VectorXd& y) {
+    const Eigen::VectorXd e = measured_error(this->model_, x_, y);
+    correction_ = options_.q * e + options_.r * (e / options_.gamma).cwiseMax(-1.0).cwiseMin(1.0);
+    pending_ = true;
+  }
+  const Eigen::VectorXd& estimate() const { return x_; }
+
   using State = ModelVector<double, Model::kStates>;
-  using Input = ModelVector<double, Model::kInputs>;
-  Model model_;
   SlidingModeOptions options_;
-  SampleClock clock_ = SampleClock::of(model_, kConstantGain, false);
-  Eigen::VectorXd x_, last_u_, correction_;
-  ObserverStep step_;
+  Eigen::VectorXd x_, correction_;
+  bool pending_ = false;
 };
 
 // Extended Kalman filter with Jacobians of f and h by forward-mode AD (ceres::Jet). At sample k,
@@ -176,12 +167,18 @@ struct EkfOptions {
 };
 
 template <DiscreteModel Model>
-class ExtendedKalmanFilter final : public Observer {
+class ExtendedKalmanFilter final
+    : public detail::PredictUpdateObserver<Model, ExtendedKalmanFilter<Model>> {
+  using Base = detail::PredictUpdateObserver<Model, ExtendedKalmanFilter<Model>>;
+  friend Base;
+  using Base::model_;
+  using Base::step_;
+
  public:
   ExtendedKalmanFilter(Model model, EkfOptions options)
-      : model_(std::move(model)), initial_(options.initial_estimate) {
+      : Base(std::move(model), "", true), initial_(options.initial_estimate) {
     options.validate();
-    info_.name = options.name;
+    this->info_.name = options.name;
     const Eigen::Index n = model_.states(), p = model_.outputs();
     const detail::Covariances c = detail::covariances_of("EkfOptions", options, n, p);
     q_ = c.process;
@@ -193,26 +190,7 @@ class ExtendedKalmanFilter final : public Observer {
   void reset() override {
     x_ = initial_;
     p_ = p0_;
-    clock_.reset();
-  }
-  const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
-                           const Eigen::VectorXd& u) override {
-    require_sample_sizes(name(), k, y, u, model_.outputs(), model_.inputs());
-    step_.failure.clear();
-    step_.failure_message.clear();
-    step_.measurement_missing = !y.array().isFinite().any();
-    if (!clock_.place(name(), k, t, step_)) {
-      step_.estimate = x_;
-      return step_;
-    }
-    for (long j = 0; j < clock_.moves(); ++j) {
-      if (!predict(k, clock_.move(j))) break;
-    }
-    clock_.commit();
-    last_u_ = u;
-    if (!step_.measurement_missing) update(k, y);
-    step_.estimate = x_;
-    return step_;
+    this->reset_clock();
   }
 
  private:
@@ -223,11 +201,11 @@ class ExtendedKalmanFilter final : public Observer {
   bool predict(long k, const ModelStep& move) {
     Matrix<Model::kStates, Model::kStates> fj;
     const State x(x_);
-    const Input u(last_u_);
+    const Input u = this->held_input();
     state_jacobian(model_, x, u, move, fj);
     const Eigen::VectorXd predicted = advance(model_, x, u, move);
     const Eigen::MatrixXd covariance = fj * p_ * fj.transpose() + move.weight * q_;
-    if (!accept_finite(predicted, x_, step_, name(), k, "the predicted state")) return false;
+    if (!accept_finite(predicted, x_, step_, this->name(), k, "the predicted state")) return false;
     if (covariance.allFinite()) {
       p_ = covariance;
       return true;
@@ -239,6 +217,7 @@ class ExtendedKalmanFilter final : public Observer {
 
   // The update with the outputs measured in y (all of them, or the finite entries).
   void update(long k, const Eigen::VectorXd& y) {
+    if (step_.measurement_missing) return;
     const Eigen::Index n = model_.states();
     Matrix<Model::kOutputs, Model::kStates> jac;
     output_jacobian(model_, State(x_), jac);
@@ -266,15 +245,14 @@ class ExtendedKalmanFilter final : public Observer {
 
   void predicted_failure(long k, const char* what, const char* action) {
     std::ostringstream os;
-    os << name() << ": " << what << " at sample k = " << k << " is not finite; " << action;
+    os << this->name() << ": " << what << " at sample k = " << k << " is not finite; " << action;
     mark_non_finite_estimate(step_, os.str());
   }
 
-  Model model_;
-  SampleClock clock_ = SampleClock::of(model_, "", true);
-  Eigen::VectorXd initial_, x_, last_u_;
+  const Eigen::VectorXd& estimate() const { return x_; }
+
+  Eigen::VectorXd initial_, x_;
   Eigen::MatrixXd q_, r_, p0_, p_;
-  ObserverStep step_;
 };
 
 }  // namespace nlobs

@@ -28,7 +28,7 @@
 #include "nlobs/models/model.hpp"
 #include "nlobs/observers/core/observer.hpp"
 #include "nlobs/observers/core/option_checks.hpp"
-#include "nlobs/observers/core/sample_clock.hpp"
+#include "nlobs/observers/core/predict_update_observer.hpp"
 
 namespace nlobs {
 
@@ -48,11 +48,17 @@ struct UkfOptions {
 };
 
 template <DiscreteModel Model>
-class UnscentedKalmanFilter final : public Observer {
+class UnscentedKalmanFilter final
+    : public detail::PredictUpdateObserver<Model, UnscentedKalmanFilter<Model>> {
+  using Base = detail::PredictUpdateObserver<Model, UnscentedKalmanFilter<Model>>;
+  friend Base;
+  using Base::model_;
+  using Base::step_;
+
  public:
   UnscentedKalmanFilter(Model model, UkfOptions options)
-      : model_(std::move(model)), options_(detail::validated(std::move(options))) {
-    info_.name = options_.name;
+      : Base(std::move(model), "", true), options_(detail::validated(std::move(options))) {
+    this->info_.name = options_.name;
     const Eigen::Index n = model_.states(), p = model_.outputs();
     const detail::Covariances c = detail::covariances_of("UkfOptions", options_, n, p);
     q_ = c.process;
@@ -76,31 +82,11 @@ class UnscentedKalmanFilter final : public Observer {
     x_ = options_.initial_estimate;
     p_ = p0_;
     repairs_ = 0;
-    clock_.reset();
+    this->reset_clock();
   }
 
   // How many times P was repaired (symmetrised and its diagonal raised) since reset().
   int covariance_repairs() const { return repairs_; }
-
-  const ObserverStep& step(long k, double t, const Eigen::VectorXd& y,
-                           const Eigen::VectorXd& u) override {
-    require_sample_sizes(name(), k, y, u, model_.outputs(), model_.inputs());
-    step_.failure.clear();
-    step_.failure_message.clear();
-    step_.measurement_missing = !y.array().isFinite().any();
-    if (!clock_.place(name(), k, t, step_)) {
-      step_.estimate = x_;
-      return step_;
-    }
-    for (long j = 0; j < clock_.moves(); ++j) {
-      if (!predict(k, clock_.move(j))) break;
-    }
-    clock_.commit();
-    last_u_ = u;
-    if (!step_.measurement_missing) update(k, y);
-    step_.estimate = x_;
-    return step_;
-  }
 
  private:
   using State = ModelVector<double, Model::kStates>;
@@ -109,7 +95,7 @@ class UnscentedKalmanFilter final : public Observer {
   bool predict(long k, const ModelStep& move) {
     const Eigen::Index n = model_.states();
     if (!sigma_points(k, "the prediction")) return false;
-    const ModelVector<double, Model::kInputs> u(last_u_);
+    const ModelVector<double, Model::kInputs> u = this->held_input();
     for (Eigen::Index i = 0; i < 2 * n + 1; ++i) {
       chi_.col(i) = Eigen::VectorXd(advance(model_, State(chi_.col(i)), u, move));
     }
@@ -131,6 +117,7 @@ class UnscentedKalmanFilter final : public Observer {
 
   // The update with the outputs measured in y (all of them, or the finite entries).
   void update(long k, const Eigen::VectorXd& y) {
+    if (step_.measurement_missing) return;
     const Eigen::Index n = model_.states();
     if (!sigma_points(k, "the measurement update")) return;
     std::vector<Eigen::Index> rows;
@@ -211,20 +198,19 @@ class UnscentedKalmanFilter final : public Observer {
 
   void fail(long k, const char* what, const char* action) {
     std::ostringstream os;
-    os << name() << ": " << what << " at sample k = " << k << " is not finite or not positive "
+    os << this->name() << ": " << what << " at sample k = " << k
+       << " is not finite or not positive "
        << "definite; " << action;
     mark_non_finite_estimate(step_, os.str());
   }
 
-  Model model_;
+  const Eigen::VectorXd& estimate() const { return x_; }
+
   UkfOptions options_;
-  SampleClock clock_ = SampleClock::of(model_, "", true);
-  Eigen::VectorXd last_u_;
   double lambda_ = 0.0, wm0_ = 0.0, wc0_ = 0.0, wi_ = 0.0;
   Eigen::VectorXd x_;
   Eigen::MatrixXd q_, r_, p0_, p_, chi_, ys_;
   int repairs_ = 0;
-  ObserverStep step_;
 };
 
 }  // namespace nlobs

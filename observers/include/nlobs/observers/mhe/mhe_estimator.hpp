@@ -43,8 +43,9 @@
 // one move of the model's flow, its noise weight · Q (weight = interval / T). A sample at the
 // last one's instant adds its outputs to that node (one measured there already: failure
 // "duplicate_measurement"). A late sample — its time before the last one's — goes into the
-// horizon: into the node of its instant, or as a new node between its neighbours (the flow over
-// both parts of their interval; a fixed-step model refuses one off its grid, "non_uniform"),
+// horizon: into the node of its instant, or as a new node between its neighbours (each part of
+// their interval made what SampleClock makes of it in order: m grid steps with m − 1 nodes
+// without a measurement, or one flow; a fixed-step model refuses one off its grid, "non_uniform"),
 // the oldest node leaving if the horizon overflows; then the estimates x̂_{j|j} of the nodes
 // from it on are re-solved on the horizon up to each (the arrival cost of later steps
 // linearises at them) and the whole horizon is solved. The answer is the one the same samples
@@ -352,8 +353,8 @@ class MheEstimator final : public Observer {
                     const Eigen::VectorXd& u) {
     const double step = clock_.sample_time();
     std::vector<Node> inserted;
-    // Nodes from `from` (exclusive) to `to` (exclusive) held with input `held`, then one at `to`
-    // when `last` says so.
+    // Nodes without a measurement at the grid points strictly between `from` and `to` when
+    // to − from is a multiple m ≥ 2 of T (input `held` over them).
     auto part = [&](double from, double to, const Input& held) {
       const double length = to - from;
       const double m = std::round(length / step);
