@@ -33,6 +33,38 @@ TEST(Models, DiscretisationsConverge) {
   EXPECT_THROW(Discretized<Duffing>(Duffing{}, 0.0), InvalidInput);  // the one exception type
 }
 
+// The flow over any interval (what observers of irregular samples integrate with): f on the
+// grid bit for bit; over 2.5 h three equal RK4 steps, as accurate as the grid's (one period of
+// the oscillator in 8 irregular intervals returns to the start); the adaptive flow agrees; a dt
+// that is negative, not finite or beyond 1e9 steps is refused by name.
+TEST(Models, FlowIntegratesOverAnyInterval) {
+  const double h = 2.0 * M_PI / 40.0;
+  const Discretized<OscillatorNonlinearOutput> rk4(OscillatorNonlinearOutput{}, h, Scheme::kRk4);
+  const OdeintDiscretized<OscillatorNonlinearOutput> adaptive(OscillatorNonlinearOutput{}, h);
+  const Eigen::Vector2d x0(1.0, 0.0);
+  for (long k : {0L, 3L, 1000L}) {
+    EXPECT_EQ(rk4.flow(x0, {}, static_cast<double>(k) * h, h), rk4.f(x0, {}, k));
+  }
+  const double intervals[] = {2.5, 0.3, 7.2, 1.0, 12.0, 0.5, 9.0, 7.5};  // in h: 40 in all
+  Eigen::Vector2d xr = x0, xa = x0;
+  double t = 0.0;
+  for (const double in_steps : intervals) {
+    xr = rk4.flow(xr, {}, t, in_steps * h);
+    xa = adaptive.flow(xa, {}, t, in_steps * h);
+    t += in_steps * h;
+  }
+  Eigen::Vector2d grid = x0;
+  for (long k = 0; k < 40; ++k) grid = rk4.f(grid, {}, k);
+  EXPECT_LT((xr - x0).norm(), 2.0 * (grid - x0).norm());  // substeps ≤ h: the grid's accuracy
+  EXPECT_LT((xr - x0).norm(), 1e-4);
+  EXPECT_LT((xa - x0).norm(), 1e-8);
+  EXPECT_EQ(rk4.flow(x0, {}, 0.0, 0.0), x0);
+  for (const double bad : {-h, std::nan(""), 2e9 * h}) {
+    EXPECT_THROW(rk4.flow(x0, {}, 0.0, bad), InvalidInput) << bad;
+  }
+  EXPECT_THROW(adaptive.flow(x0, {}, 0.0, std::nan("")), InvalidInput);
+}
+
 TEST(Models, OdeintAdaptiveIntegrationIsAccurate) {
   // One period of the oscillator in 10 samples: dopri5 with tight tolerances is exact to
   // ~1e-9, where RK4 with the same sample step is off by ~1e-4.

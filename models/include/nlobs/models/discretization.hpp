@@ -73,9 +73,16 @@ class Discretized : public SampledModel<Model> {
   }
 
   // x(t + dt) from x(t), u held: ⌈dt / h⌉ steps of the scheme of equal length dt / ⌈dt / h⌉ ≤ h
-  // (one step of h when dt = h, so that f is this flow on the grid). dt ≥ 0.
+  // (one step of h when dt = h, so that f is this flow on the grid). Throws InvalidInput unless
+  // 0 ≤ dt ≤ 1e9 h (a bounded number of steps).
   template <typename T>
   State<T> flow(const State<T>& x, const Input& u, double t, double dt) const {
+    if (!(dt >= 0.0) || !(dt <= 1e9 * this->step_)) {
+      std::ostringstream os;
+      os << "Discretized::flow: dt = " << dt
+         << " must be >= 0 and at most 1e9 steps of h = " << this->step_;
+      throw InvalidInput(os.str());
+    }
     const Model& m = this->model_;
     // A dt within rounding of a multiple of h takes that many steps (no sliver of a step).
     const long steps = std::max(1L, static_cast<long>(std::ceil(dt / this->step_ - 1e-9)));

@@ -44,13 +44,15 @@ class OdeintDiscretized : public SampledModel<Model> {
     return flow(x, u, static_cast<double>(k) * this->step_, this->step_);
   }
 
-  // x(t + dt) from x(t), u held, dt ≥ 0 (x itself for dt = 0).
+  // x(t + dt) from x(t), u held, dt ≥ 0 (x itself for dt = 0); throws InvalidInput for a dt that
+  // is not finite.
   template <typename T>
   State<T> flow(const State<T>& x, const Input& u, double t, double dt) const {
     static_assert(std::is_same_v<T, double>,
                   "OdeintDiscretized is evaluated in double only (use Discretized for AD)");
     namespace odeint = boost::numeric::odeint;
     using Buffer = std::vector<double>;
+    if (!std::isfinite(dt)) throw InvalidInput("OdeintDiscretized::flow: dt is not finite");
     if (!(dt > 0.0)) return x;
     Buffer state(x.data(), x.data() + x.size());
     const auto rhs = [this, &u](const Buffer& s, Buffer& ds, double time) {

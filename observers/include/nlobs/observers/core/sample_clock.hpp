@@ -43,12 +43,13 @@ class SampleClock {
   // model, so it is bounded.
   static constexpr double kLongestInterval = 1e6;
 
-  // `sample_time`: T > 0, or 0 for a model that declares none (its first interval is taken);
+  // `sample_time`: T > 0, or 0 for a model that declares none (its first interval is taken; so
+  // is a T that is not finite and > 0);
   // `flow`: the model integrates over any interval; `needs_grid`: empty when the observer
   // integrates over an irregular interval, else why it cannot (the refusal says it);
   // `same_time`: a sample at the last one's time is taken (no move) rather than refused.
   SampleClock(double sample_time, bool flow, std::string needs_grid, bool same_time)
-      : declared_(sample_time),
+      : declared_(std::isfinite(sample_time) && sample_time > 0.0 ? sample_time : 0.0),
         flow_(flow),
         needs_grid_(std::move(needs_grid)),
         same_time_(same_time) {
