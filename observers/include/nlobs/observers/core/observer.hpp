@@ -83,9 +83,12 @@ struct ObserverStep {
   // x̂_k; finite once the observer has started (a PI bank publishes NaN before its first good
   // sample; accept_finite() keeps it finite after).
   Eigen::VectorXd estimate;
-  bool ready = true;                 // false while a window fills (the estimate coasts on f)
-  bool measurement_missing = false;  // y_k had a non-finite entry: skipped, estimate coasts
-  std::optional<Summary> summary;    // the engine's summary when this step solved a window
+  bool ready = true;  // false while a window fills (the estimate coasts on f)
+  // y_k is missing: every entry non-finite for the observers that take the outputs a sample has
+  // (EKF, UKF, MHE, Luenberger, sliding mode), any entry for those that need them all (window and
+  // sampled-data observers); the estimate coasts
+  bool measurement_missing = false;
+  std::optional<Summary> summary;  // the engine's summary when this step solved a window
   // The observer took the answer although summary->usable() is false: a moving-horizon
   // estimator's solve cut short (or its one real-time iteration) still lowered its cost from the
   // warm start. Reports then say "used", not "not used".
