@@ -328,6 +328,13 @@ TEST(SampleTimes, AMheGivenALateMeasurementGivesTheEstimateOfTheDataInOrder) {
   // A flow: the late sample becomes a node between its neighbours, at irregular times.
   EXPECT_LT(late_against_in_order(sampled(), o, irregular_times(40), 20, 0.2), 1e-9);
   EXPECT_LT(late_against_in_order(sampled(), o, irregular_times(40), 6, 0.2), 1e-9);
+  // A late sample whose split brings grid steps (nodes without a measurement) and overflows a
+  // short horizon: the nodes it brings are taken as in order before any of them leaves.
+  MheOptions short_horizon = o;
+  short_horizon.horizon = 3;
+  EXPECT_LT(late_against_in_order(sampled(), short_horizon,
+                                  {0.0, 0.3, 0.75, 0.85, 0.95, 1.05, 1.15, 1.5}, 1, 0.2),
+            1e-9);
   // A fixed-step map: the late sample fills the node of its grid point.
   std::vector<double> grid;
   for (int i = 0; i < 40; ++i) grid.push_back(static_cast<double>(i));

@@ -211,8 +211,8 @@ class ExtendedKalmanFilter final
       return true;
     }
     predicted_failure(k, "the predicted covariance P", "P restarts from P0");
-    p_ = p0_;  // so that the filter can re-acquire
-    return false;
+    p_ = p0_;  // so that the filter can re-acquire; the state moved, so the next moves go on
+    return true;
   }
 
   // The update with the outputs measured in y (all of them, or the finite entries).

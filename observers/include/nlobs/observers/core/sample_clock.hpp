@@ -3,7 +3,7 @@
 // moves its model from one sample to the next by the samples' times. A discrete model steps by
 // T, its sample time (sample_time_of; a model that declares none takes its first interval as T).
 // Sample k at t, after the last one placed at t′:
-//  * on the grid, t − t′ = m·T within the rounding of recorded times (grid_tolerance): m moves
+//  * on the grid, t − t′ = m·T within the rounding of recorded times (tolerance()): m moves
 //    of one step each (m − 1 of them over samples that did not come: a gap, as a missing y), at
 //    the grid times t′ + j·T, so that the rounding of recorded times never enters the estimate;
 //  * off the grid: one move over the actual interval t − t′ when the model has a flow (the
@@ -42,6 +42,13 @@ class SampleClock {
   // The longest interval between two samples, in sample times: a gap is that many steps of the
   // model, so it is bounded.
   static constexpr double kLongestInterval = 1e6;
+
+  // Half-width, in steps T, of "on the grid" (and "the same instant") at time t: recorded times
+  // carry their decimal rounding — six decimals at T = 1/30 are 1e-5 T off — plus a few ulps
+  // of t relative to T. Moves on the grid use the grid time, so the rounding never enters.
+  static double tolerance(double t, double step) {
+    return 1e-4 + 4.0 * std::numeric_limits<double>::epsilon() * std::abs(t) / step;
+  }
 
   // `sample_time`: T > 0, or 0 for a model that declares none (its first interval is taken; so
   // is a T that is not finite and > 0);
@@ -85,14 +92,14 @@ class SampleClock {
     const double last = time();
     const double interval = t - last;
     const double scale = step_ > 0.0 ? step_ : std::abs(interval);
-    const double tolerance =
-        scale > 0.0 ? grid_tolerance(std::max(std::abs(t), std::abs(last)), scale) : 0.0;
-    if (!(tolerance < 0.25)) {
+    const double rounding =
+        scale > 0.0 ? tolerance(std::max(std::abs(t), std::abs(last)), scale) : 0.0;
+    if (!(rounding < 0.25)) {
       return refuse(step, "non_uniform", who, k, t,
                     "the time is too large for the sample time T to be resolved (its rounding "
                     "exceeds a quarter step)");
     }
-    if (interval == 0.0 || (step_ > 0.0 && std::abs(interval) <= tolerance * step_)) {
+    if (interval == 0.0 || (step_ > 0.0 && std::abs(interval) <= rounding * step_)) {
       if (!same_time_) {
         return refuse(step, "non_uniform", who, k, t,
                       "it comes at the last sample's time; this observer takes one sample per "
@@ -115,7 +122,7 @@ class SampleClock {
       return refuse(step, "non_uniform", who, k, t, os.str());
     }
     const double m = std::round(interval / grid);
-    if (m >= 1.0 && std::abs(interval / grid - m) <= tolerance) {
+    if (m >= 1.0 && std::abs(interval / grid - m) <= rounding) {
       pending_.moves = static_cast<long>(m);
       pending_.step = grid;
       return true;

@@ -148,7 +148,7 @@ class MheEstimator final : public Observer {
     step_.measurement_missing = !y.array().isFinite().any();
     step_.summary.reset();
     step_.used_unusable_answer = false;
-    if (!nodes_.empty() && t < clock_.time() - same_instant()) {
+    if (!nodes_.empty() && std::isfinite(t) && t < clock_.time() - same_instant()) {
       late(k, t, y, u);
     } else if (clock_.place(name(), k, t, step_)) {
       if (clock_.moves() == 0 && !nodes_.empty()) {  // a second sample of the last instant
@@ -208,6 +208,9 @@ class MheEstimator final : public Observer {
     State filtered;      // x̂_{i|i}: the estimate from the samples up to this one
   };
   static constexpr double kMissing = std::numeric_limits<double>::quiet_NaN();
+  // The longest part of an interval a late sample may split into grid steps (each a node), in
+  // sample times: beyond it the late sample is dropped, so that its cost stays bounded.
+  static constexpr double kLongestLateSplit = 1e4;
 
   // M⁻¹ of a symmetric positive definite M (validated options, or P = F P⁺ Fᵀ + Q).
   template <typename Matrix>
@@ -220,7 +223,7 @@ class MheEstimator final : public Observer {
   // "The same instant" for sample times: within the rounding of recorded times.
   double same_instant() const {
     const double step = clock_.sample_time();
-    return step > 0.0 ? grid_tolerance(std::abs(clock_.time()), step) * step : 0.0;
+    return step > 0.0 ? SampleClock::tolerance(std::abs(clock_.time()), step) * step : 0.0;
   }
 
   // The node's y, mask and R⁻¹ from y (non-finite entries: not measured).
@@ -329,36 +332,50 @@ class MheEstimator final : public Observer {
         step_.failure_message = os.str();
         return;
       }
-      insert_after(i, k, t, y, u);
+      if (!insert_after(i, k, t, y, u)) {
+        os << " would split an interval of more than " << kLongestLateSplit
+           << " sample times into grid steps; dropped";
+        step_.failure = "late_measurement_dropped";
+        step_.failure_message = os.str();
+        return;
+      }
       from = i + 1;
-      while (nodes_.size() > static_cast<std::size_t>(options_.horizon)) {
+    }
+    // The samples from the late one on are taken again as in order: each x̂_{j|j} re-solved on
+    // the horizon up to it (what the arrival cost of later steps linearises at), the oldest
+    // leaving first whenever that horizon would exceed N; the last is the step's answer.
+    const auto horizon = static_cast<std::size_t>(options_.horizon);
+    for (std::size_t j = from; j < nodes_.size(); ++j) {
+      for (; j + 1 > horizon; --j) {
         drop_oldest(k);
         nodes_.erase(nodes_.begin());
-        if (from > 0) --from;
       }
-    }
-    // The estimates x̂_{j|j} of the samples from the late one on change: each is re-solved on
-    // the horizon up to it (what the arrival cost of the later steps linearises at).
-    for (std::size_t j = from; j + 1 < nodes_.size(); ++j) {
+      if (j + 1 == nodes_.size()) {
+        report(solve(k, j + 1));
+        break;
+      }
       const Summary replay = solve(k, j + 1);
       if (replay.status != Status::kNonFinite) nodes_[j].filtered = nodes_[j].x;
     }
-    report(solve(k, nodes_.size()));
   }
 
   // A node at t between nodes i and i + 1: each part of the interval between them is what
   // SampleClock makes of it in order — a multiple m of T is m steps (with m − 1 nodes without a
   // measurement between), any other length one flow.
-  void insert_after(std::size_t i, long k, double t, const Eigen::VectorXd& y,
+  // False (nothing inserted) when a part would bring more than kLongestLateSplit grid steps.
+  bool insert_after(std::size_t i, long k, double t, const Eigen::VectorXd& y,
                     const Eigen::VectorXd& u) {
     const double step = clock_.sample_time();
+    for (const double length : {t - nodes_[i].t, nodes_[i + 1].t - t}) {
+      if (length / step > kLongestLateSplit) return false;
+    }
     std::vector<Node> inserted;
     // Nodes without a measurement at the grid points strictly between `from` and `to` when
     // to − from is a multiple m ≥ 2 of T (input `held` over them).
     auto part = [&](double from, double to, const Input& held) {
       const double length = to - from;
       const double m = std::round(length / step);
-      if (m >= 2.0 && std::abs(length / step - m) <= grid_tolerance(std::abs(to), step)) {
+      if (m >= 2.0 && std::abs(length / step - m) <= SampleClock::tolerance(std::abs(to), step)) {
         for (long j = 1; j < static_cast<long>(m); ++j) {
           Node gap;
           gap.k = k;
@@ -387,7 +404,7 @@ class MheEstimator final : public Observer {
       return s;
     };
     const auto is_grid_step = [step](double length) {
-      return std::abs(length / step - 1.0) <= grid_tolerance(length, step);
+      return std::abs(length / step - 1.0) <= SampleClock::tolerance(length, step);
     };
     Node* previous = &nodes_[i];
     for (Node& n : inserted) {
@@ -402,6 +419,7 @@ class MheEstimator final : public Observer {
     if (is_grid_step(previous->next.length)) previous->next.weight = 1.0;
     nodes_.insert(nodes_.begin() + static_cast<std::ptrdiff_t>(i + 1), inserted.begin(),
                   inserted.end());
+    return true;
   }
 
   // The step's estimate, summary and signal from the solve of the whole horizon.

@@ -115,6 +115,11 @@ class WindowEstimator final : public Observer {
   // The estimate kept for the window's first sample k − N + 1 (k the model index), coasted on
   // the model; `moved`: k is not the first sample.
   State coasted_guess(long k, bool moved) const;
+  // The entry of history_ for model index k (any sign).
+  std::size_t slot(long k) const {
+    const long length = static_cast<long>(state_->window.length());
+    return static_cast<std::size_t>(((k % length) + length) % length);
+  }
   Summary solve_window(Engine<N>& engine, State& w, long k);
   Summary solve_once(Engine<N>& engine, State& w);
   void choose_gain(const Engine<N>& engine, const State& w, long k);
@@ -301,7 +306,7 @@ const ObserverStep& WindowEstimator<Model>::step(long k, double t, const Eigen::
                   "the state coasted on the model from the last estimate");
   }
   last_u_ = u;
-  history_[static_cast<size_t>(index % length)] = coast_;
+  history_[slot(index)] = coast_;
   step_.estimate = coast_;
   return step_;
 }
@@ -309,7 +314,7 @@ const ObserverStep& WindowEstimator<Model>::step(long k, double t, const Eigen::
 template <DiscreteModel Model>
 auto WindowEstimator<Model>::coasted_guess(long k, bool moved) const -> State {
   const Eigen::Index length = state_->window.length();
-  if (length > 1) return history_[static_cast<size_t>((k + 1) % length)];
+  if (length > 1) return history_[slot(k + 1)];
   if (!moved) return initial_guess_;
   const State next =
       state_->window.model().f(coast_, typename OutputWindow<Model>::Input(last_u_), k - 1);
