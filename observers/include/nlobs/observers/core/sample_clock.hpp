@@ -32,9 +32,10 @@
 namespace nlobs {
 
 // Half-width, in grid steps, of "on the grid" at time t for a grid step T: recorded times carry
-// their decimal rounding, a few ulps of t relative to T.
-inline double grid_tolerance(double t, double step) {
-  return 1e-6 + 4.0 * std::numeric_limits<double>::epsilon() * std::abs(t) / step;
+// their decimal rounding (`rounding` steps; the sampled-data observers' 1e-6 by default), plus a
+// few ulps of t relative to T.
+inline double grid_tolerance(double t, double step, double rounding = 1e-6) {
+  return rounding + 4.0 * std::numeric_limits<double>::epsilon() * std::abs(t) / step;
 }
 
 class SampleClock {
@@ -46,9 +47,7 @@ class SampleClock {
   // Half-width, in steps T, of "on the grid" (and "the same instant") at time t: recorded times
   // carry their decimal rounding — six decimals at T = 1/30 are 1e-5 T off — plus a few ulps
   // of t relative to T. Moves on the grid use the grid time, so the rounding never enters.
-  static double tolerance(double t, double step) {
-    return 1e-4 + 4.0 * std::numeric_limits<double>::epsilon() * std::abs(t) / step;
-  }
+  static double tolerance(double t, double step) { return grid_tolerance(t, step, 1e-4); }
 
   // `sample_time`: T > 0, or 0 for a model that declares none (its first interval is taken; so
   // is a T that is not finite and > 0);
