@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "nlobs/common/printable.hpp"
+
 namespace nlobs {
 
 std::string_view to_string(Status status) {
@@ -33,24 +35,7 @@ std::string_view to_string(Status status) {
 }
 
 std::string quoted_excerpt(std::string_view text, std::size_t max_length) {
-  std::size_t cut = std::min(text.size(), max_length);
-  // Never inside a UTF-8 sequence: back up over continuation bytes (10xxxxxx) at the cut.
-  while (cut > 0 && cut < text.size() && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) {
-    --cut;
-  }
-  std::string out = "'";
-  for (const char c : text.substr(0, cut)) {
-    const auto u = static_cast<unsigned char>(c);
-    if (u < 0x20 || u == 0x7f) {
-      static const char* const kHex = "0123456789abcdef";
-      out += "\\x";
-      out += kHex[u >> 4];
-      out += kHex[u & 15];
-    } else {
-      out += c;
-    }
-  }
-  return out + (cut < text.size() ? "...'" : "'");
+  return "'" + printable(text, max_length) + "'";
 }
 
 }  // namespace nlobs

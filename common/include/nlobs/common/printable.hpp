@@ -3,11 +3,10 @@
 // made safe to echo: a message nlobs prints must not carry a terminal escape sequence, a line
 // break that forges a second line, or ten thousand characters.
 //
-// printable(text, limit): control characters (C0, DEL, the C1 range U+0080..U+009F) become
-// \n, \t, \r, \e or \xHH; bytes that are not valid UTF-8 become \xHH; every other character
-// (UTF-8 included) is kept. The result stops at the first character boundary once it holds
-// `limit` bytes (the last character or escape may end up to 3 bytes past it), and a cut says how
-// many bytes of the text were left out: "…(+N bytes)".
+// printable(text, limit): control characters (C0, DEL, and the C1 range U+0080..U+009F, which
+// some terminals take as escapes) and bytes that are not valid UTF-8 are written as \xNN; every
+// other character (UTF-8 included) is kept. At most `limit` bytes of the text are shown, never
+// half a character, and "..." marks a cut (docs/cli.md: user text in messages).
 //
 // current_exception_text(): inside a catch block, the printable message of the exception being
 // handled: what() for a std::exception, "a non-standard exception" for anything else
@@ -62,47 +61,28 @@ inline void append_hex_escape(std::string& out, unsigned char c) {
 inline std::string printable(std::string_view text, std::size_t limit = kPrintableLimit) {
   std::string out;
   std::size_t i = 0;
-  for (; i < text.size() && out.size() < limit;) {
+  while (i < text.size()) {
     const auto c = static_cast<unsigned char>(text[i]);
-    if (c >= 0x20 && c < 0x7F) {
-      out += static_cast<char>(c);
-      ++i;
-      continue;
-    }
-    if (c < 0x80) {  // C0 controls and DEL
-      switch (c) {
-        case '\n':
-          out += "\\n";
-          break;
-        case '\t':
-          out += "\\t";
-          break;
-        case '\r':
-          out += "\\r";
-          break;
-        case 0x1B:
-          out += "\\e";
-          break;
-        default:
-          detail::append_hex_escape(out, c);
+    std::size_t length = 1;
+    bool escape = c < 0x20 || c == 0x7F;
+    if (c >= 0x80) {
+      length = detail::utf8_sequence_length(text, i);
+      // C1 controls (U+0080..U+009F) are C2 80..C2 9F in UTF-8.
+      const bool c1 = length == 2 && c == 0xC2 && static_cast<unsigned char>(text[i + 1]) < 0xA0;
+      if (length == 0 || c1) {
+        length = 1;
+        escape = true;
       }
-      ++i;
-      continue;
     }
-    const std::size_t length = detail::utf8_sequence_length(text, i);
-    // C1 controls (U+0080..U+009F: C2 80..C2 9F) act as escapes on some terminals.
-    const bool c1 = length == 2 && c == 0xC2 && static_cast<unsigned char>(text[i + 1]) < 0xA0;
-    if (length == 0 || c1) {
+    if (i + length > limit) break;
+    if (escape) {
       detail::append_hex_escape(out, c);
-      ++i;
-      continue;
+    } else {
+      out.append(text.substr(i, length));
     }
-    out.append(text.substr(i, length));
     i += length;
   }
-  if (i < text.size()) {
-    out += "…(+" + std::to_string(text.size() - i) + " bytes)";
-  }
+  if (i < text.size()) out += "...";
   return out;
 }
 

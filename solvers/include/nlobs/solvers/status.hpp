@@ -34,9 +34,9 @@ std::string_view to_string(Status status);
 // Bad input (dimension mismatch, non-finite initial guess, invalid options) throws
 // InvalidInput (nlobs/common/invalid_input.hpp), the message naming what and its value.
 
-// How user text (an engine spec, a CSV cell) appears in an error message: single-quoted, cut
-// to max_length characters ("..." after: a hostile megabyte stays one line), control characters
-// written as \xNN.
+// How user text (an engine spec, a CSV cell) appears in an error message: single-quoted,
+// nlobs::printable() (nlobs/common/printable.hpp): cut to max_length bytes ("..." after: a
+// hostile megabyte stays one line), control characters and invalid UTF-8 written as \xNN.
 inline constexpr std::size_t kExcerptLength = 60;
 std::string quoted_excerpt(std::string_view text, std::size_t max_length = kExcerptLength);
 
