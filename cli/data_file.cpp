@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <istream>
 #include <sstream>
 #include <stdexcept>
@@ -178,9 +179,30 @@ class Reader {
 Measurements parse_measurements_csv(std::istream& in, const std::string& name, Eigen::Index outputs,
                                     Eigen::Index inputs, bool late_rows) {
   Reader reader(name, outputs, inputs, late_rows);
-  std::string line;
-  for (long number = 1; std::getline(in, line); ++number) reader.line(line, number);
-  if (in.bad()) throw std::invalid_argument(name + ": read error");
+  // Lines are read into a buffer of the limit's size, never grown: a file without line breaks
+  // (/dev/zero) is refused at the limit, not read until memory runs out.
+  std::vector<char> buffer(kMaxDataLineBytes + 1);
+  long number = 1;
+  for (;; ++number) {
+    errno = 0;
+    in.getline(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+    const auto count = static_cast<std::size_t>(in.gcount());
+    if (in.bad()) break;
+    if (in.fail()) {
+      if (count == 0) break;  // the end of the file
+      throw std::invalid_argument(name + ":" + std::to_string(number) +
+                                  ": the line is longer than " + std::to_string(kMaxDataLineBytes) +
+                                  " bytes, the limit of a data file's line");
+    }
+    const bool ended = !in.eof();  // the delimiter was extracted (and counted)
+    reader.line(std::string_view(buffer.data(), ended ? count - 1 : count), number);
+    if (!ended) break;
+  }
+  if (in.bad()) {
+    const int error = errno;
+    throw std::invalid_argument(name + ":" + std::to_string(number) + ": read error" +
+                                (error != 0 ? std::string(": ") + std::strerror(error) : ""));
+  }
   return reader.finish();
 }
 

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "output_directory.hpp"
+#include "output_file.hpp"
 
 extern char** environ;
 
@@ -91,12 +92,16 @@ std::string run_gnuplot_script(OutputDirectory& dir, const std::string& script_n
   } catch (const std::exception& e) {
     return e.what();
   }
-  // The log is opened here, so that a failure names it rather than gnuplot.
+  // The log is opened here, so that a failure names it rather than gnuplot; like every output
+  // file it is written under a temporary name and renamed when gnuplot is done.
   const std::filesystem::path log_path = dir.path() / "gnuplot.log";
-  const int log =
-      ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW, 0644);
-  if (log < 0) return "cannot write " + log_path.string() + ": " + std::strerror(errno);
-  dir.note_written("gnuplot.log");
+  std::optional<OutputFile> log_file;
+  try {
+    log_file.emplace(log_path);
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  const int log = log_file->descriptor();
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   // The child starts in dir (no "cd" through a shell), stdin and stdout on /dev/null, stderr
@@ -116,7 +121,6 @@ std::string run_gnuplot_script(OutputDirectory& dir, const std::string& script_n
       setup != 0 ? setup
                  : posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
-  ::close(log);
   if (spawned != 0) {
     return "cannot start " + program + " in " + dir.path().string() + ": " + std::strerror(spawned);
   }
@@ -144,6 +148,12 @@ std::string run_gnuplot_script(OutputDirectory& dir, const std::string& script_n
   set_interruptible_child(0);
   int status = 0;
   while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  try {
+    log_file->commit();
+    dir.note_written("gnuplot.log");
+  } catch (const std::exception& e) {
+    return e.what();
   }
   if (timed_out) {
     char limit[32];

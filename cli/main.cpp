@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <iostream>
 #include <limits>
 #include <sstream>
@@ -13,7 +14,9 @@
 #include <string>
 #include <vector>
 
+#include "descriptor_buffer.hpp"
 #include "list_command.hpp"
+#include "nlobs/common/printable.hpp"
 #include "nlobs/common/version.hpp"
 #include "nlobs/reference/problem_suite.hpp"
 #include "nlobs/registry/plugin.hpp"
@@ -38,21 +41,23 @@ constexpr int kCommandLineError = 1;  // an unknown option, a value that does no
 constexpr int kRunError = 2;          // a scenario, data file or computation that failed
 
 // A finite number in [min, max] (CLI::Range lets NaN through: every comparison with it is false),
-// with the same message for inf and nan.
-CLI::Validator finite_in(double min, double max, const std::string& description) {
+// with the same message for inf and nan; above_min: in (min, max] (every positive subnormal is a
+// positive number).
+CLI::Validator finite_in(double min, double max, const std::string& description,
+                         bool above_min = false) {
   return CLI::Validator(
-      [min, max](std::string& text) {
+      [min, max, above_min](std::string& text) {
         char* end = nullptr;
-        const double v = std::strtod(text.c_str(), &end);
-        const bool ok =
-            end != text.c_str() && *end == '\0' && std::isfinite(v) && v >= min && v <= max;
+        const double v = std::strtod(text.c_str(), &end);  // ERANGE for a subnormal: still exact
+        const bool ok = end != text.c_str() && *end == '\0' && std::isfinite(v) &&
+                        (above_min ? v > min : v >= min) && v <= max;
         if (ok) return std::string();
         std::ostringstream os;
-        os << "'" << text.substr(0, 40) << "' is not a finite number ";
+        os << "'" << nlobs::printable(text, 40) << "' is not a finite number ";
         if (max == std::numeric_limits<double>::max()) {
-          os << ">= " << min;
+          os << (above_min ? "> " : ">= ") << min;
         } else {
-          os << "in " << min << ".." << max;
+          os << "in " << (above_min ? "(" : "[") << min << ", " << max << "]";
         }
         return os.str();
       },
@@ -67,10 +72,17 @@ std::uint64_t parse_seed(const std::string& text) {
   char* end = nullptr;
   const unsigned long long v = digits ? std::strtoull(text.c_str(), &end, 10) : 0;
   if (!digits || errno == ERANGE || end == nullptr || *end != '\0') {
-    throw std::invalid_argument("--seed '" + text.substr(0, 40) +
+    throw std::invalid_argument("--seed '" + nlobs::printable(text, 40) +
                                 "' is not an integer in 0..18446744073709551615");
   }
   return static_cast<std::uint64_t>(v);
+}
+
+// A terminal gets a line rewritten in place; a log (stderr redirected), a line every 10 s of a
+// long suite, whatever stdout is.
+nlobs::cli::SuiteArguments::Progress progress_mode() {
+  return isatty(STDERR_FILENO) == 1 ? nlobs::cli::SuiteArguments::Progress::kTerminal
+                                    : nlobs::cli::SuiteArguments::Progress::kLines;
 }
 
 // The options `nlobs suite` and `nlobs solve SET/NAME` share.
@@ -81,8 +93,7 @@ void add_suite_options(CLI::App* app, nlobs::cli::SuiteArguments& a) {
   app->add_option("--starts", a.starts, "Comma-separated start labels (default: all)");
   app->add_option("--threshold", a.threshold,
                   "Solved when |F|2 <= this at the returned point (default: the set's, 1e-8)")
-      ->check(finite_in(std::numeric_limits<double>::min(), std::numeric_limits<double>::max(),
-                        "X > 0"));
+      ->check(finite_in(0.0, std::numeric_limits<double>::max(), "X > 0", true));
   app->add_option("--budget", a.evaluations_per_dimension,
                   "F evaluations per unknown and one (budget = this * (n + 1)); default 1000")
       ->check(CLI::Range(1L, 1000000L));
@@ -90,9 +101,7 @@ void add_suite_options(CLI::App* app, nlobs::cli::SuiteArguments& a) {
   app->add_option("--csv", a.csv, "Also write the rows as CSV to FILE ('-': stdout, no table)");
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run_command_line(int argc, char** argv) {
   CLI::App app{"nlobs: nonlinear state estimation — solvers and observers"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "nlobs " NLOBS_VERSION_STRING);
@@ -213,10 +222,10 @@ int main(int argc, char** argv) {
                      "SET/NAME:n=K or SET (nlobs list problems)\n";
         return kCommandLineError;
       }
-      solve_args.progress = isatty(STDERR_FILENO);
+      solve_args.progress = progress_mode();
       nlobs::cli::run_problem_suite(solve_selectors, solve_args, "solve", std::cout, std::cerr);
     } else if (*suite) {
-      suite_args.progress = isatty(STDERR_FILENO);
+      suite_args.progress = progress_mode();
       nlobs::cli::run_problem_suite({suite_set}, suite_args, "suite", std::cout, std::cerr);
     } else if (*run) {
       if (*steps_opt) run_options.steps = steps;
@@ -233,9 +242,37 @@ int main(int argc, char** argv) {
     } else if (*list) {
       nlobs::cli::print_list(list_what, std::cout);
     }
-  } catch (const std::exception& e) {
-    std::cerr << "nlobs: error: " << e.what() << '\n';
+  } catch (...) {  // any type: a plugin's code may throw anything
+    // Bounded and escaped: the message may carry a user's text (a name, a cell, an exception's).
+    std::cerr << "nlobs: error: " << nlobs::current_exception_text(4000) << '\n';
     return kRunError;
   }
   return 0;
+}
+
+}  // namespace
+
+// Standard output goes through a DescriptorBuffer, so that a write that fails (a full disk, a
+// closed pipe: `nlobs suite mgh --json > /dev/full`) is an error naming the stream and the
+// system's reason, never a run that exits 0 having lost its output.
+int main(int argc, char** argv) {
+  static nlobs::cli::DescriptorBuffer standard_output;  // outlives cout's flush at exit
+  standard_output.attach(STDOUT_FILENO, isatty(STDOUT_FILENO) == 1);
+  std::streambuf* const original = std::cout.rdbuf(&standard_output);
+  int status = kRunError;
+  try {
+    status = run_command_line(argc, argv);
+  } catch (...) {  // nothing may escape main without a word (CLI11's own exceptions included)
+    std::cerr << "nlobs: error: " << nlobs::current_exception_text() << '\n';
+  }
+  std::cout.flush();
+  if (!standard_output.drain() || !std::cout) {
+    const int error = standard_output.error() != 0 ? standard_output.error() : EIO;
+    std::cerr << "nlobs: error: writing standard output failed: " << std::strerror(error) << '\n';
+    if (status == 0) status = kRunError;
+  }
+  std::cout.rdbuf(original);
+  std::cerr.flush();
+  if (!std::cerr && status == 0) status = kRunError;  // nothing left to say it with
+  return status;
 }

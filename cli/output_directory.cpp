@@ -1,81 +1,29 @@
 #include "output_directory.hpp"
 
-#include <signal.h>
-#include <sys/wait.h>
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <array>
-#include <atomic>
 #include <cerrno>
 #include <cstring>
-#include <fstream>
+#include <map>
 #include <mutex>
 #include <stdexcept>
 #include <system_error>
+
+#include "nlobs/solvers/status.hpp"
 
 namespace nlobs::cli {
 namespace {
 
 namespace fs = std::filesystem;
 
-constexpr std::string_view kTemporarySuffix = ".tmp";
+constexpr std::string_view kOldTemporarySuffix = ".tmp";  // before OutputFile's random names
 
-// Temporaries the signal handler removes. The handler may only read what is lock-free and
-// call async-signal-safe functions (kill, waitpid, unlink, raise): a fixed table of paths,
-// each published by an atomic flag after it is copied.
-constexpr std::size_t kSlots = 64, kPathLength = 4096;
-struct Slot {
-  std::atomic<bool> used{false};
-  std::array<char, kPathLength> path{};
-};
-std::array<Slot, kSlots> g_slots;
-std::atomic<pid_t> g_child{0};
-std::mutex g_slots_mutex;  // between registering threads, never taken by the handler
-static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<pid_t>::is_always_lock_free);
-
-// The slot holding `path`, or -1 when the table is full or the path too long (then a signal
-// may leave that temporary; the next run into the directory removes it).
-int register_temporary(const fs::path& path) {
-  const std::string& text = path.native();
-  if (text.size() >= kPathLength) return -1;
-  const std::lock_guard<std::mutex> lock(g_slots_mutex);
-  for (std::size_t i = 0; i < kSlots; ++i) {
-    if (g_slots[i].used.load()) continue;
-    std::memcpy(g_slots[i].path.data(), text.c_str(), text.size() + 1);
-    g_slots[i].used.store(true);
-    return static_cast<int>(i);
-  }
-  return -1;
-}
-
-void unregister_temporary(int slot) {
-  if (slot >= 0) g_slots[static_cast<std::size_t>(slot)].used.store(false);
-}
-
-extern "C" void remove_temporaries_and_reraise(int signal_number) {
-  const int saved_errno = errno;
-  if (const pid_t child = g_child.load(); child > 0) {
-    ::kill(child, SIGKILL);
-    int status = 0;
-    while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
-    }
-  }
-  for (Slot& slot : g_slots) {
-    if (slot.used.load()) ::unlink(slot.path.data());
-  }
-  errno = saved_errno;
-  // SA_RESETHAND restored the default action: the signal, pending until we return, then
-  // ends the process as it would have without us (exit status by signal).
-  ::raise(signal_number);
-}
-
-std::string temporary_name(const std::string& name) {
-  return name + std::string(kTemporarySuffix);
-}
-
-std::string reason(int error) {
-  return error != 0 ? std::strerror(error) : "input/output error";
+std::string shown(const fs::path& p) {
+  return quoted_excerpt(p.native(), 300);
 }
 
 bool is_signals_png(std::string_view name) {  // signals_<digits>.png
@@ -89,15 +37,109 @@ bool is_signals_png(std::string_view name) {  // signals_<digits>.png
   return std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; });
 }
 
-// Removes a file (or a link) of that name; a directory of that name is the user's and stays.
-void remove_file(const fs::path& p) {
+bool is_final_output_name(std::string_view name) {
+  const auto& names = output_file_names();
+  return is_signals_png(name) || std::find(names.begin(), names.end(), name) != names.end();
+}
+
+// Removes a regular file of that name; anything else under it (a directory, a link, a FIFO) is
+// the user's and stays.
+void remove_regular_file(const fs::path& p) {
+  struct stat st {};
+  if (::lstat(p.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return;
+  if (::unlink(p.c_str()) != 0 && errno != ENOENT) {
+    const int error = errno;
+    throw std::runtime_error("cannot remove " + shown(p) + ": " + std::strerror(error));
+  }
+}
+
+// The directory locks this process holds, by path: run_scenario() locks its --out directory
+// before it computes, the OutputDirectory it then opens shares that lock (a second flock of the
+// same file from this process would refuse it).
+struct HeldLock {
+  int fd = -1;
+  fs::path file;
+  ~HeldLock() {
+    // Removed while still held, so that no later run takes a lock on an unlinked file (the
+    // taker checks the path still names its file).
+    ::unlink(file.c_str());
+    ::close(fd);
+  }
+};
+std::mutex g_locks_mutex;
+std::map<fs::path, std::weak_ptr<HeldLock>> g_locks;
+
+std::shared_ptr<HeldLock> take_lock(const fs::path& directory) {
+  const std::lock_guard<std::mutex> guard(g_locks_mutex);
+  if (auto held = g_locks[directory].lock()) return held;
+  const fs::path file = directory / kOutputLockName;
+  for (int attempt = 0; attempt < 8; ++attempt) {
+    // O_NOFOLLOW | O_NONBLOCK: a link or a FIFO planted under the name is neither followed nor
+    // waited on; it is refused below.
+    const int fd =
+        ::open(file.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC, 0644);
+    if (fd < 0) {
+      const int error = errno;
+      throw std::runtime_error("cannot lock the output directory " + shown(directory) + ": " +
+                               shown(file) + ": " +
+                               (error == ELOOP ? "it is a symbolic link" : std::strerror(error)));
+    }
+    struct stat own {};
+    if (::fstat(fd, &own) != 0 || !S_ISREG(own.st_mode)) {
+      ::close(fd);
+      throw std::runtime_error("cannot lock the output directory " + shown(directory) + ": " +
+                               shown(file) + " is not a regular file");
+    }
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+      const int error = errno;
+      char text[32] = {};
+      const ssize_t n = ::pread(fd, text, sizeof text - 1, 0);
+      ::close(fd);
+      if (error != EWOULDBLOCK) {
+        throw std::runtime_error("cannot lock the output directory " + shown(directory) + ": " +
+                                 std::strerror(error));
+      }
+      std::string pid(text, n > 0 ? static_cast<std::size_t>(n) : 0);
+      pid.erase(std::remove_if(pid.begin(), pid.end(), [](char c) { return c < '0' || c > '9'; }),
+                pid.end());
+      throw std::runtime_error("another nlobs run" + (pid.empty() ? "" : " (pid " + pid + ")") +
+                               " is writing into " + shown(directory) +
+                               "; two runs cannot share an output directory");
+    }
+    struct stat by_name {};
+    if (::stat(file.c_str(), &by_name) == 0 && by_name.st_ino == own.st_ino &&
+        by_name.st_dev == own.st_dev) {
+      const std::string pid = std::to_string(::getpid()) + "\n";
+      if (::ftruncate(fd, 0) == 0) (void)!::pwrite(fd, pid.data(), pid.size(), 0);
+      auto held = std::make_shared<HeldLock>();
+      held->fd = fd;
+      held->file = file;
+      g_locks[directory] = held;
+      return held;
+    }
+    ::close(fd);  // the holder removed the file between our open and our flock: try again
+  }
+  throw std::runtime_error("cannot lock the output directory " + shown(directory) +
+                           ": its lock file keeps changing");
+}
+
+fs::path create_output_directory(const std::string& path) {
+  if (path.empty()) throw std::runtime_error("the output directory has an empty name");
+  const fs::path absolute = fs::absolute(path);
   std::error_code ec;
-  if (fs::is_directory(fs::symlink_status(p, ec))) return;
-  fs::remove(p, ec);
-  if (ec) throw std::runtime_error("cannot remove " + p.string() + ": " + ec.message());
+  fs::create_directories(absolute, ec);
+  if (ec) throw std::runtime_error("cannot create " + shown(absolute) + ": " + ec.message());
+  if (!fs::is_directory(absolute)) {
+    throw std::runtime_error("cannot write into " + shown(absolute) + ": not a directory");
+  }
+  return absolute;
 }
 
 }  // namespace
+
+OutputDirectoryLock::OutputDirectoryLock(const std::string& path)
+    : lock_(take_lock(create_output_directory(path))) {}
+OutputDirectoryLock::~OutputDirectoryLock() = default;
 
 const std::vector<std::string>& output_file_names() {
   static const std::vector<std::string> names = {
@@ -109,116 +151,44 @@ const std::vector<std::string>& output_file_names() {
 }
 
 bool is_output_file_name(std::string_view name) {
-  if (name.ends_with(kTemporarySuffix)) name.remove_suffix(kTemporarySuffix.size());
-  const auto& names = output_file_names();
-  return is_signals_png(name) || std::find(names.begin(), names.end(), name) != names.end();
-}
-
-void install_interrupt_cleanup() {
-  struct sigaction action {};
-  action.sa_handler = remove_temporaries_and_reraise;
-  sigemptyset(&action.sa_mask);
-  action.sa_flags = SA_RESETHAND;
-  for (const int s : {SIGINT, SIGTERM, SIGHUP}) {
-    // A signal the caller ignores (nohup, a background job's SIGINT) stays ignored.
-    struct sigaction previous {};
-    if (::sigaction(s, nullptr, &previous) == 0 && previous.sa_handler == SIG_IGN) continue;
-    ::sigaction(s, &action, nullptr);
+  if (const std::string_view final_name = final_name_of_temporary(name); !final_name.empty()) {
+    return is_final_output_name(final_name);
   }
-}
-
-void set_interruptible_child(pid_t pid) {
-  g_child.store(pid);
+  if (name.ends_with(kOldTemporarySuffix)) name.remove_suffix(kOldTemporarySuffix.size());
+  return is_final_output_name(name);
 }
 
 // ---------------------------------------------------------------------------------------------
 
-struct OutputDirectory::Writer::State {
-  OutputDirectory* owner;
-  std::string name;
-  fs::path final_path, temporary;
-  std::ofstream out;
-  int slot = -1;
-};
-
-OutputDirectory::Writer::Writer(std::unique_ptr<State> state) : state_(std::move(state)) {}
-OutputDirectory::Writer::Writer(Writer&&) noexcept = default;
-
-OutputDirectory::Writer::~Writer() {
-  if (!state_) return;
-  state_->out.close();
-  std::error_code ignored;
-  fs::remove(state_->temporary, ignored);
-  unregister_temporary(state_->slot);
-}
-
-std::ostream& OutputDirectory::Writer::stream() {
-  return state_->out;
-}
+OutputDirectory::Writer::Writer(OutputDirectory& owner, std::string name)
+    : owner_(&owner), name_(std::move(name)), file_(owner.path() / name_) {}
 
 void OutputDirectory::Writer::commit() {
-  State& s = *state_;
-  errno = 0;
-  s.out.flush();
-  if (!s.out) {
-    throw std::runtime_error("writing " + s.temporary.string() + " failed: " + reason(errno));
-  }
-  s.out.close();
-  if (s.out.fail()) {
-    throw std::runtime_error("writing " + s.temporary.string() + " failed: " + reason(errno));
-  }
-  std::error_code ec;
-  fs::rename(s.temporary, s.final_path, ec);
-  if (ec) {
-    throw std::runtime_error("cannot rename " + s.temporary.string() + " to " +
-                             s.final_path.string() + ": " + ec.message());
-  }
-  unregister_temporary(s.slot);
-  s.owner->note_written(s.name);
-  state_.reset();
+  file_.commit();
+  owner_->note_written(name_);
 }
 
 // ---------------------------------------------------------------------------------------------
 
-OutputDirectory::OutputDirectory(const std::string& path) : path_(fs::absolute(path)) {
-  std::error_code ec;
-  fs::create_directories(path_, ec);
-  if (ec) throw std::runtime_error("cannot create " + path_.string() + ": " + ec.message());
-  if (!fs::is_directory(path_)) {
-    throw std::runtime_error("cannot write into " + path_.string() + ": not a directory");
-  }
+OutputDirectory::OutputDirectory(const std::string& path)
+    : path_(create_output_directory(path)), lock_(take_lock(path_)) {
   // From here on the directory is incomplete until its marker is written again.
-  remove_file(path_ / "summary.json");
-  remove_file(path_ / "sweep.csv");
-  for (const std::string& name : output_file_names()) {
-    remove_file(path_ / temporary_name(name));
+  remove_regular_file(path_ / "summary.json");
+  remove_regular_file(path_ / "sweep.csv");
+  // Temporaries a killed run left (the lock says no run is writing here now).
+  std::error_code ec;
+  for (fs::directory_iterator it(path_, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    const bool temporary = !final_name_of_temporary(name).empty() ||
+                           std::string_view(name).ends_with(kOldTemporarySuffix);
+    if (temporary && is_output_file_name(name)) remove_regular_file(it->path());
   }
 }
 
-OutputDirectory::~OutputDirectory() {
-  try {
-    discard_external();
-  } catch (...) {  // nothing may leave a destructor; what is left, the next run removes
-  }
-}
+OutputDirectory::~OutputDirectory() = default;  // the OutputFiles remove their temporaries
 
 OutputDirectory::Writer OutputDirectory::open(const std::string& name) {
-  auto state = std::make_unique<Writer::State>();
-  state->owner = this;
-  state->name = name;
-  state->final_path = path_ / name;
-  state->temporary = path_ / temporary_name(name);
-  std::error_code ignored;
-  fs::remove(state->temporary, ignored);  // never write through a link left under that name
-  state->slot = register_temporary(state->temporary);
-  errno = 0;
-  state->out.open(state->temporary, std::ios::binary | std::ios::trunc);
-  if (!state->out) {
-    const int error = errno;
-    unregister_temporary(state->slot);
-    throw std::runtime_error("cannot write " + state->temporary.string() + ": " + reason(error));
-  }
-  return Writer(std::move(state));
+  return Writer(*this, name);
 }
 
 void OutputDirectory::write(const std::string& name, std::string_view content) {
@@ -228,39 +198,34 @@ void OutputDirectory::write(const std::string& name, std::string_view content) {
 }
 
 std::string OutputDirectory::external(const std::string& name) {
-  const std::string temporary = temporary_name(name);
-  std::error_code ignored;
-  fs::remove(path_ / temporary, ignored);
-  const bool known = std::any_of(external_.begin(), external_.end(),
-                                 [&](const External& e) { return e.name == name; });
-  if (!known) external_.push_back({name, register_temporary(path_ / temporary)});
-  return temporary;
+  for (const External& e : external_) {
+    if (e.name == name) return e.file.temporary().filename().string();
+  }
+  external_.push_back({name, OutputFile(path_ / name)});
+  const fs::path& temporary = external_.back().file.temporary();
+  if (temporary.empty() || temporary.parent_path() != path_) {
+    // A FIFO or device under the name, or a link out of the directory: gnuplot cannot be given
+    // a name relative to DIR for it.
+    external_.pop_back();
+    throw std::runtime_error("cannot plot into " + shown(path_ / name) +
+                             ": it is not a regular file in the output directory");
+  }
+  return temporary.filename().string();
 }
 
 std::vector<std::string> OutputDirectory::commit_external() {
   std::vector<std::string> renamed;
-  for (const External& e : external_) {
-    const fs::path temporary = path_ / temporary_name(e.name);
-    std::error_code ec;
-    if (!fs::is_regular_file(temporary, ec)) continue;
-    fs::rename(temporary, path_ / e.name, ec);
-    if (ec) {
-      throw std::runtime_error("cannot rename " + temporary.string() + " to " + e.name + ": " +
-                               ec.message());
-    }
+  for (External& e : external_) {
+    if (e.file.empty()) continue;  // gnuplot wrote nothing there: discarded below
+    e.file.commit();
     note_written(e.name);
     renamed.push_back(e.name);
   }
-  discard_external();  // unregisters; the renamed ones are gone already
+  external_.clear();  // the uncommitted ones remove their temporaries
   return renamed;
 }
 
 void OutputDirectory::discard_external() {
-  for (const External& e : external_) {
-    std::error_code ignored;
-    fs::remove(path_ / temporary_name(e.name), ignored);
-    unregister_temporary(e.slot);
-  }
   external_.clear();
 }
 
@@ -275,14 +240,13 @@ void OutputDirectory::remove_stale_files() {
   std::error_code ec;
   for (fs::directory_iterator it(path_, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();
-    std::error_code type_error;
-    if (!is_output_file_name(name) || it->is_directory(type_error)) continue;  // not ours
+    if (!is_output_file_name(name)) continue;  // not ours
     if (std::find(written_.begin(), written_.end(), name) == written_.end()) {
       stale.push_back(it->path());
     }
   }
-  if (ec) throw std::runtime_error("cannot list " + path_.string() + ": " + ec.message());
-  for (const fs::path& p : stale) remove_file(p);
+  if (ec) throw std::runtime_error("cannot list " + shown(path_) + ": " + ec.message());
+  for (const fs::path& p : stale) remove_regular_file(p);
 }
 
 }  // namespace nlobs::cli

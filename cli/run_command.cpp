@@ -500,6 +500,9 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
     os << "plot timeout " << options.plot_timeout << " s is out of range: must be in (0, 86400]";
     throw std::invalid_argument(os.str());
   }
+  // Before any computation: a second run into the same --out fails now, not after its work.
+  std::optional<OutputDirectoryLock> out_lock;
+  if (!options.out_dir.empty()) out_lock.emplace(options.out_dir);
   const ModelInstance instance = scenario_model(s);
   const AnyModel& model = instance.discrete;
 

@@ -1,9 +1,11 @@
 #include "suite_command.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <ostream>
 #include <stdexcept>
 
+#include "nlobs/common/printable.hpp"
 #include "nlobs/reference/problem_suite.hpp"
 #include "nlobs/registry/problem_sets.hpp"
 #include "suite_report.hpp"
@@ -33,8 +35,9 @@ void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArg
   double threshold = std::numeric_limits<double>::quiet_NaN();
   for (const std::string& selector : selectors) {
     if (command == "suite" && selector.find('/') != std::string::npos) {
-      throw std::invalid_argument("nlobs suite takes a problem set ('" + selector.substr(0, 60) +
-                                  "' names a problem: nlobs solve " + selector.substr(0, 60) + ")");
+      throw std::invalid_argument(
+          "nlobs suite takes a problem set ('" + nlobs::printable(selector, 60) +
+          "' names a problem: nlobs solve " + nlobs::printable(selector, 60) + ")");
     }
     selections.push_back(select_problems(selector, problem_set_registry()));
     const double t = reference::suite_threshold(*selections.back().set, options);
@@ -46,19 +49,33 @@ void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArg
     total += reference::count_suite_pairs(s.problems, options);
   }
   std::vector<reference::SuiteRow> rows;
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point started = Clock::now();
+  Clock::time_point last_line = started;
+  const auto interval = std::chrono::duration<double>(args.progress_interval_s);
   for (const ProblemSelection& s : selections) {
     reference::SuiteOptions o = options;
-    if (args.progress) {
+    if (args.progress == SuiteArguments::Progress::kTerminal) {
       o.progress = [&, before](int done, int) {
         err << "\rnlobs " << command << ": " << before + done << "/" << total
             << " (problem, start) pairs" << std::flush;
+      };
+    } else if (args.progress == SuiteArguments::Progress::kLines) {
+      o.progress = [&, before](int done, int) {
+        const Clock::time_point now = Clock::now();
+        if (now - last_line < interval) return;
+        last_line = now;
+        err << "nlobs " << command << ": " << before + done << "/" << total
+            << " (problem, start) pairs, "
+            << static_cast<long>(std::chrono::duration<double>(now - started).count()) << " s\n"
+            << std::flush;
       };
     }
     const auto part = reference::run_suite(*s.set, s.problems, solvers, o);
     before += reference::count_suite_pairs(s.problems, options);
     rows.insert(rows.end(), part.begin(), part.end());
   }
-  if (args.progress) err << '\n';
+  if (args.progress == SuiteArguments::Progress::kTerminal) err << '\n';
   if (!args.csv.empty()) write_text_file(args.csv, suite_to_csv(rows), out);
   if (args.json) {
     out << suite_to_json(rows).dump(2) << '\n';

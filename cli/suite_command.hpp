@@ -14,8 +14,13 @@ struct SuiteArguments {
   double threshold = std::numeric_limits<double>::quiet_NaN();  // NaN: each set's own
   long evaluations_per_dimension = 1000;
   bool json = false;
-  std::string csv{};      // a file to write the CSV to ("-": stdout); empty: none
-  bool progress = false;  // a progress line on `err`
+  std::string csv{};  // a file to write the CSV to ("-": stdout); empty: none
+  // Progress on `err`: none; one line rewritten after every (problem, start) pair (a
+  // terminal); or, for a log, a line per pair at most every progress_interval_s seconds, the
+  // first after that long (a short suite prints none).
+  enum class Progress { kNone, kTerminal, kLines };
+  Progress progress = Progress::kNone;
+  double progress_interval_s = 10.0;
 };
 
 // Runs every selector ("SET", "SET/NAME", "SET/NAME:n=K") in turn and prints the table (or

@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "output_file.hpp"
 #include "run_support.hpp"
 
 namespace nlobs::cli {
@@ -131,29 +132,7 @@ void write_text_file(const std::string& path, const std::string& text, std::ostr
     stdout_ << text;
     return;
   }
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) {
-    throw std::runtime_error("cannot write '" + path + "': it is a directory");
-  }
-  const std::string temporary = path + ".tmp-nlobs";
-  {
-    std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
-    if (!file) {
-      throw std::runtime_error("cannot write '" + path + "': " + std::strerror(errno));
-    }
-    file << text;
-    file.close();
-    if (!file) {
-      fs::remove(temporary, ec);
-      throw std::runtime_error("cannot write '" + path + "': the write failed");
-    }
-  }
-  fs::rename(temporary, path, ec);
-  if (ec) {
-    fs::remove(temporary, ec);
-    throw std::runtime_error("cannot write '" + path + "': " + ec.message());
-  }
+  write_output_file(path, text);  // never replaces a link, a FIFO or a device (output_file.hpp)
 }
 
 }  // namespace nlobs::cli

@@ -69,6 +69,46 @@ TEST(Cli, InvalidToleranceIsAnError) {
   EXPECT_NE(r.out.find("--tol"), std::string::npos) << r.out;
 }
 
+// Output lost to a full disk or a closed pipe used to exit 0 (`nlobs suite … --json >
+// /dev/full`): the write to standard output is checked and named.
+TEST(Cli, AFailedWriteToStandardOutputIsAnError) {
+  for (const char* args :
+       {"list", "suite chua-window --solvers newton --json",
+        "solve chua-window --engines newton --no-reference", "run chua-fp --steps 20"}) {
+    // stderr to the pipe, stdout to the full device.
+    std::string command = "(";
+    command += NLOBS_CLI_PATH;
+    command += " ";
+    command += args;
+    command += " 2>&1 >/dev/full)";
+    const CliRun r = nlobs::test::run_shell_command(command);
+    EXPECT_EQ(r.status, 2) << args << ": " << r.out;
+    EXPECT_NE(r.out.find("nlobs: error: writing standard output failed: No space left on device"),
+              std::string::npos)
+        << args << ": " << r.out;
+  }
+}
+
+// As root, `--csv /dev/null` replaced the device node with a regular file.
+TEST(Cli, CsvIntoADeviceIsWrittenNotReplaced) {
+  const CliRun r = run("suite chua-window --solvers newton --csv /dev/null");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_TRUE(std::filesystem::is_character_file("/dev/null"));
+  const CliRun full = run("suite chua-window --solvers newton --csv /dev/full");
+  EXPECT_EQ(full.status, 2) << full.out;
+  EXPECT_NE(full.out.find("writing '/dev/full': No space left on device"), std::string::npos)
+      << full.out;
+  EXPECT_TRUE(std::filesystem::is_character_file("/dev/full"));
+}
+
+// Every positive finite threshold is meaningful; subnormals were refused as "not a finite number".
+TEST(Cli, ThresholdTakesEveryPositiveFiniteNumber) {
+  EXPECT_EQ(run("suite chua-window --solvers newton --threshold 1e-320").status, 0);
+  const CliRun zero = run("suite chua-window --solvers newton --threshold 0");
+  EXPECT_EQ(zero.status, 1);
+  EXPECT_NE(zero.out.find("'0' is not a finite number > 0"), std::string::npos) << zero.out;
+}
+
 // Out-of-range integers are errors naming the option and the range, before anything runs
 // (--seed -1 became 2^64 - 1, huge --steps ended in std::bad_alloc).
 TEST(Cli, OutOfRangeIntegersAreErrors) {
@@ -238,17 +278,26 @@ TEST(Cli, SigtermLeavesNoTemporaryFiles) {
   pid_t pid = 0;
   ASSERT_EQ(posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), env.data()), 0);
   posix_spawn_file_actions_destroy(&actions);
+  // The PNG's temporary (`.states.png.tmp-XXXXXX`), once the fake gnuplot has written into it.
+  const auto started = [&dir] {
+    std::error_code ec;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+      const std::string name = it->path().filename().string();
+      if (name.rfind(".states.png.tmp-", 0) == 0 && fs::file_size(it->path(), ec) > 0) return true;
+    }
+    return false;
+  };
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  while (!fs::exists(dir / "states.png.tmp") && std::chrono::steady_clock::now() < deadline) {
+  while (!started() && std::chrono::steady_clock::now() < deadline) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  ASSERT_TRUE(fs::exists(dir / "states.png.tmp")) << "the fake gnuplot never started";
+  ASSERT_TRUE(started()) << "the fake gnuplot never started";
   ::kill(pid, SIGTERM);
   int status = 0;
   ASSERT_EQ(waitpid(pid, &status, 0), pid);
   EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << status;
   for (const auto& e : fs::directory_iterator(dir)) {
-    EXPECT_NE(e.path().extension(), ".tmp") << e.path();
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
     EXPECT_NE(e.path().extension(), ".png") << e.path();
   }
   EXPECT_FALSE(fs::exists(dir / "summary.json"));

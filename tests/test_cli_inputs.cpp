@@ -120,7 +120,7 @@ TEST(DataFile, OutOfRangeAndInfiniteValuesAreNamed) {
 }
 
 TEST(DataFile, HostileBytesGiveShortMessages) {
-  const std::string huge(1 << 20, 'x');
+  const std::string huge((1 << 20) - 10, 'x');  // just within a line's limit
   const std::string e = parse_error("0," + huge + "\n");
   EXPECT_LT(e.size(), 200U);
   EXPECT_NE(e.find("cell 2 'xxxx"), std::string::npos) << e;
@@ -130,6 +130,22 @@ TEST(DataFile, HostileBytesGiveShortMessages) {
             std::string::npos);
   EXPECT_NE(parse_error("").find("d.csv: no data rows"), std::string::npos);
   EXPECT_NE(parse_error("t,y1\n\n").find("no data rows"), std::string::npos);
+}
+
+// A line of any length used to be read whole: /dev/zero grew to 1 GB, then "read error" named
+// no line.
+TEST(DataFile, ALineBeyondTheLimitIsNamedWithItsNumber) {
+  const std::string beyond = parse_error("t,y1\n0,1\n" + std::string(kMaxDataLineBytes + 1, '0'));
+  EXPECT_NE(beyond.find("d.csv:3: the line is longer than 1048576 bytes"), std::string::npos)
+      << beyond;
+  // At the limit a line is read: what is wrong with it is its number, not its length.
+  const std::string at = parse_error("0," + std::string(kMaxDataLineBytes - 2, '1') + "\n");
+  EXPECT_EQ(at.find("longer than"), std::string::npos) << at.substr(0, 200);
+  EXPECT_NE(at.find("d.csv:1:"), std::string::npos) << at.substr(0, 200);
+  const std::string zeros = error_of([] { read_measurements_csv("/dev/zero", 1, 0); });
+  EXPECT_NE(zeros.find("/dev/zero:1: the line is longer than"), std::string::npos) << zeros;
+  // A last line without a line break is read as a line.
+  EXPECT_EQ(parse("0,1\n1,2").steps(), 2);
 }
 
 TEST(DataFile, InputsAndSeveralOutputs) {

@@ -118,6 +118,55 @@ TEST(Mhe, ItIsTheLibrarysEkfOnALinearModelToo) {
   EXPECT_LT(worst, 1e-9);
 }
 
+// Linear3 counting its evaluations of f (values and AD Jacobians alike).
+struct CountedLinear3 : Linear3 {
+  inline static long evaluations = 0;
+  template <typename T>
+  State<T> f(const State<T>& x, const Input& u, long k) const {
+    ++evaluations;
+    return Linear3::f(x, u, k);
+  }
+};
+
+// A gap of G grid steps brings G − 1 nodes without a measurement. Once none of the horizon's
+// nodes holds one, the minimiser is the model's prediction: the gap then costs a few model
+// evaluations per grid step (it cost a solve of the whole horizon per step, > 2N evaluations,
+// so a gap just under the clock's 10⁶ steps took seconds), and the estimates stay the Kalman
+// filter's.
+TEST(Mhe, AGapCostsPredictionsNotSolvesOfTheHorizon) {
+  constexpr long kHorizon = 20, kGap = 2000;
+  MheEstimator<CountedLinear3> mhe(CountedLinear3{}, linear_options(kHorizon));
+  KalmanReference kalman;
+  const Linear3 model;
+  Eigen::Vector3d x(1.0, 0.0, -1.0);
+  long grid = 0;  // the grid point of the next sample
+  double worst = 0.0, u = 0.0;
+  long gap_evaluations = 0;
+  for (long k = 0; k < 70; ++k) {
+    const bool after_gap = k == 50;
+    if (after_gap) {
+      for (long j = 1; j < kGap; ++j) {  // the grid points the gap skips: no measurement
+        kalman.step(Eigen::Vector2d::Constant(kNaN), u);
+        x = model.f(x, Linear3::Input::Constant(u), grid);
+        ++grid;
+      }
+    }
+    u = std::sin(0.1 * static_cast<double>(k));
+    const Eigen::Vector2d y = model.h(x) + Eigen::Vector2d(0.01, -0.02);
+    const Eigen::Vector3d expected = kalman.step(y, u);
+    const long before = CountedLinear3::evaluations;
+    const ObserverStep& s =
+        mhe.step(k, 0.1 * static_cast<double>(grid), y, Eigen::VectorXd::Constant(1, u));
+    if (after_gap) gap_evaluations = CountedLinear3::evaluations - before;
+    ASSERT_TRUE(s.failure.empty()) << s.failure_message;
+    worst = std::max(worst, (s.estimate - expected).norm() / std::max(1.0, expected.norm()));
+    x = model.f(x, Linear3::Input::Constant(u), grid);
+    ++grid;
+  }
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_LT(gap_evaluations, 10 * kGap) << "a solve of the horizon per grid step of the gap";
+}
+
 TEST(Mhe, ASampleMissingSomeOutputsUsesTheOthers) {
   for (const long horizon : {1L, 6L}) {
     MheEstimator<Linear3> mhe(Linear3{}, linear_options(horizon));
@@ -356,6 +405,10 @@ TEST(Mhe, BadOptionsAreNamed) {
             })).find("initial_covariance must be a finite 3x3 matrix"),
             std::string::npos);
   EXPECT_NE(message(with([](MheOptions& o) { o.horizon = 0; })).find("horizon must be >= 1"),
+            std::string::npos);
+  EXPECT_NE(message(with([](MheOptions& o) {
+              o.horizon = 100000;
+            })).find("horizon = 100000 is above 10000, the longest MheEstimator takes"),
             std::string::npos);
   EXPECT_NE(message(with([](MheOptions& o) { o.step_tolerance = kNaN; })).find("step_tolerance"),
             std::string::npos);

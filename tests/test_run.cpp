@@ -119,7 +119,8 @@ TEST(Run, ChuaFpReproducesThePapersClaims) {
     EXPECT_TRUE(fs::exists(dir / f)) << f;
   }
   for (const auto& entry : fs::directory_iterator(dir)) {
-    EXPECT_NE(entry.path().extension(), ".tmp") << entry.path();  // nothing half-written
+    // Nothing half-written (temporaries: `.NAME.tmp-XXXXXX`).
+    EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
   }
   std::ifstream csv(dir / "trajectories.csv");
   std::string header;

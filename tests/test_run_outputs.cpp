@@ -43,31 +43,44 @@ bool has(const std::vector<std::string>& names, const std::string& name) {
 
 bool any_temporary(const fs::path& dir) {
   for (const auto& e : fs::directory_iterator(dir)) {
-    if (e.path().extension() == ".tmp") return true;
+    const std::string name = e.path().filename().string();
+    if (e.path().extension() == ".tmp" || !final_name_of_temporary(name).empty()) return true;
   }
   return false;
+}
+
+// The temporaries of `final_name` in `dir` (OutputFile's `.NAME.tmp-XXXXXX`).
+int temporaries_of(const fs::path& dir, const std::string& final_name) {
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    n += is_temporary_name_of(e.path().filename().string(), final_name);
+  }
+  return n;
 }
 
 TEST(OutputDirectory, SummaryFirstRemovedStaleNlobsFilesOnly) {
   const fs::path dir = scratch("stale");
   fs::create_directories(dir / "errors.png");  // a directory by an nlobs name is the user's
-  for (const char* f :
-       {"summary.json", "sweep.csv", "signals_3.png", "states.png", "states.png.tmp",
-        "trajectories.csv.tmp", "notes.txt", "signals_x.png", "my.tmp"}) {
+  for (const char* f : {"summary.json", "sweep.csv", "signals_3.png", "states.png",
+                        "states.png.tmp", "trajectories.csv.tmp", ".plots.gp.tmp-Ab12Cd",
+                        "notes.txt", "signals_x.png", "my.tmp", ".notes.txt.tmp-Ab12Cd"}) {
     test::write_file(dir / f, "old");
   }
   OutputDirectory out(dir.string());
-  // From the start the directory no longer claims to be complete; old temporaries are gone.
+  // From the start the directory no longer claims to be complete; old temporaries (of this
+  // version's names and the earlier `NAME.tmp`) are gone.
   EXPECT_FALSE(fs::exists(dir / "summary.json"));
   EXPECT_FALSE(fs::exists(dir / "sweep.csv"));  // a sweep's marker too
   EXPECT_FALSE(fs::exists(dir / "states.png.tmp"));
   EXPECT_FALSE(fs::exists(dir / "trajectories.csv.tmp"));
+  EXPECT_FALSE(fs::exists(dir / ".plots.gp.tmp-Ab12Cd"));
   out.write("trajectories.csv", "t\n0\n");
   out.remove_stale_files();
   out.write("summary.json", "{}");
-  EXPECT_EQ(files_in(dir),
-            (std::vector<std::string>{"errors.png", "my.tmp", "notes.txt", "signals_x.png",
-                                      "summary.json", "trajectories.csv"}));
+  // .nlobs.lock: the run's lock, held while `out` lives.
+  EXPECT_EQ(files_in(dir), (std::vector<std::string>{
+                               ".nlobs.lock", ".notes.txt.tmp-Ab12Cd", "errors.png", "my.tmp",
+                               "notes.txt", "signals_x.png", "summary.json", "trajectories.csv"}));
 }
 
 TEST(OutputDirectory, UncommittedAndExternalTemporariesAreRemoved) {
@@ -77,13 +90,14 @@ TEST(OutputDirectory, UncommittedAndExternalTemporariesAreRemoved) {
     {
       OutputDirectory::Writer w = out.open("trajectories.csv");
       w.stream() << "half";
-      EXPECT_TRUE(fs::exists(dir / "trajectories.csv.tmp"));
+      EXPECT_EQ(temporaries_of(dir, "trajectories.csv"), 1);
     }  // dropped, e.g. by an exception
-    EXPECT_FALSE(fs::exists(dir / "trajectories.csv.tmp"));
+    EXPECT_EQ(temporaries_of(dir, "trajectories.csv"), 0);
     EXPECT_FALSE(fs::exists(dir / "trajectories.csv"));
     const std::string name = out.external("states.png");
-    EXPECT_EQ(name, "states.png.tmp");
-    test::write_file(dir / name, "png");  // as gnuplot would
+    EXPECT_TRUE(is_temporary_name_of(name, "states.png")) << name;
+    EXPECT_EQ(out.external("states.png"), name);  // asked twice: the same file
+    test::write_file(dir / name, "png");          // as gnuplot would
     test::write_file(dir / out.external("errors.png"), "png");
   }  // destroyed before commit_external()
   EXPECT_TRUE(files_in(dir).empty()) << files_in(dir).size();
@@ -91,7 +105,7 @@ TEST(OutputDirectory, UncommittedAndExternalTemporariesAreRemoved) {
   test::write_file(dir / out.external("states.png"), "png");
   out.external("errors.png");  // never drawn: not renamed, nothing left
   EXPECT_EQ(out.commit_external(), std::vector<std::string>{"states.png"});
-  EXPECT_EQ(files_in(dir), std::vector<std::string>{"states.png"});
+  EXPECT_EQ(files_in(dir), (std::vector<std::string>{".nlobs.lock", "states.png"}));
 }
 
 TEST(OutputDirectory, WriteErrorsGiveTheSystemsReason) {
@@ -102,8 +116,10 @@ TEST(OutputDirectory, WriteErrorsGiveTheSystemsReason) {
     out.write("summary.json", "{}");
     ADD_FAILURE() << "no error";
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("summary.json.tmp: No such file or directory"),
+    EXPECT_NE(std::string(e.what()).find("summary.json': cannot create a file in"),
               std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("No such file or directory"), std::string::npos)
         << e.what();
   }
   const fs::path file = scratch("a-file");
@@ -188,7 +204,9 @@ TEST(RunOutputs, AGnuplotThatHangsIsStoppedAndTheRunCompletes) {
   std::optional<test::FakeProgramOnPath> fake;
   // It starts its PNG, then never finishes.
   fake.emplace(scratch("hanging_bin"), "gnuplot",
-               "#!/bin/sh\nprintf partial > states.png.tmp\nexec /bin/sleep 60\n");
+               "#!/bin/sh\n"
+               "out=$(sed -n \"s/^set output '\\(.*\\)'$/\\1/p\" \"$1\" | head -n 1)\n"
+               "printf partial > \"$out\"\nexec /bin/sleep 60\n");
   const fs::path dir = scratch("hanging");
   std::ostringstream out, err;
   RunOptions o;

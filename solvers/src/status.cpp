@@ -35,7 +35,11 @@ std::string_view to_string(Status status) {
 }
 
 std::string quoted_excerpt(std::string_view text, std::size_t max_length) {
-  return "'" + printable(text, max_length) + "'";
+  // Appended, not `"'" + …`: GCC 12 warns (-Wrestrict) on that form wrongly.
+  std::string out = "'";
+  out += printable(text, max_length);
+  out += '\'';
+  return out;
 }
 
 }  // namespace nlobs

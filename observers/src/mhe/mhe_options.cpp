@@ -18,6 +18,13 @@ void MheOptions::validate() const {
   detail::require_covariance(who, "measurement_covariance", measurement_covariance,
                              detail::Definiteness::kDefinite);
   detail::require_at_least(who, "horizon", horizon, 1L);
+  if (horizon > kMaxHorizon) {
+    std::ostringstream os;
+    os << who << ": horizon = " << horizon << " is above " << kMaxHorizon
+       << ", the longest MheEstimator takes (every sample solves the whole horizon, O(N n^3) "
+          "per iteration: docs/observers.md)";
+    throw InvalidInput(os.str());
+  }
   detail::require_at_least(who, "max_iterations", max_iterations, 1L);
   detail::require_positive(who, "step_tolerance", step_tolerance);
   detail::require_positive(who, "cost_tolerance", cost_tolerance);

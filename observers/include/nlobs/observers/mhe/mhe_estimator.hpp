@@ -39,7 +39,9 @@
 // when all are missing.
 //
 // Samples with times (SampleClock): a gap on the model's grid brings one node per skipped grid
-// point, without a measurement (the horizon is N grid points then); an interval off the grid is
+// point, without a measurement (the horizon is N grid points then; while none of its nodes holds
+// a measurement the model's prediction is taken without a solve, predict_unmeasured_horizon());
+// an interval off the grid is
 // one move of the model's flow, its noise weight · Q (weight = interval / T). A sample at the
 // last one's instant adds its outputs to that node (one measured there already: failure
 // "duplicate_measurement"). A late sample — its time before the last one's — goes into the
@@ -137,6 +139,7 @@ class MheEstimator final : public Observer {
     prior_inv_ = p0_inv_;
     estimate_ = prior_;
     late_dropped_ = 0;
+    chain_ = false;
     info_.warnings.clear();
   }
 
@@ -163,6 +166,7 @@ class MheEstimator final : public Observer {
           const auto move = clock_.moves() ? std::optional(clock_.move(j)) : std::nullopt;
           if (j + 1 < moves) {
             append(k, move, t, missing_, Eigen::VectorXd(nodes_.back().u));
+            if (predict_unmeasured_horizon()) continue;
           } else {
             append(k, move, t, y, u);
           }
@@ -434,6 +438,46 @@ class MheEstimator final : public Observer {
 
   State predict(const Node& node) const { return advance(model_, node.x, node.u, node.next); }
 
+  // A node of a gap while no node of the horizon holds a measurement: V's minimiser is then the
+  // model's prediction from x̄ (V = 0 there) whenever it stays in the bounds and the domain, and
+  // Gauss–Newton from the warm start would stop at it after one linearisation. It is taken
+  // without a solve, so that a gap of m grid steps costs m arrival-cost updates (an EKF's
+  // predictions) instead of m solves of the horizon. The chain is extended by its last node
+  // while x̄ is the first node's state (the nodes before it came from the same chain), rebuilt
+  // otherwise. False (nothing changed) when it does not apply.
+  bool predict_unmeasured_horizon() {
+    for (const Node& node : nodes_) {
+      if ((node.measured.array() > 0.0).any()) return false;
+    }
+    const auto usable = [this](const State& x) {
+      return x.allFinite() && (x.array() >= lower_.array()).all() &&
+             (x.array() <= upper_.array()).all() && inside_domain(x);
+    };
+    const std::size_t m = nodes_.size();
+    const std::size_t first = chain_ && nodes_.front().x == prior_ ? m - 1 : 0;
+    for (std::size_t i = first; i < m; ++i) {
+      trial_[i] = i == 0 ? prior_
+                         : advance(model_, i == first ? nodes_[i - 1].x : trial_[i - 1],
+                                   nodes_[i - 1].u, nodes_[i - 1].next);
+      if (!usable(trial_[i])) {
+        chain_ = false;
+        return false;
+      }
+    }
+    for (std::size_t i = first; i < m; ++i) nodes_[i].x = trial_[i];
+    chain_ = true;
+    Summary summary;
+    summary.engine = kEngine;
+    summary.status = Status::kConverged;
+    summary.objective = 0.0;
+    summary.residual_norm = 0.0;
+    summary.step_norm = 0.0;
+    summary.function_evaluations = static_cast<int>(m - first);
+    summary.message = "no measurement in the horizon: the model's prediction from the prior";
+    report(std::move(summary));
+    return true;
+  }
+
   // The filtering update of the arrival cost along the sample that leaves the horizon.
   void drop_oldest(long k) {
     const Node& old = nodes_.front();
@@ -441,9 +485,12 @@ class MheEstimator final : public Observer {
     StateMatrix fj(n, n);
     OutputJacobian hj(model_.outputs(), n);
     state_jacobian(model_, old.filtered, old.u, old.next, fj);
-    output_jacobian(model_, old.filtered, hj);
-    const StateMatrix information = prior_inv_ + hj.transpose() * old.r_inv * hj;
-    const StateMatrix updated = inverse(information);
+    StateMatrix updated = prior_cov_;  // a node without a measurement: P⁺ = P
+    if ((old.measured.array() > 0.0).any()) {
+      output_jacobian(model_, old.filtered, hj);
+      const StateMatrix information = prior_inv_ + hj.transpose() * old.r_inv * hj;
+      updated = inverse(information);
+    }
     StateMatrix covariance = fj * updated * fj.transpose() + old.next.weight * q_;
     covariance = 0.5 * (covariance + covariance.transpose());
     const State mean = advance(model_, old.filtered, old.u, old.next);
@@ -573,6 +620,7 @@ class MheEstimator final : public Observer {
   // Summary, V in its objective; a V not finite at the warm start marks the step.
   Summary solve(long k, std::size_t m) {
     active_ = m;
+    chain_ = false;
     Summary summary;
     summary.engine = kEngine;
     evaluations_ = 0;
@@ -654,6 +702,8 @@ class MheEstimator final : public Observer {
   detail::BlockTridiagonalCholesky<Model::kStates> solver_;
   int evaluations_ = 0;
   std::size_t active_ = 0;  // the nodes of the problem being solved (the first active_)
+  // The nodes' states are the model's prediction chain from x̄ (predict_unmeasured_horizon()).
+  bool chain_ = false;
   SampleClock clock_ = SampleClock::of(model_, "", true);
   Eigen::VectorXd missing_;  // y of a gap's node: no output measured
   long late_dropped_ = 0;

@@ -12,9 +12,13 @@ struct MheOptions {
   Eigen::MatrixXd initial_covariance{};      // P_0 (n × n), the prior's covariance; empty: I
   Eigen::MatrixXd process_covariance{};      // Q (n × n), of w_i; empty: 1e-6 I
   Eigen::MatrixXd measurement_covariance{};  // R (p × p), of v_i; empty: 1e-4 I
-  // N ≥ 1: the samples y_{k−N+1..k} the problem at k holds (the full-information problem on
-  // the samples so far until k + 1 = N).
+  // 1 ≤ N ≤ kMaxHorizon: the samples y_{k−N+1..k} the problem at k holds (the full-information
+  // problem on the samples so far until k + 1 = N).
   long horizon = 10;
+  // Every sample solves the whole horizon, O(N n³) per Gauss–Newton iteration (about 0.7 µs · N
+  // for n = 3, docs/observers.md): N = 10⁴ is some 7 ms a sample, 10⁵ would make a run of 10⁵
+  // samples last hours. Longer horizons are refused rather than left to run.
+  static constexpr long kMaxHorizon = 10000;
   // Box on every state of the horizon, l ≤ x_i ≤ u: empty for no bound on that side, ±inf for
   // no bound on a component; the prior x̄_0 must lie inside.
   Eigen::VectorXd lower_bounds{}, upper_bounds{};
@@ -33,9 +37,9 @@ struct MheOptions {
   double cost_tolerance = 1e-12;
   // Throws InvalidInput naming the field: an empty name; an initial estimate empty or not
   // finite; a covariance given but not square, finite, symmetric and positive definite (the
-  // cost weighs by its inverse); horizon or max_iterations < 1; step_tolerance or cost_tolerance ≤
-  // 0; bounds with NaN, lower > upper, or sizes that differ; an initial estimate outside the
-  // bounds.
+  // cost weighs by its inverse); horizon or max_iterations < 1, horizon > kMaxHorizon;
+  // step_tolerance or cost_tolerance ≤ 0; bounds with NaN, lower > upper, or sizes that differ; an
+  // initial estimate outside the bounds.
   void validate() const;
 };
 
