@@ -41,14 +41,15 @@ sanitize: deps
 	cmake --build build-asan -j $(JOBS)
 	ctest --test-dir build-asan --output-on-failure -j $(JOBS)
 
-# libFuzzer (clang) on the scenario and --data readers, FUZZ_SECONDS per target, seeded, from
-# tests/fuzz/corpus; ASan + UBSan on; a finding fails the target (docs/fuzzing.md).
+# libFuzzer (clang) on the scenario and --data readers and the plugin loader's ELF checks,
+# FUZZ_SECONDS per target, seeded, from tests/fuzz/corpus; ASan + UBSan on; a finding fails the
+# target (docs/fuzzing.md).
 FUZZ_SECONDS ?= 300
 fuzz:
 	@./scripts/ensure-deps.sh fuzz
 	cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER=clang++ -DNLOBS_FUZZ=ON \
 	      -DNLOBS_SANITIZE=ON -DNLOBS_BUILD_TESTS=OFF -DNLOBS_BUILD_BENCH=OFF $(CMAKE_ARGS)
-	cmake --build build-fuzz -j $(JOBS) --target fuzz_scenario fuzz_data_csv
+	cmake --build build-fuzz -j $(JOBS) --target fuzz_scenario fuzz_data_csv fuzz_plugin_file
 	./scripts/run-fuzz build-fuzz $(FUZZ_SECONDS)
 
 format: deps

@@ -4,10 +4,16 @@
 // every library it must (no file, a directory, not a library, not a plugin, another nlobs, a
 // throwing registration, a taken name) with a message naming the plugin, registering nothing.
 // ctest runs every test in its own process: each starts with the built-ins only.
+#include <elf.h>
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
 #include <unistd.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -16,8 +22,10 @@
 
 #include "bad_broyden_engine.hpp"
 #include "cli_test_files.hpp"
+#include "nlobs/common/printable.hpp"
 #include "nlobs/reference/problem_suite.hpp"
 #include "nlobs/registry/plugin.hpp"
+#include "plugin_file.hpp"
 #include "run_command.hpp"
 #include "run_support.hpp"
 #include "scenario.hpp"
@@ -45,6 +53,13 @@ std::string refusal(const std::string& path) {
 
 bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
+}
+
+using test::CliRun;
+
+// `nlobs ARGS` run by the shell after `prefix` (variables, `timeout 60`, `true |`).
+CliRun cli(const std::string& prefix, const std::string& args) {
+  return test::run_shell_command(prefix + " " + std::string(NLOBS_CLI_PATH) + " " + args);
 }
 
 TEST(Plugins, TheExamplePluginRegistersOneEntryOfEachKind) {
@@ -355,12 +370,345 @@ TEST(Plugins, AProgramsOwnRegistrationHasTheSameChecks) {
   EXPECT_EQ(EngineRegistry<Dynamic>::global().source("mine"), "my program");
 }
 
-// The CLI: --plugin (before or after the subcommand, repeatable) and NLOBS_PLUGIN_PATH.
-using test::CliRun;
+// A fresh scratch directory for one test, removed when the test ends.
+struct Scratch {
+  fs::path dir;
+  explicit Scratch(const std::string& name)
+      : dir(fs::temp_directory_path() / ("nlobs-" + name + "-" + std::to_string(getpid()))) {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  }
+  ~Scratch() { fs::remove_all(dir); }
+  std::string write(const std::string& name, const std::string& bytes) const {
+    std::ofstream(dir / name, std::ios::binary) << bytes;
+    return (dir / name).string();
+  }
+};
 
-CliRun cli(const std::string& environment, const std::string& args) {
-  return test::run_shell_command(environment + " " + std::string(NLOBS_CLI_PATH) + " " + args);
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
 }
+
+bool has_control_character(const std::string& text) {
+  for (const char c : text) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7F) return true;
+  }
+  return false;
+}
+
+// dlopen on a FIFO blocks until a writer comes; on a device it reads what the device gives.
+// The loader refuses both by the file's type (stat: through links) before opening anything.
+TEST(Plugins, RefusesAFifoADeviceAndASocketByName) {
+  const Scratch scratch("special");
+  const fs::path fifo = scratch.dir / "libfifo.so";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);
+  // A writer with bytes waiting: a loader that opened the FIFO would read them and fail on
+  // them instead of hanging this test (and name them, not the FIFO).
+  const int writer = open(fifo.c_str(), O_RDWR | O_NONBLOCK);
+  ASSERT_GE(writer, 0);
+  ASSERT_EQ(write(writer, "not a library", 13), 13);
+  std::string why = refusal(fifo.string());
+  EXPECT_EQ(why, "plugin '" + fifo.string() + "' is a FIFO, not a shared library");
+  const fs::path link = scratch.dir / "liblink.so";
+  fs::create_symlink(fifo, link);
+  why = refusal(link.string());
+  EXPECT_EQ(why, "plugin '" + link.string() + "' is a FIFO, not a shared library");
+  close(writer);
+
+  EXPECT_EQ(refusal("/dev/null"), "plugin '/dev/null' is a character device, not a shared library");
+
+  const fs::path socket_path = scratch.dir / "libsocket.so";
+  const int server = socket(AF_UNIX, SOCK_STREAM, 0);
+  ASSERT_GE(server, 0);
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  ASSERT_LT(socket_path.string().size(), sizeof(address.sun_path));
+  std::strcpy(address.sun_path, socket_path.c_str());
+  ASSERT_EQ(bind(server, reinterpret_cast<const sockaddr*>(&address), sizeof(address)), 0);
+  why = refusal(socket_path.string());
+  close(server);
+  EXPECT_EQ(why, "plugin '" + socket_path.string() + "' is a socket, not a shared library");
+}
+
+// The CLI with a FIFO where a plugin is expected: as --plugin, as /dev/stdin on a pipe, as a
+// *.so in a NLOBS_PLUGIN_PATH directory. `timeout` turns a loader that waits into a failure.
+TEST(Plugins, TheCliRefusesAFifoInsteadOfWaitingForAWriter) {
+  const Scratch scratch("cli-fifo");
+  const fs::path fifo = scratch.dir / "libfifo.so";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);
+  const CliRun given = cli("timeout 60", "--plugin " + fifo.string() + " list");
+  EXPECT_EQ(given.status, 2) << given.out;
+  EXPECT_TRUE(contains(
+      given.out, "nlobs: error: plugin '" + fifo.string() + "' is a FIFO, not a shared library"))
+      << given.out;
+  // /dev/stdin of `true | nlobs`: a pipe whose writer has gone.
+  const CliRun stdin_pipe = cli("true | timeout 60", "--plugin /dev/stdin list");
+  EXPECT_EQ(stdin_pipe.status, 2) << stdin_pipe.out;
+  EXPECT_TRUE(contains(stdin_pipe.out, "plugin '/dev/stdin' is a FIFO, not a shared library"))
+      << stdin_pipe.out;
+  // On the path, the FIFO is refused by name, not skipped (a plugin put there would otherwise
+  // go missing without a word); the library beside it sorts after it and is not reached.
+  fs::copy_file(kExample, scratch.dir / "libz_example.so");
+  const CliRun path = cli("NLOBS_PLUGIN_PATH=" + scratch.dir.string() + " timeout 60", "list");
+  EXPECT_EQ(path.status, 2) << path.out;
+  EXPECT_TRUE(contains(path.out, "plugin '" + fifo.string() + "' is a FIFO, not a shared library"))
+      << path.out;
+}
+
+// An interrupted copy: dlopen maps segments past the end of the file and dies of SIGBUS when it
+// touches them. The loader reads the ELF headers first and refuses, at every length.
+TEST(Plugins, ATruncatedLibraryIsRefusedByNameAtEveryLength) {
+  const Scratch scratch("truncated");
+  const std::string library = file_bytes(kExample);
+  ASSERT_GT(library.size(), 10000u);
+  const std::size_t half = library.size() / 2;
+  for (const std::size_t size :
+       {std::size_t{1}, std::size_t{4}, std::size_t{63}, std::size_t{64}, std::size_t{200},
+        std::size_t{4096}, half, library.size() - 4096, library.size() - 1}) {
+    SCOPED_TRACE(size);
+    const std::string path = scratch.write("libcut.so", library.substr(0, size));
+    const std::string why = refusal(path);
+    EXPECT_TRUE(contains(why, "plugin '" + path + "' cannot be loaded: it is truncated: ")) << why;
+    EXPECT_TRUE(size < 64 || contains(why, " of a " + std::to_string(size) + "-byte file")) << why;
+  }
+  // Half the file: a loadable segment reaches past the cut.
+  const std::string path = scratch.write("libhalf.so", library.substr(0, half));
+  const std::string why = refusal(path);
+  EXPECT_TRUE(contains(why, "it is truncated: its program header ")) << why;
+  EXPECT_TRUE(contains(why, " of a " + std::to_string(half) + "-byte file")) << why;
+  // The last byte missing: the section header table ends the file.
+  const std::string short_path =
+      scratch.write("libshort.so", library.substr(0, library.size() - 1));
+  const std::string short_why = refusal(short_path);
+  EXPECT_TRUE(contains(short_why, "it is truncated: its section header table ends at byte " +
+                                      std::to_string(library.size()) + " of a " +
+                                      std::to_string(library.size() - 1) + "-byte file"))
+      << short_why;
+  const std::string header_why = refusal(scratch.write("libheader.so", library.substr(0, 63)));
+  EXPECT_TRUE(contains(header_why, "its ELF header needs 64 bytes, the file has 63")) << header_why;
+  EXPECT_FALSE(model_registry().contains("fitzhugh-nagumo"));
+  // The whole copy passes the same checks and loads.
+  const std::string whole = scratch.write("libwhole.so", library);
+  EXPECT_EQ(load_plugin(whole).models, std::vector<std::string>{"fitzhugh-nagumo"});
+}
+
+// Files that are no shared library for this nlobs, each refused by what is wrong with it.
+TEST(Plugins, AFileThatIsNoLibraryForThisHostIsRefusedByWhatItIs) {
+  const Scratch scratch("not-library");
+  const std::string library = file_bytes(kExample);
+  ASSERT_GE(library.size(), sizeof(Elf64_Ehdr));
+  const auto refused = [&](const std::string& bytes) {
+    return refusal(scratch.write("libx.so", bytes));
+  };
+  const std::string prefix = "cannot be loaded: it ";
+  EXPECT_TRUE(contains(refused(""), prefix + "is empty")) << refused("");
+  EXPECT_TRUE(contains(refused("not a shared library\n"), prefix + "is not an ELF file"));
+  // A header changed field by field (native byte order: this build's).
+  const auto changed = [&](auto change) {
+    std::string bytes = library;
+    Elf64_Ehdr header;
+    std::memcpy(&header, bytes.data(), sizeof(header));
+    change(header);
+    std::memcpy(bytes.data(), &header, sizeof(header));
+    return refused(bytes);
+  };
+  std::string why = changed([](Elf64_Ehdr& h) { h.e_ident[EI_CLASS] = ELFCLASS32; });
+  EXPECT_TRUE(contains(why, prefix + "is a 32-bit ELF file; this nlobs is 64-bit")) << why;
+  why = changed([](Elf64_Ehdr& h) { h.e_ident[EI_DATA] = ELFDATA2MSB; });
+  EXPECT_TRUE(contains(why, prefix + "is big-endian; this machine is little-endian")) << why;
+  why = changed([](Elf64_Ehdr& h) { h.e_machine = EM_S390; });
+  EXPECT_TRUE(contains(why, prefix + "is built for s390; this nlobs runs on ")) << why;
+  why = changed([](Elf64_Ehdr& h) { h.e_type = ET_EXEC; });
+  EXPECT_TRUE(contains(why, prefix + "is not a shared library: it is an executable")) << why;
+  why = changed([](Elf64_Ehdr& h) { h.e_type = ET_REL; });
+  EXPECT_TRUE(contains(why, prefix + "is not a shared library: it is a relocatable object")) << why;
+  why = changed([](Elf64_Ehdr& h) { h.e_phentsize = 32; });
+  EXPECT_TRUE(contains(why, prefix + "has program headers of 32 bytes, not 56")) << why;
+  // Tables beyond any file: their ends are computed without wrapping around.
+  why = changed([](Elf64_Ehdr& h) { h.e_phoff = ~Elf64_Off{0} - 8; });
+  EXPECT_TRUE(
+      contains(why, prefix + "is truncated: its program header table ends beyond byte 2^64"))
+      << why;
+  why = changed([](Elf64_Ehdr& h) { h.e_shoff = ~Elf64_Off{0}; });
+  EXPECT_TRUE(
+      contains(why, prefix + "is truncated: its section header table ends beyond byte 2^64"))
+      << why;
+  EXPECT_FALSE(model_registry().contains("fitzhugh-nagumo"));
+}
+
+// The seeds of fuzz_plugin_file (tests/fuzz/make_plugin_file_corpus.py) get the verdicts they
+// were written for: the checks accept a well-formed file, extended numbering included, and
+// name what is wrong with each damaged one.
+TEST(Plugins, TheElfChecksGiveTheFuzzSeedsTheirVerdicts) {
+  if (plugin_file::detail::kHostMachine != EM_X86_64) GTEST_SKIP() << "the seeds are x86-64";
+  const std::vector<std::pair<std::string, std::string>> seeds = {
+      {"minimal.so", ""},
+      {"extended_numbering.so", ""},
+      {"header_only.so", ""},
+      {"truncated_header.so", "is truncated: its ELF header needs 64 bytes, the file has 40"},
+      {"truncated_segment.so",
+       "is truncated: its program header 0 ends at byte 65536 of a "
+       "384-byte file"},
+      {"truncated_sections.so",
+       "is truncated: its section header table ends at byte 384 of a "
+       "383-byte file"},
+      {"executable.so", "is not a shared library: it is an executable"},
+      {"elf32.so", "is a 32-bit ELF file; this nlobs is 64-bit"},
+      {"big_endian.so", "is big-endian; this machine is little-endian"},
+      {"text.so", "is not an ELF file (a shared library starts with \\x7fELF)"}};
+  for (const auto& [name, expected] : seeds) {
+    SCOPED_TRACE(name);
+    const std::string bytes = file_bytes(std::string(NLOBS_PLUGIN_FILE_CORPUS) + "/" + name);
+    ASSERT_FALSE(bytes.empty());
+    EXPECT_EQ(plugin_file::elf_problem(bytes), expected);
+  }
+}
+
+// An engine entry of the given name (the example's Broyden engine).
+EngineRegistry<Dynamic>::Entry engine_named(const std::string& name) {
+  return {.name = name, .make = [](EngineSpecReader&, SolverOptions o) {
+            return std::unique_ptr<Engine<>>(new example::BadBroydenEngine<>(o, {}));
+          }};
+}
+
+// What the captureless registration below stages (PluginRegistration is a function pointer).
+std::string staged_name;
+
+// One name rule for models, observer types, engines and problem sets (registry_name.hpp):
+// 1 to 64 of [A-Za-z0-9_.+-], refused by name with the name made printable, wherever it is
+// added: through a plugin's registrar or a registry's own add.
+TEST(Plugins, OneNameRuleForEveryRegistryBoundedAndPrintable) {
+  const std::string longest(64, 'n');
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"", "is empty"},
+      {"line\nbreak", "'line\\nbreak' from my program has '\\n' at byte 5"},
+      {"\x1b[31mred", "'\\e[31mred' from my program has '\\e' at byte 1"},
+      {"tab\there", "has '\\t' at byte 4"},
+      {"bell\a", "has '\\x07' at byte 5"},
+      {"quote'd", "has ''' at byte 6"},
+      {"\"quoted\"", "has '\"' at byte 1"},
+      {"my engine", "has ' ' at byte 3"},
+      {"anderson:m=3", "has ':' at byte 9"},
+      {"a,b", "has ',' at byte 2"},
+      {"a=b", "has '=' at byte 2"},
+      {"set/name", "has '/' at byte 4"},
+      {"caf\xc3\xa9", "has '\\xc3' at byte 4"},
+      {longest + "n", "has 65 bytes, more than 64"},
+      {std::string(10000, 'x'), "has 10000 bytes, more than 64"}};
+  for (const auto& [name, expected] : bad) {
+    SCOPED_TRACE(printable(name, 40));
+    staged_name = name;
+    const auto stage_engine = [](PluginRegistrar& r) { r.add_engine(engine_named(staged_name)); };
+    std::string why;
+    try {
+      register_extensions(stage_engine, "my program");
+      ADD_FAILURE() << "a bad engine name was registered";
+    } catch (const InvalidInput& e) {
+      why = e.what();
+    }
+    EXPECT_TRUE(contains(why, "engine name '")) << why;
+    EXPECT_TRUE(contains(why, expected)) << why;
+    EXPECT_TRUE(contains(why, "(a name is 1 to 64 characters: ASCII letters, digits and _ . + -)"))
+        << why;
+    EXPECT_FALSE(has_control_character(why)) << why;
+    EXPECT_LT(why.size(), 300u) << why;  // the name is cut at 60 bytes
+    // The registries' own add() applies the same rule.
+    try {
+      EngineRegistry<Dynamic>::global().add(engine_named(name), "my program");
+      ADD_FAILURE() << "EngineRegistry::add took a bad name";
+    } catch (const InvalidInput& e) {
+      EXPECT_TRUE(contains(e.what(), expected)) << e.what();
+      EXPECT_FALSE(has_control_character(e.what())) << e.what();
+    }
+    try {
+      problem_set_registry().add(
+          {.name = name, .problems = [] { return std::vector<TestProblem>{}; }}, "my program");
+      ADD_FAILURE() << "NamedRegistry::add took a bad name";
+    } catch (const InvalidInput& e) {
+      EXPECT_TRUE(contains(e.what(), "problem set name '")) << e.what();
+      EXPECT_TRUE(contains(e.what(), expected)) << e.what();
+      EXPECT_FALSE(has_control_character(e.what())) << e.what();
+    }
+  }
+  // 64 characters, and every kind of character the rule allows, make names.
+  const auto good = [](PluginRegistrar& r) {
+    r.add_engine(engine_named(std::string(64, 'n')));
+    r.add_engine(engine_named("Az09_.+-"));
+    r.add_problem_set(
+        {.name = std::string(64, 'n'), .problems = [] { return std::vector<TestProblem>{}; }});
+  };
+  const LoadedPlugin loaded = register_extensions(good, "my program");
+  EXPECT_EQ(loaded.engines, (std::vector<std::string>{longest, "Az09_.+-"}));
+  EXPECT_TRUE(problem_set_registry().contains(longest));
+}
+
+// What the loader echoes of a user's or a plugin's text goes through printable(): a path with
+// a line break or a terminal escape, dlopen's message (which repeats the path), a registration's
+// exception text of any type, a program's source name.
+TEST(Plugins, PathsAndExceptionTextsAreEchoedPrintable) {
+  const Scratch scratch("echo");
+  const fs::path evil = scratch.dir / "dir\nnlobs: fake line \x1b[2J";
+  fs::create_directories(evil);
+  const std::string shown = printable((evil / "libthrowing.so").string());
+  EXPECT_TRUE(contains(shown, "dir\\nnlobs: fake line \\e[2J")) << shown;
+  // The throwing plugin: the path twice (the plugin, the source of its registration).
+  fs::copy_file(test_plugin("test_plugin_throwing"), evil / "libthrowing.so");
+  std::string why = refusal((evil / "libthrowing.so").string());
+  EXPECT_FALSE(has_control_character(why)) << why;
+  EXPECT_TRUE(
+      contains(why, "plugin '" + shown + "' refused: " + shown + ": its registration threw"))
+      << why;
+  // An ELF header alone passes the file checks and reaches dlopen, whose message names the path.
+  std::string header = file_bytes(kExample).substr(0, sizeof(Elf64_Ehdr));
+  Elf64_Ehdr h;
+  std::memcpy(&h, header.data(), sizeof(h));
+  h.e_phnum = 0;
+  h.e_shnum = 0;
+  h.e_shoff = 0;
+  std::memcpy(header.data(), &h, sizeof(h));
+  std::ofstream(evil / "libheader.so", std::ios::binary) << header;
+  why = refusal((evil / "libheader.so").string());
+  EXPECT_TRUE(contains(why, "cannot be loaded: ")) << why;
+  EXPECT_TRUE(contains(why, "fake line \\e[2J/libheader.so: ")) << why;  // dlopen's message
+  EXPECT_FALSE(has_control_character(why)) << why;
+  // A missing file and a directory, named printable as well.
+  why = refusal((evil / "libmissing.so").string());
+  EXPECT_TRUE(contains(why, ": no such file")) << why;
+  EXPECT_FALSE(has_control_character(why)) << why;
+  EXPECT_FALSE(has_control_character(refusal(evil.string())));
+
+  // Exceptions of a program's registration: any text, any type.
+  const auto throws_text = [](PluginRegistrar&) {
+    throw std::runtime_error("bad\nnlobs: error: forged\x1b[0m");
+  };
+  try {
+    register_extensions(throws_text, "my\nprogram");
+    ADD_FAILURE() << "a throwing registration was accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "my\\nprogram: its registration threw: bad\\nnlobs: error: forged\\e[0m (nothing of "
+              "it was registered)");
+  }
+  const auto throws_int = [](PluginRegistrar&) { throw 42; };
+  try {
+    register_extensions(throws_int, "my program");
+    ADD_FAILURE() << "a throwing registration was accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "my program: its registration threw: a non-standard exception (nothing of it was "
+              "registered)");
+  }
+  // The source a registry keeps is the printable one (`nlobs list` prints it).
+  const auto good = [](PluginRegistrar& r) {
+    r.add_problem_set({.name = "echo-set", .problems = [] { return std::vector<TestProblem>{}; }});
+  };
+  EXPECT_EQ(register_extensions(good, "my\x1b]0;title\a program").source,
+            "my\\e]0;title\\x07 program");
+  EXPECT_EQ(problem_set_registry().source("echo-set"), "my\\e]0;title\\x07 program");
+}
+
+// The CLI: --plugin (before or after the subcommand, repeatable) and NLOBS_PLUGIN_PATH.
 
 TEST(Plugins, TheCliLoadsPluginsFromTheCommandLineAndThePath) {
   const CliRun list = cli("", "--plugin " + kExample + " list");

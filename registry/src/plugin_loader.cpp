@@ -1,6 +1,11 @@
 #include <dlfcn.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <optional>
 #include <set>
@@ -8,11 +13,19 @@
 #include <system_error>
 #include <vector>
 
+#include "nlobs/common/printable.hpp"
+#include "nlobs/common/registry_name.hpp"
 #include "nlobs/registry/plugin.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
+#include "plugin_file.hpp"
 
 namespace nlobs {
 namespace {
+
+// A plugin's path as the registries keep it (its entries' source, `nlobs list`'s "from …"):
+// printable, so that a path with a control character cannot forge a line, and long enough
+// (PATH_MAX) that two plugins never share one.
+constexpr std::size_t kSourceLimit = 4096;
 
 // Every name the staged registration adds, checked before anything is added: the registry's
 // name rule, not taken (by whom), not twice in the same registration.
@@ -36,8 +49,7 @@ void check_registry_names(const std::vector<Entry>& staged, const NamedRegistry<
                           const std::string& source) {
   for (const Entry& e : staged) {
     if (!is_registry_name(e.name)) {
-      throw InvalidInput(registry.kind() + " name '" + e.name.substr(0, 60) + "' from " + source +
-                         " is empty or has characters other than letters, digits and _ . + -");
+      throw InvalidInput(registry_name_refusal(registry.kind(), e.name, source));
     }
   }
   check_names(staged, registry.kind(), source,
@@ -68,10 +80,8 @@ void check_staged(const PluginRegistrar& staged, const std::string& source) {
   check_registry_names(staged.observer_types(), observer_type_registry(), source);
   check_registry_names(staged.problem_sets(), problem_set_registry(), source);
   for (const auto& e : staged.engines()) {
-    if (e.name.empty() || e.name.find_first_of(":,=") != std::string::npos) {
-      throw InvalidInput("engine name '" + e.name.substr(0, 60) + "' from " + source +
-                         " is empty or contains ':', ',' or '='");
-    }
+    if (!is_registry_name(e.name))
+      throw InvalidInput(registry_name_refusal("engine", e.name, source));
     if (!e.make) throw InvalidInput("engine '" + e.name + "' from " + source + " has no factory");
   }
   check_names(staged.engines(), "engine", source, engine_source);
@@ -113,27 +123,75 @@ LoadedPlugin commit(const PluginRegistrar& staged, const std::string& source) {
   return loaded;
 }
 
+// A user's text in quotes, made printable (nlobs/common/printable.hpp). Appended, not
+// `"'" + printable(text)`: GCC 12 warns of a false -Wrestrict on that form.
 std::string quoted(const std::string& text) {
-  return "'" + (text.size() > 200 ? text.substr(0, 200) + "…" : text) + "'";
+  std::string out = "'";
+  out += printable(text);
+  out += '\'';
+  return out;
 }
 
-}  // namespace
+// What a stat or fstat says a path is, when it is not a file dlopen can be given: dlopen on a
+// FIFO blocks forever waiting for a writer, on a device it reads whatever the device gives.
+std::string not_a_file(mode_t mode) {
+  if (S_ISREG(mode)) return {};
+  if (S_ISDIR(mode)) return "is a directory (NLOBS_PLUGIN_PATH takes directories)";
+  if (S_ISFIFO(mode)) return "is a FIFO, not a shared library";
+  if (S_ISCHR(mode)) return "is a character device, not a shared library";
+  if (S_ISBLK(mode)) return "is a block device, not a shared library";
+  if (S_ISSOCK(mode)) return "is a socket, not a shared library";
+  return "is not a regular file, not a shared library";
+}
 
-LoadedPlugin register_extensions(PluginRegistration registration, const std::string& source) {
-  if (source.empty()) throw InvalidInput("register_extensions: the source has no name");
+// Closes the descriptor it holds when it goes out of scope.
+struct FileDescriptor {
+  int fd = -1;
+  ~FileDescriptor() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+// Why the file at `file` (an absolute path, already stat'ed as a regular file) must not be
+// given to dlopen; empty when it may. The checks read an open descriptor, not the path again:
+// O_NONBLOCK so that a path swapped for a FIFO since the stat cannot block the open, fstat so
+// that what is checked is what was opened.
+std::string file_problem(const std::string& file) {
+  FileDescriptor opened{::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY)};
+  if (opened.fd < 0) return std::string("cannot be read: ") + std::strerror(errno);
+  struct stat status {};
+  if (::fstat(opened.fd, &status) != 0) {
+    return std::string("cannot be read: ") + std::strerror(errno);
+  }
+  if (std::string kind = not_a_file(status.st_mode); !kind.empty()) return kind;
+  const auto read_at = [fd = opened.fd](std::uint64_t offset, std::size_t count, void* out) {
+    auto* bytes = static_cast<char*>(out);
+    while (count > 0) {
+      const ssize_t got = ::pread(fd, bytes, count, static_cast<off_t>(offset));
+      if (got < 0 && errno == EINTR) continue;
+      if (got <= 0) return false;  // an error, or the file shrank since fstat
+      bytes += got;
+      offset += static_cast<std::uint64_t>(got);
+      count -= static_cast<std::size_t>(got);
+    }
+    return true;
+  };
+  const std::string problem =
+      plugin_file::elf_problem(static_cast<std::uint64_t>(status.st_size), read_at);
+  return problem.empty() ? problem : "it " + problem;
+}
+
+// register_extensions with `source` already made printable (the loader's, up to kSourceLimit).
+LoadedPlugin register_printable(PluginRegistration registration, const std::string& source) {
   if (registration == nullptr) {
     throw InvalidInput(source + ": no registration function");
   }
   PluginRegistrar staged;
   try {
     registration(staged);
-  } catch (const std::exception& e) {
-    throw InvalidInput(source + ": its registration threw: " + std::string(e.what()) +
+  } catch (...) {  // of any type: a plugin may throw anything
+    throw InvalidInput(source + ": its registration threw: " + current_exception_text() +
                        " (nothing of it was registered)");
-  } catch (...) {
-    throw InvalidInput(source +
-                       ": its registration threw a non-standard exception (nothing of it was "
-                       "registered)");
   }
   try {
     return commit(staged, source);
@@ -142,22 +200,42 @@ LoadedPlugin register_extensions(PluginRegistration registration, const std::str
   }
 }
 
+}  // namespace
+
+LoadedPlugin register_extensions(PluginRegistration registration, const std::string& source) {
+  if (source.empty()) throw InvalidInput("register_extensions: the source has no name");
+  return register_printable(registration, printable(source, kSourceLimit));
+}
+
 LoadedPlugin load_plugin(const std::string& path) {
   namespace fs = std::filesystem;
-  const std::string named = "plugin " + quoted(path);
-  std::error_code ec;
   if (path.empty()) throw InvalidInput("plugin path is empty");
-  const fs::file_status status = fs::status(path, ec);
-  if (status.type() == fs::file_type::not_found) throw InvalidInput(named + ": no such file");
-  if (ec) throw InvalidInput(named + " cannot be read: " + ec.message());
-  if (fs::is_directory(status)) {
-    throw InvalidInput(named + " is a directory (NLOBS_PLUGIN_PATH takes directories)");
+  const std::string named = "plugin " + quoted(path);
+  // stat, not lstat: a link to a plugin is a plugin, a link to a FIFO is a FIFO.
+  struct stat status {};
+  if (::stat(path.c_str(), &status) != 0) {
+    const int error = errno;
+    if (error == ENOENT) throw InvalidInput(named + ": no such file");
+    throw InvalidInput(named + " cannot be read: " + std::strerror(error));
+  }
+  if (const std::string kind = not_a_file(status.st_mode); !kind.empty()) {
+    throw InvalidInput(named + " " + kind);
   }
   // An absolute path: dlopen searches the library path for a name without '/', and the
   // registries name this file as the source of its entries.
+  std::error_code ec;
   fs::path absolute = fs::absolute(path, ec);
   const std::string file = ec ? path : absolute.lexically_normal().string();
   const std::string plugin = "plugin " + quoted(file);
+  const std::string source = printable(file, kSourceLimit);
+
+  // The file's type and ELF headers are checked on a descriptor, then dlopen is given the path
+  // (not /proc/self/fd/N: the library keeps the name it is loaded by, for $ORIGIN in its
+  // RUNPATH, for dladdr and backtraces, and for dlopen's own "already loaded" check). Whoever
+  // can swap the file between the two can as well write code into it.
+  if (const std::string problem = file_problem(file); !problem.empty()) {
+    throw InvalidInput(plugin + " cannot be loaded: " + problem);
+  }
 
   // A library that loaded is never unloaded, refused or not: its static constructors have run,
   // an exception or an entry may still refer to its code, and template statics (GNU unique
@@ -166,7 +244,7 @@ LoadedPlugin load_plugin(const std::string& path) {
   void* library = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!library) {
     const char* why = dlerror();
-    throw InvalidInput(plugin + " cannot be loaded: " + (why ? why : "dlopen failed"));
+    throw InvalidInput(plugin + " cannot be loaded: " + (why ? printable(why) : "dlopen failed"));
   }
   using InfoFunction = const PluginInfo* (*)();
   void* symbol = dlsym(library, kPluginSymbol);
@@ -178,7 +256,8 @@ LoadedPlugin load_plugin(const std::string& path) {
   try {
     info = reinterpret_cast<InfoFunction>(symbol)();
   } catch (...) {
-    throw InvalidInput(plugin + " is not an nlobs plugin: its " + kPluginSymbol + " threw");
+    throw InvalidInput(plugin + " is not an nlobs plugin: its " + kPluginSymbol +
+                       " threw: " + current_exception_text());
   }
   if (info == nullptr || info->magic != kPluginMagic) {
     throw InvalidInput(plugin + " is not an nlobs plugin: its " + kPluginSymbol +
@@ -200,11 +279,11 @@ LoadedPlugin load_plugin(const std::string& path) {
                        NLOBS_PLUGIN_ABI_TAG + "': rebuild it with the same compiler setup");
   }
   try {
-    return register_extensions(info->registration, file);
+    return register_printable(info->registration, source);
   } catch (const InvalidInput& e) {
     throw InvalidInput(plugin + " refused: " + e.what());
-  } catch (const std::exception& e) {  // out of memory while its entries were added
-    throw InvalidInput(plugin + " could not be registered: " + e.what());
+  } catch (...) {  // out of memory while its entries were added
+    throw InvalidInput(plugin + " could not be registered: " + current_exception_text());
   }
 }
 
@@ -222,6 +301,9 @@ std::vector<LoadedPlugin> load_plugin_path(const std::string& list) {
       std::vector<std::string> files;
       fs::directory_iterator it(item, ec), last;
       for (; !ec && it != last; it.increment(ec)) {
+        // Every *.so but a directory: a FIFO, device or socket among them is refused by
+        // load_plugin by name (not skipped: a plugin the user put there would go missing
+        // silently, and dlopen would block on a FIFO).
         std::error_code kind;
         if (it->path().extension() == ".so" && !it->is_directory(kind)) {
           files.push_back(it->path().string());

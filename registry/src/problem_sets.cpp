@@ -4,6 +4,8 @@
 #include <set>
 #include <sstream>
 
+#include "nlobs/common/printable.hpp"
+#include "nlobs/common/registry_name.hpp"
 #include "problem_sets/builtin_problem_sets.hpp"
 
 namespace nlobs {
@@ -24,8 +26,8 @@ std::string shape(Index n) {
 void validate_test_problem(const TestProblem& p, std::string_view where) {
   const Index n = p.residual.size();
   if (!is_registry_name(p.name)) {
-    throw InvalidInput(std::string(where) + ": problem name '" + p.name +
-                       "' is empty or has characters other than letters, digits and _ . + -");
+    throw InvalidInput(printable(where) + ": problem name '" + printable(p.name, 60) + "' " +
+                       registry_name_problem(p.name) + " (" + std::string(kRegistryNameRule) + ")");
   }
   if (p.residual.residual_size() != n) {
     fail(where, p,

@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "nlobs/common/invalid_input.hpp"
+#include "nlobs/common/printable.hpp"
+#include "nlobs/common/registry_name.hpp"  // is_registry_name: the name rule of every registry
 
 namespace nlobs {
 
@@ -21,31 +23,21 @@ struct KeyInfo {
   std::string default_value;  // as text; empty: required (or no default)
 };
 
-// The name rule of every registry (and of a problem set's problems): non-empty, letters, digits
-// and _ . + - only, so that a name can be typed on a command line and in SET/NAME.
-inline bool is_registry_name(const std::string& name) {
-  return !name.empty() && name.find_first_not_of(
-                              "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
-                              "0123456789_.+-") == std::string::npos;
-}
-
 template <typename Entry>
 class NamedRegistry {
  public:
   // `kind` names the entries in messages: "model", "observer type", "problem set".
   explicit NamedRegistry(std::string kind) : kind_(std::move(kind)) {}
 
-  // Throws InvalidInput for an empty name, one with characters outside [A-Za-z0-9_.+-], or one
-  // already registered (naming both sources). Entry must have a `name` member.
+  // Throws InvalidInput for a name that breaks the registry name rule (registry_name.hpp:
+  // 1 to 64 of [A-Za-z0-9_.+-]), or one already registered (naming both sources). Entry must
+  // have a `name` member.
   void add(Entry entry, std::string source = "built-in") {
     const std::string& name = entry.name;
-    if (!is_registry_name(name)) {
-      throw InvalidInput(kind_ + " name '" + name + "' from " + source +
-                         " is empty or has characters other than letters, digits and _ . + -");
-    }
+    if (!is_registry_name(name)) throw InvalidInput(registry_name_refusal(kind_, name, source));
     if (auto it = index_.find(name); it != index_.end()) {
-      throw InvalidInput(kind_ + " '" + name + "' from " + source + " is already registered by " +
-                         entries_[it->second].second);
+      throw InvalidInput(kind_ + " '" + name + "' from " + printable(source) +
+                         " is already registered by " + printable(entries_[it->second].second));
     }
     index_.emplace(name, entries_.size());
     entries_.emplace_back(std::move(entry), std::move(source));
@@ -58,8 +50,8 @@ class NamedRegistry {
   // Throws std::invalid_argument "unknown <kind> 'x'; valid <kind>s: a, b, …".
   const Entry& get(const std::string& name) const {
     if (const Entry* e = find(name)) return *e;
-    throw std::invalid_argument("unknown " + kind_ + " '" + name + "'; valid " + kind_ +
-                                "s: " + valid_list());
+    throw std::invalid_argument("unknown " + kind_ + " '" + printable(name, 60) + "'; valid " +
+                                kind_ + "s: " + valid_list());
   }
   // The source that registered `name` (empty when none did).
   std::string source(const std::string& name) const {

@@ -21,6 +21,7 @@
 #include <string_view>
 #include <vector>
 
+#include "nlobs/common/registry_name.hpp"
 #include "nlobs/solvers/dynamic_size_engine.hpp"
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/engine_spec.hpp"
@@ -69,8 +70,9 @@ class EngineRegistry {
     return common;
   }
 
-  // Throws InvalidInput if the name is empty, malformed or taken (naming both sources), or the
-  // factory is empty. `source` says who registered it: "built-in", a plugin's path, a program.
+  // Throws InvalidInput if the name breaks the registry name rule (registry_name.hpp), is taken
+  // (naming both sources), or the factory is empty. `source` says who registered it: "built-in", a
+  // plugin's path, a program.
   void add(Entry entry, std::string source = "built-in");
 
   // The source that registered `name` in this registry (empty when none did).
@@ -137,13 +139,14 @@ class EngineRegistry {
 template <int N>
 void EngineRegistry<N>::add(Entry entry, std::string source) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (entry.name.empty() || entry.name.find_first_of(":,=") != std::string::npos) {
-    throw InvalidInput("engine name '" + entry.name + "' from " + source +
-                       " is empty or contains ':', ',' or '='");
+  // The rule of every registry (registry_name.hpp): no ':' ',' '=' (they delimit a spec), and
+  // nothing that cannot be typed or printed.
+  if (!is_registry_name(entry.name)) {
+    throw InvalidInput(registry_name_refusal("engine", entry.name, source));
   }
   if (auto it = sources_.find(entry.name); it != sources_.end()) {
-    throw InvalidInput("engine '" + entry.name + "' from " + source + " is already registered by " +
-                       it->second);
+    throw InvalidInput("engine '" + entry.name + "' from " + printable(source) +
+                       " is already registered by " + printable(it->second));
   }
   if (!entry.make)
     throw InvalidInput("engine '" + entry.name + "' from " + source + " has no factory");
