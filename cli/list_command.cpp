@@ -3,6 +3,7 @@
 #include <ostream>
 #include <stdexcept>
 
+#include "nlobs/common/printable.hpp"
 #include "nlobs/reference/problem_suite.hpp"
 #include "nlobs/registry/model_registry.hpp"
 #include "nlobs/registry/observer_types.hpp"
@@ -75,8 +76,8 @@ void print_list(const std::string& what, std::ostream& out) {
           if (!p.description.empty()) out << "; " << p.description;
           out << '\n';
         }
-      } catch (const std::exception& e) {  // a user's set that cannot be built: say so, go on
-        out << "      (cannot be built: " << e.what() << ")\n";
+      } catch (...) {  // a user's set that cannot be built (whatever it threw): say so, go on
+        out << "      (cannot be built: " << current_exception_text(1000) << ")\n";
       }
     }
   }

@@ -75,9 +75,18 @@ void add_coordinate_errors(const Measurements& data,
     std::vector<Eigen::Index> rows = signal_rows(info, SignalKind::kEmbeddedEstimate);
     const bool canonical = rows.empty();
     if (canonical) rows = signal_rows(info, SignalKind::kCanonicalEstimate);
+    // The observer's coordinates of the truth: its (or the user's model's) code, which may
+    // throw anything; that sample's error is then unknown (NaN), as for a size that does not
+    // match.
+    const auto coordinates = [&](Eigen::Index k) -> Eigen::VectorXd {
+      try {
+        return observers[i]->coordinates_at(data.x.col(k), data.t[k]);
+      } catch (...) {
+        return Eigen::VectorXd::Constant(1, NAN);  // not empty: the observer has coordinates
+      }
+    };
     // Nothing to compare with (no coordinates_at), or done already (a second call).
-    if (rows.empty() || data.steps() == 0 ||
-        observers[i]->coordinates_at(data.x.col(0), data.t[0]).size() == 0 ||
+    if (rows.empty() || data.steps() == 0 || coordinates(0).size() == 0 ||
         signal_row(info, canonical ? SignalKind::kCanonicalError : SignalKind::kEmbeddedError)) {
       continue;
     }
@@ -88,7 +97,7 @@ void add_coordinate_errors(const Measurements& data,
     signals.conservativeResize(at + added, Eigen::NoChange);
     Eigen::VectorXd estimate(size);
     for (Eigen::Index k = 0; k < K; ++k) {
-      const Eigen::VectorXd z = observers[i]->coordinates_at(data.x.col(k), data.t[k]);
+      const Eigen::VectorXd z = coordinates(k);
       for (Eigen::Index j = 0; j < size; ++j) {
         estimate[j] = signals(rows[static_cast<size_t>(j)], k);
       }

@@ -5,8 +5,11 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 #include "input_file.hpp"
+#include "nlobs/common/printable.hpp"
 #include "nlobs/registry/json_reader.hpp"
 
 namespace nlobs::cli {
@@ -459,10 +462,19 @@ std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& s,
 
 nlohmann::json observer_reports(const Scenario& s, std::vector<std::string>* warnings) {
   nlohmann::json out = nlohmann::json::array();
-  for (const ObserverSpec& o : s.observers) {
+  for (size_t i = 0; i < s.observers.size(); ++i) {
+    const ObserverSpec& o = s.observers[i];
     const ObserverTypeEntry& entry = observer_type_registry().get(o.type);
     if (!entry.report) continue;
-    for (auto& item : entry.report(o.spec, warnings)) out.push_back(std::move(item));
+    nlohmann::json items;
+    try {  // a user's report hook: anything it throws is named
+      items = entry.report(o.spec, warnings);
+    } catch (...) {
+      throw std::invalid_argument(s.name + ".observers[" + std::to_string(i) +
+                                  "]: observer type '" + o.type +
+                                  "': its report threw: " + current_exception_text());
+    }
+    for (auto& item : items) out.push_back(std::move(item));
   }
   return out;
 }

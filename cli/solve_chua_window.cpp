@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <ostream>
 #include <stdexcept>
 
+#include "nlobs/common/printable.hpp"
 #include "nlobs/reference/kinsol_adapter.hpp"
 #include "nlobs/reference/timing.hpp"
 #include "nlobs/registry/problem_sets/chua_window_set.hpp"
@@ -30,22 +32,37 @@ SolveRow run_engine(const std::string& name, const reference::ChuaWindowCase& c,
   options.stop.residual_tolerance = tol;  // KINSOL's fnormtol
   std::unique_ptr<Engine<3>> engine = EngineRegistry<3>::global().create(name, options);
   Vector<3> x = c.initial_guess;
-  const Summary s = engine->solve(c.problem, x);
-  SolveRow row{name,
-               std::string(to_string(s.status)),
-               s.iterations,
-               s.function_evaluations,
-               x,
-               (x - c.true_state).lpNorm<Eigen::Infinity>(),
-               0.0};
-  // At least 3 solves and 20 ms in total.
-  row.ns_per_solve = reference::mean_ns_per_call(
-      [&] {
-        Vector<3> xr = c.initial_guess;
-        engine->solve(c.problem, xr);
-      },
-      2e7, 3);
-  return row;
+  try {
+    const Summary s = engine->solve(c.problem, x);
+    SolveRow row{name,
+                 std::string(to_string(s.status)),
+                 s.iterations,
+                 s.function_evaluations,
+                 x,
+                 (x - c.true_state).lpNorm<Eigen::Infinity>(),
+                 0.0,
+                 {}};
+    // At least 3 solves and 20 ms in total.
+    row.ns_per_solve = reference::mean_ns_per_call(
+        [&] {
+          Vector<3> xr = c.initial_guess;
+          engine->solve(c.problem, xr);
+        },
+        2e7, 3);
+    return row;
+  } catch (...) {
+    // F is ours; an engine of a user's (a plugin's) may throw anything: a row, as in
+    // `nlobs suite` (engine_threw), never the end of the run.
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    return {name,
+            "engine_threw",
+            0,
+            0,
+            Eigen::Vector3d::Constant(nan),
+            nan,
+            0.0,
+            name + " threw: " + current_exception_text()};
+  }
 }
 
 SolveRow run_kinsol(const std::string& name, const reference::ChuaWindowCase& c, double tol) {
@@ -62,7 +79,8 @@ SolveRow run_kinsol(const std::string& name, const reference::ChuaWindowCase& c,
                r.evaluations,
                x,
                (x - c.true_state).lpNorm<Eigen::Infinity>(),
-               0.0};
+               0.0,
+               {}};
   Eigen::VectorXd xr(3);
   row.ns_per_solve = reference::mean_ns_per_call(
       [&] {
@@ -144,6 +162,9 @@ void print_table(const std::vector<SolveRow>& rows, double tolerance, std::ostre
                   r.ns_per_solve);
     out << line;
   }
+  for (const SolveRow& r : rows) {
+    if (!r.message.empty()) out << r.message << '\n';
+  }
 }
 
 nlohmann::json to_json(const std::vector<SolveRow>& rows) {
@@ -156,6 +177,7 @@ nlohmann::json to_json(const std::vector<SolveRow>& rows) {
                  {"solution", {r.solution[0], r.solution[1], r.solution[2]}},
                  {"error", r.error},
                  {"ns_per_solve", r.ns_per_solve}});
+    if (!r.message.empty()) a.back()["message"] = r.message;
   }
   return a;
 }

@@ -17,6 +17,8 @@ struct SolveRow {
   Eigen::Vector3d solution = Eigen::Vector3d::Zero();
   double error = 0.0;  // ‖x − x_true‖∞
   double ns_per_solve = 0.0;
+  // Status "engine_threw": what the engine threw (printable); the run goes on with the next.
+  std::string message;
 };
 
 // Our engines' names, in table order.

@@ -1,8 +1,11 @@
 #include "nlobs/registry/model_registry.hpp"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "builtin_models.hpp"
+#include "nlobs/common/printable.hpp"
 
 namespace nlobs {
 
@@ -43,6 +46,12 @@ ModelInstance make_model_instance(JsonReader& spec, const ModelRegistry& registr
     return entry->make(p, step, scheme);
   } catch (const InvalidInput& e) {  // the discretisation's refusal of the step
     spec.fail(e.what());
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    if (what.compare(0, spec.where().size(), spec.where()) == 0) throw;  // JsonReader::fail
+    spec.fail("model '" + printable(name) + "': " + printable(what));
+  } catch (...) {  // an entry of a user's (a plugin's make): anything, named by the model
+    spec.fail("model '" + printable(name) + "': its factory threw: " + current_exception_text());
   }
 }
 

@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <any>
+#include <stdexcept>
+#include <string>
 
+#include "nlobs/common/printable.hpp"
 #include "observer_types/builtin_observer_types.hpp"
 
 namespace nlobs {
@@ -41,6 +44,10 @@ ObserverSpec parse_observer_spec(JsonReader& o, const ModelInstance& model,
     spec.spec = entry->parse(o, model);
   } catch (const InvalidInput& e) {  // thrown by the entry itself, not through o.fail: add where
     o.fail(e.what());
+  } catch (const std::invalid_argument&) {  // o.fail (where included), as documented
+    throw;
+  } catch (...) {  // a user's parse hook: anything, named by the type
+    o.fail("observer type '" + spec.type + "': its parse threw: " + current_exception_text());
   }
   if (lists(*entry, "initial")) spec.initial = o.vector("initial");
   if (lists(*entry, "model")) {
@@ -67,6 +74,9 @@ nlohmann::json observer_spec_json(const ObserverSpec& spec, const ObserverTypeRe
     types.get(spec.type).write(spec.spec, out);
   } catch (const std::bad_any_cast&) {
     throw mismatched(spec.type);
+  } catch (...) {  // a user's write hook
+    throw InvalidInput("observer type '" + spec.type +
+                       "': its write threw: " + current_exception_text());
   }
   if (spec.initial) {
     out["initial"] =
@@ -102,10 +112,9 @@ std::unique_ptr<Observer> build_observer(const ObserverSpec& spec, const ModelIn
   }
   const ObserverBuild build{model, design ? design->discrete : model.discrete, start, where,
                             trace_first_window};
+  std::unique_ptr<Observer> observer;
   try {
-    std::unique_ptr<Observer> observer = entry.build(spec.spec, build);
-    if (!observer) throw InvalidInput("observer type '" + spec.type + "' built no observer");
-    return observer;
+    observer = entry.build(spec.spec, build);
   } catch (const std::bad_any_cast&) {
     throw std::invalid_argument(where + ": " + mismatched(spec.type).what());
   } catch (const std::invalid_argument& e) {
@@ -113,7 +122,16 @@ std::unique_ptr<Observer> build_observer(const ObserverSpec& spec, const ModelIn
     const std::string what = e.what();
     if (what.compare(0, where.size(), where) == 0) throw;
     throw std::invalid_argument(where + ": " + what);
+  } catch (...) {  // a user's build hook (or the model code it runs): anything, named
+    throw std::invalid_argument(where + ": observer type '" + spec.type +
+                                "': its build threw: " + current_exception_text());
   }
+  if (!observer) {
+    throw std::invalid_argument(where + ": observer type '" + spec.type + "' built no observer");
+  }
+  // What a report names when a step of this observer throws (run_observers).
+  observer->set_model_name(design ? design->name : model.name);
+  return observer;
 }
 
 }  // namespace nlobs

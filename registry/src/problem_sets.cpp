@@ -98,7 +98,12 @@ std::vector<TestProblem> build_problem_set(const ProblemSetEntry& set) {
   if (!(set.solved_threshold > 0.0) || !std::isfinite(set.solved_threshold)) {
     throw InvalidInput(where + ": solved_threshold must be finite and > 0");
   }
-  std::vector<TestProblem> problems = set.problems();
+  std::vector<TestProblem> problems;
+  try {  // a user's function (a plugin's): anything it throws is named by the set
+    problems = set.problems();
+  } catch (...) {
+    throw InvalidInput(where + ": building its problems threw: " + current_exception_text());
+  }
   if (problems.empty()) throw InvalidInput(where + ": it has no problems");
   std::set<std::pair<std::string, Index>> seen;
   for (const TestProblem& p : problems) {

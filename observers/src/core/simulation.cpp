@@ -1,10 +1,14 @@
 #include "nlobs/observers/core/simulation.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "nlobs/common/printable.hpp"
 
 namespace nlobs {
 namespace {
@@ -85,7 +89,14 @@ RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Ob
   // reports lay the estimates side by side.
   Eigen::Index states = data.has_truth() ? data.x.rows() : 0;
   for (auto& observer : observers) {
-    observer->reset();
+    try {
+      observer->reset();
+    } catch (const InvalidInput&) {
+      throw;
+    } catch (...) {  // a user's observer that cannot start: nothing of it can run
+      throw std::runtime_error("run_observers: observer '" + printable(observer->name()) +
+                               "' threw in reset(): " + current_exception_text());
+    }
     ObserverMetrics m;
     m.name = observer->name();
     m.engine = observer->info().engine;
@@ -98,8 +109,48 @@ RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Ob
     double elapsed_ns = 0.0;
     for (long k = 0; k < steps; ++k) {
       const Eigen::VectorXd y = data.y.col(k), u = data.u.col(k);
+      // The first failing step's reason: the engine's (status, message, why not used) before
+      // the observer's own, which often follows from it. Built once.
+      const auto note_first = [&](const auto& why) {
+        if (!m.first_failure.empty()) return;
+        std::ostringstream os;
+        os << "k = " << k << " (t = " << data.t[k] << "): " << why();
+        m.first_failure = os.str();
+      };
       const auto t0 = std::chrono::steady_clock::now();
-      const ObserverStep& s = observer->step(k, data.t[k], y, u);
+      const ObserverStep* stepped = nullptr;
+      try {
+        stepped = &observer->step(k, data.t[k], y, u);
+      } catch (const InvalidInput&) {
+        throw;  // the observer refused the sample itself (its sizes): the caller's mistake
+      } catch (...) {
+        // A user's model, engine or observer threw (any type, `throw 42` too). Like any failed
+        // step: counted, named in first_failure, the last good estimate kept, the run goes on
+        // (the observer is stepped again at the next sample).
+        elapsed_ns +=
+            std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count();
+        ++m.failures["observer_threw"];
+        note_first([&] {
+          std::string who = "observer '" + printable(m.name) + "'";
+          if (!observer->info().model.empty()) {
+            who += " on model '" + printable(observer->info().model) + "'";
+          }
+          return who + " threw: " + current_exception_text();
+        });
+        const auto hold = [k](Eigen::MatrixXd& columns) {  // the last good column, or NaN
+          if (columns.rows() == 0) return;
+          if (k > 0) {
+            columns.col(k) = columns.col(k - 1);
+          } else {
+            columns.col(k).setConstant(std::numeric_limits<double>::quiet_NaN());
+          }
+        };
+        hold(estimate);
+        hold(signals);
+        if (progress) progress(++done, total);
+        continue;
+      }
+      const ObserverStep& s = *stepped;
       elapsed_ns +=
           std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count();
       if (states == 0) {  // the first observer without truth sets the size
@@ -108,7 +159,8 @@ RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Ob
           throw InvalidInput("run_observers: " + m.name +
                              " published an empty estimate at k = " + std::to_string(k));
         }
-        estimate.resize(states, steps);
+        // Samples before this one (steps that threw) have no estimate.
+        estimate.setConstant(states, steps, std::numeric_limits<double>::quiet_NaN());
       }
       if (s.estimate.size() != estimate.rows() || s.signals.size() != signals.rows()) {
         // An observer of a user's own that breaks its promise: named, never written past.
@@ -120,14 +172,6 @@ RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Ob
       }
       estimate.col(k) = s.estimate;
       if (signals.rows() > 0) signals.col(k) = s.signals;
-      // The first failing step's reason: the engine's (status, message, why not used) before
-      // the observer's own, which often follows from it. Built once.
-      const auto note_first = [&](const auto& why) {
-        if (!m.first_failure.empty()) return;
-        std::ostringstream os;
-        os << "k = " << k << " (t = " << data.t[k] << "): " << why();
-        m.first_failure = os.str();
-      };
       if (s.summary && !s.summary->usable()) {
         if (s.summary->converged()) ++m.failures["unusable"];
         note_first([&] {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "nlobs/common/printable.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 #include "nlobs/solvers/problem.hpp"
 
@@ -141,8 +142,9 @@ ModulatingKernels::ModulatingKernels(int n, double horizon, ModulatingKernelOpti
            ++pass) {
         try {
           s = engine->solve_least_squares(problem, q);
-        } catch (const std::exception& e) {
-          fail("engine '" + engine_ + "' failed on the noise-optimal kernel: " + e.what());
+        } catch (...) {  // an engine by name may be a user's: whatever it throws is named
+          fail("engine '" + engine_ +
+               "' failed on the noise-optimal kernel: " + current_exception_text());
         }
         gradient = QJ.transpose() * (r0 + QJ * q);
       }

@@ -27,6 +27,7 @@
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -34,6 +35,7 @@
 #include <utility>
 #include <vector>
 
+#include "nlobs/common/printable.hpp"
 #include "nlobs/models/discretization.hpp"
 #include "nlobs/observers/mvt/mvt_observer.hpp"
 #include "nlobs/registry/hooks/high_gain_hook.hpp"
@@ -147,36 +149,57 @@ ModelEntry model_entry(ModelDefinition<Model, Parameters> definition) {
     if (!p.value)
       throw InvalidInput("model '" + entry.name + "': parameter '" + p.key +
                          "' has no field (ModelParameter::value)");
-    entry.parameters.push_back(
-        {p.key, p.meaning, detail::number_text(p.value(definition.defaults))});
+    double default_value = 0.0;
+    try {  // the user's hook, run once here: what it throws is refused by the model's name
+      default_value = p.value(definition.defaults);
+    } catch (...) {
+      throw InvalidInput("model '" + definition.name + "': parameter '" + p.key +
+                         "': its field (ModelParameter::value) threw: " + current_exception_text());
+    }
+    entry.parameters.push_back({p.key, p.meaning, detail::number_text(default_value)});
   }
   const auto build = [definition](const Parameters& p) -> Model {
     if (definition.build) return definition.build(p);
     if constexpr (std::is_same_v<Model, Parameters>) return p;
     throw InvalidInput("unreachable");  // refused above
   };
-  const Model probe = build(definition.defaults);
-  entry.states = probe.states();
-  entry.inputs = probe.inputs();
-  entry.outputs = probe.outputs();
+  std::optional<Model> probe;
+  try {
+    probe.emplace(build(definition.defaults));
+  } catch (...) {
+    throw InvalidInput("model '" + definition.name +
+                       "': its build threw on the defaults: " + current_exception_text());
+  }
+  entry.states = probe->states();
+  entry.inputs = probe->inputs();
+  entry.outputs = probe->outputs();
   entry.families = {"window", "ekf", "luenberger", "sliding_mode"};
   if constexpr (detail::kMvtFits<Model>) entry.families.push_back("mvt");
   if constexpr (detail::kHighGainFits<Model>) entry.families.push_back("high_gain");
   if constexpr (detail::HasModulatingForm<Model>) entry.families.push_back("modulating");
-  if (probe.outputs() == 1) entry.families.push_back("finite_difference");
+  if (probe->outputs() == 1) entry.families.push_back("finite_difference");
   entry.make = [definition, build](JsonReader& reader, double step, Scheme scheme) {
     Parameters p = definition.defaults;
     std::vector<std::string> keys;
     for (const auto& parameter : definition.parameters) {
       keys.push_back(parameter.key);
-      if (auto v = reader.number(parameter.key)) parameter.value(p) = *v;
+      if (auto v = reader.number(parameter.key)) {
+        try {  // the user's hook
+          parameter.value(p) = *v;
+        } catch (...) {
+          reader.fail("parameter '" + parameter.key + "' of model '" + definition.name +
+                      "': its field (ModelParameter::value) threw: " + current_exception_text());
+        }
+      }
     }
     reader.finish(keys);
     std::optional<Model> model;
     try {  // the model's refusal names the parameters object
       model.emplace(build(p));
-    } catch (const std::exception& e) {  // a user's model may throw any standard exception
-      reader.fail(e.what());
+    } catch (const std::exception&) {  // a refusal of values: its message says which
+      reader.fail(current_exception_text());
+    } catch (...) {  // `throw 42`: nothing to quote, so name whose code it was
+      reader.fail("model '" + definition.name + "': its build threw " + current_exception_text());
     }
     return detail::model_instance(definition.name, std::move(*model), step, scheme);
   };

@@ -14,6 +14,7 @@
 #include <ceres/tiny_solver.h>
 
 #include <cmath>
+#include <exception>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -111,6 +112,7 @@ class CeresEngine : public Engine<N> {
     int evaluations = 0, jacobians = 0;
     bool non_finite = false, jacobian_failed = false, budget_exhausted = false, have_prev = false;
     double last_step = 0.0;
+    std::exception_ptr thrown;  // what a user's F or Jacobian threw inside ceres::Solve
 
     void resize(Index n, Index m) {
       x.resize(n), prev.resize(n), f.resize(m), fp.resize(m), fm.resize(m), j.resize(m, n);
@@ -199,6 +201,8 @@ class CeresEngine : public Engine<N> {
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
+  // TinySolver is a header template compiled here, holding nothing but Eigen values: a user's
+  // exception unwinds through it to the caller like through any of our engines.
   template <int M>
   Summary run_tiny(const detail::ResidualSource<N, M>& source, Vector<N>& x) {
     Workspace<M> w;  // fixed sizes: on the stack, nothing allocated
@@ -247,12 +251,15 @@ class CeresEngine : public Engine<N> {
     int NumParameters() const { return N; }
   };
 
-  // Aborts the Solver when the residual target or the evaluation budget is reached.
+  // Aborts the Solver when the residual target or the evaluation budget is reached, or when a
+  // user's function threw.
   struct Monitor : ceres::IterationCallback {
     double cost_target = 0.0;
     const bool* budget = nullptr;
+    const std::exception_ptr* thrown = nullptr;
     bool reached = false;
     ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+      if (*thrown) return ceres::SOLVER_ABORT;
       if (s.cost <= cost_target) {
         reached = true;
         return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
@@ -279,8 +286,18 @@ class CeresEngine : public Engine<N> {
     if (!problem_ || prepared_n_ != n || prepared_m_ != m) prepare(n, m);
     Workspace<M> w;
     w.resize(n, m);
+    // Ceres does not promise to survive an exception unwinding through ceres::Solve (it holds
+    // the prepared Problem's state, reused by the next solve): a user's exception, of any type,
+    // fails this evaluation and every later one (no more user calls), the Monitor aborts, and
+    // the exception is rethrown unchanged once Solve has returned.
     cost_->callback = [this, &source, &w](const double* p, double* r, double* j) {
-      return evaluate(source, w, p, r, j, /*row_major=*/true);
+      if (w.thrown) return false;
+      try {
+        return evaluate(source, w, p, r, j, /*row_major=*/true);
+      } catch (...) {
+        w.thrown = std::current_exception();
+        return false;
+      }
     };
     Eigen::Map<Vector<N>>(params_.data(), n) = x;
     const StopCriteria& stop = this->options_.stop;
@@ -301,10 +318,12 @@ class CeresEngine : public Engine<N> {
     const double ftol = stop.residual_tolerance.value_or(1e-15);
     monitor.cost_target = 0.5 * ftol * ftol;
     monitor.budget = &w.budget_exhausted;
+    monitor.thrown = &w.thrown;
     o.callbacks.push_back(&monitor);
     o.update_state_every_iteration = false;
     ceres::Solve(o, problem_.get(), &ceres_summary_);
     cost_->callback = nullptr;
+    if (w.thrown) std::rethrow_exception(w.thrown);
 
     Status status = Status::kSolverFailure;
     switch (ceres_summary_.termination_type) {

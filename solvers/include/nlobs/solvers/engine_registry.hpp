@@ -21,6 +21,7 @@
 #include <string_view>
 #include <vector>
 
+#include "nlobs/common/printable.hpp"
 #include "nlobs/common/registry_name.hpp"
 #include "nlobs/solvers/dynamic_size_engine.hpp"
 #include "nlobs/solvers/engine.hpp"
@@ -98,7 +99,8 @@ class EngineRegistry {
 
   // Builds the engine a spec names; `base` supplies stop criteria the spec does not set. The
   // engine's label() is the spec as given.
-  // Throws InvalidInput for an unknown name (listing the valid ones) or option.
+  // Throws InvalidInput for an unknown name (listing the valid ones) or option, and for anything
+  // the entry's factory throws (a user's: named with its source).
   std::unique_ptr<Engine<N>> create(std::string_view spec_text, SolverOptions base = {}) const;
 
  private:
@@ -197,7 +199,17 @@ std::unique_ptr<Engine<N>> EngineRegistry<N>::create(std::string_view spec_text,
   if (auto v = reader.number("ftol")) base.stop.residual_tolerance = *v;
   if (auto v = reader.integer("max_iter", 1, 1000000000)) base.stop.max_iterations = *v;
   if (auto v = reader.integer("max_evals", 1, 1000000000)) base.stop.max_evaluations = *v;
-  std::unique_ptr<Engine<N>> engine = entry->make(reader, std::move(base));
+  std::unique_ptr<Engine<N>> engine;
+  try {
+    engine = entry->make(reader, std::move(base));
+  } catch (const InvalidInput&) {  // a refused option: the reader's message names it
+    throw;
+  } catch (...) {  // a user's factory (a plugin's): anything it throws, named by the engine
+    const std::string from = source(spec.name);
+    throw InvalidInput("engine '" + spec.name + "'" +
+                       (from.empty() || from == "built-in" ? "" : " from " + printable(from)) +
+                       ": its factory threw: " + current_exception_text());
+  }
   reader.finish();
   if (!engine) throw InvalidInput("engine '" + spec.name + "': its factory returned no engine");
   engine->set_label(std::string(spec_text));

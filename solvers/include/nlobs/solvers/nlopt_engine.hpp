@@ -7,6 +7,7 @@
 // every solve, so repeated small bounded problems (the MVT observer's β) pay no set-up.
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <nlopt.hpp>
 #include <optional>
@@ -158,12 +159,21 @@ class NloptEngine : public Engine<N> {
     auto* self = static_cast<NloptEngine*>(data);
     self->x_ = Eigen::Map<const Vector<N>>(x, n);
     double f;
-    if (grad != nullptr) {
-      f = self->thunk_(self->context_, self->x_, &self->grad_);
-      Eigen::Map<Vector<N>>(grad, n) = self->grad_;
-      if (!self->grad_.allFinite()) f = std::numeric_limits<double>::quiet_NaN();
-    } else {
-      f = self->thunk_(self->context_, self->x_, nullptr);
+    // A user's F or Jacobian may throw anything. NLopt's C++ wrapper would catch it and report
+    // only "nlopt failure" (and nothing may unwind through NLopt's C frames): keep it, stop NLopt,
+    // and run() rethrows it once NLopt has returned.
+    try {
+      if (grad != nullptr) {
+        f = self->thunk_(self->context_, self->x_, &self->grad_);
+        Eigen::Map<Vector<N>>(grad, n) = self->grad_;
+        if (!self->grad_.allFinite()) f = std::numeric_limits<double>::quiet_NaN();
+      } else {
+        f = self->thunk_(self->context_, self->x_, nullptr);
+      }
+    } catch (...) {
+      self->thrown_ = std::current_exception();
+      self->opt_->force_stop();
+      return std::numeric_limits<double>::max();
     }
     if (!std::isfinite(f)) {
       self->non_finite_ = true;
@@ -187,6 +197,7 @@ class NloptEngine : public Engine<N> {
   void* context_ = nullptr;
   int evaluations_ = 0, jacobians_ = 0;
   bool non_finite_ = false;
+  std::exception_ptr thrown_;  // what a user's F or Jacobian threw during optimize()
 };
 
 template <int N>
@@ -241,6 +252,7 @@ Summary NloptEngine<N>::run(Vector<N>& x, double stop_value, ObjectiveThunk thun
   context_ = context;
   evaluations_ = jacobians_ = 0;
   non_finite_ = false;
+  thrown_ = nullptr;
   for (Index i = 0; i < n; ++i) xv_[static_cast<size_t>(i)] = x[i];
 
   Summary s;
@@ -256,6 +268,11 @@ Summary NloptEngine<N>::run(Vector<N>& x, double stop_value, ObjectiveThunk thun
   } catch (const std::exception& e) {
     result = opt_->last_optimize_result();
     s.message = e.what();
+  }
+  if (thrown_) {  // the user's exception, unchanged, now that no NLopt frame is left to unwind
+    std::exception_ptr thrown = std::move(thrown_);
+    thrown_ = nullptr;
+    std::rethrow_exception(thrown);
   }
   switch (result) {
     case nlopt::SUCCESS:

@@ -4,8 +4,10 @@
 // (Summary::usable()). The registry's `auto` is this with the stages of kAutoOrder
 // (builtin_engines.hpp), the order measured on the MGH set (docs/solvers.md). Summary::stage names
 // the engine whose answer is returned; Summary::message lists how every stage before it ended (a
-// stage that throws is one of them). The budget is shared through Engine::limit_evaluations: a
-// stage that ignores it ends the run after it.
+// stage that throws, whatever it throws, is one of them; when every stage that ran threw, the
+// first stage's exception is rethrown unchanged, so that a user's F that throws wherever it is
+// evaluated reaches the caller as it does from any other engine). The budget is shared through
+// Engine::limit_evaluations: a stage that ignores it ends the run after it.
 #include <algorithm>
 #include <cmath>
 #include <exception>
@@ -17,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include "nlobs/common/printable.hpp"
 #include "nlobs/solvers/engine.hpp"
 
 namespace nlobs {
@@ -60,6 +63,7 @@ class PolyalgorithmEngine : public Engine<N> {
     double best_residual = std::numeric_limits<double>::infinity();
     Summary best_summary, last;
     bool have_best = false, have_last = false;
+    std::exception_ptr first_throw;  // null unless a stage threw: nothing allocated otherwise
     int evaluations = 0, jacobians = 0, iterations = 0;
     std::ostringstream history;
     auto note = [&history](const std::string& what) {
@@ -74,8 +78,9 @@ class PolyalgorithmEngine : public Engine<N> {
       trial = poly_.restart_from_best && have_best ? best : start;
       try {
         last = stage.solve(problem, trial);
-      } catch (const std::exception& e) {  // a stage's failure is a row of the history
-        note(stage.label() + " threw: " + e.what());
+      } catch (...) {  // a stage's failure, whatever it threw, is a row of the history
+        if (!first_throw) first_throw = std::current_exception();
+        note(stage.label() + " threw: " + current_exception_text());
         continue;
       }
       have_last = true;
@@ -118,7 +123,12 @@ class PolyalgorithmEngine : public Engine<N> {
         s.step_norm = 0.0;
         s.trace.clear();
       }
-    } else {  // every stage threw
+    } else if (first_throw) {
+      // Every stage that ran threw: most likely the user's F or Jacobian, which the caller must
+      // see as from any engine (a cancellation, a domain error), not as a solver failure.
+      x = start;
+      std::rethrow_exception(first_throw);
+    } else {  // no stage ran (an empty budget)
       x = start;
       s.status = Status::kSolverFailure;
     }

@@ -77,6 +77,9 @@ struct ObserverInfo {
   // contract; cleared by reset()); printed and kept in summary.json.
   std::vector<std::string> warnings;
   std::vector<SignalInfo> signals;  // the entries of ObserverStep::signals, in order
+  // The name of the model the observer runs on, for messages ("observer 'ekf' on model 'x'
+  // threw: …"); set by whoever knows it (the registry's build_observer), empty otherwise.
+  std::string model;
 };
 
 struct ObserverStep {
@@ -105,6 +108,8 @@ class Observer {
 
   const ObserverInfo& info() const { return info_; }
   const std::string& name() const { return info_.name; }
+  // ObserverInfo::model: what a report names when this observer's step throws.
+  void set_model_name(std::string model) { info_.model = std::move(model); }
 
   virtual void reset() = 0;  // back to the initial estimate, empty window
   // Sample k (0, 1, 2, … in order) taken at time t. A non-finite entry of y is a missing

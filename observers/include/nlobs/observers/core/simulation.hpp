@@ -13,9 +13,11 @@
 #include <optional>
 #include <random>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "nlobs/common/printable.hpp"
 #include "nlobs/models/model.hpp"
 #include "nlobs/observers/core/observer.hpp"
 #include "nlobs/solvers/status.hpp"
@@ -59,7 +61,8 @@ double simulation_sample_time(const Model& model, const SimulationOptions& o) {
 }
 
 // Throws InvalidInput for steps < 1, σ < 0 or non-finite, a sample time that is not finite and
-// > 0, or an x0 of the wrong size.
+// > 0, or an x0 of the wrong size; std::runtime_error naming the model (its name() when it has
+// one), the sample and its time when the model or the input signal throws.
 template <DiscreteModel Model>
 Measurements simulate(const Model& model, const Eigen::VectorXd& x0, const SimulationOptions& o) {
   const Eigen::Index n = model.states(), p = model.outputs(), m = model.inputs();
@@ -89,45 +92,64 @@ Measurements simulate(const Model& model, const Eigen::VectorXd& x0, const Simul
   std::mt19937_64 rng(o.seed);
   std::normal_distribution<double> noise(0.0, 1.0);
   ModelVector<double, Model::kStates> x = x0;
-  for (long k = 0; k < o.steps; ++k) {
-    // Stop where the state leaves its domain or the state or its output is no longer finite:
-    // a NaN measurement must never reach the observers.
-    std::string violation = domain_violation_of(model, x);
-    Eigen::VectorXd y;
-    if (violation.empty() && !x.allFinite()) {
-      std::ostringstream os;
-      os << "the true state is not finite (x = [" << x.transpose()
-         << "]): the model overflowed or left its domain";
-      violation = os.str();
+  long k = 0;
+  // The true system is the user's model too: whatever it (or the input signal) throws ends the
+  // simulation with an error naming the model, the sample and its time. An exception is not a
+  // domain exit (the model did not say where its domain ends); InvalidInput is ours, unchanged.
+  try {
+    for (; k < o.steps; ++k) {
+      // Stop where the state leaves its domain or the state or its output is no longer finite:
+      // a NaN measurement must never reach the observers.
+      std::string violation = domain_violation_of(model, x);
+      Eigen::VectorXd y;
+      if (violation.empty() && !x.allFinite()) {
+        std::ostringstream os;
+        os << "the true state is not finite (x = [" << x.transpose()
+           << "]): the model overflowed or left its domain";
+        violation = os.str();
+      }
+      if (violation.empty()) {
+        y = model.h(x);
+        if (!y.allFinite()) violation = "the output h(x) is not finite";
+      }
+      if (!violation.empty()) {
+        std::ostringstream os;
+        os << "stopped at sample " << k << " (t = " << static_cast<double>(k) * sample_time
+           << "): " << violation;
+        data.stop_message = os.str();
+        data.x.conservativeResize(n, k);
+        data.y.conservativeResize(p, k);
+        data.u.conservativeResize(m, k);
+        data.t.conservativeResize(k);
+        break;
+      }
+      const Eigen::VectorXd u = o.input ? o.input(k) : Eigen::VectorXd::Zero(m);
+      if (u.size() != m) throw InvalidInput("simulate: the input signal has the wrong size");
+      data.x.col(k) = x;
+      data.t[k] = static_cast<double>(k) * sample_time;
+      data.u.col(k) = u;
+      if (o.noise_std > 0.0) {
+        for (Eigen::Index i = 0; i < p; ++i) y[i] += o.noise_std * noise(rng);
+      }
+      data.y.col(k) = y;
+      x = model.f(x, ModelVector<double, Model::kInputs>(u), k);
+      if (o.process_noise_std > 0.0) {
+        for (Eigen::Index i = 0; i < n; ++i) x[i] += o.process_noise_std * noise(rng);
+      }
     }
-    if (violation.empty()) {
-      y = model.h(x);
-      if (!y.allFinite()) violation = "the output h(x) is not finite";
+  } catch (const InvalidInput&) {
+    throw;
+  } catch (...) {
+    std::ostringstream os;
+    os << "simulate: ";
+    if constexpr (requires { model.name(); }) {
+      os << "model '" << printable(model.name()) << "'";
+    } else {
+      os << "the model";
     }
-    if (!violation.empty()) {
-      std::ostringstream os;
-      os << "stopped at sample " << k << " (t = " << static_cast<double>(k) * sample_time
-         << "): " << violation;
-      data.stop_message = os.str();
-      data.x.conservativeResize(n, k);
-      data.y.conservativeResize(p, k);
-      data.u.conservativeResize(m, k);
-      data.t.conservativeResize(k);
-      break;
-    }
-    const Eigen::VectorXd u = o.input ? o.input(k) : Eigen::VectorXd::Zero(m);
-    if (u.size() != m) throw InvalidInput("simulate: the input signal has the wrong size");
-    data.x.col(k) = x;
-    data.t[k] = static_cast<double>(k) * sample_time;
-    data.u.col(k) = u;
-    if (o.noise_std > 0.0) {
-      for (Eigen::Index i = 0; i < p; ++i) y[i] += o.noise_std * noise(rng);
-    }
-    data.y.col(k) = y;
-    x = model.f(x, ModelVector<double, Model::kInputs>(u), k);
-    if (o.process_noise_std > 0.0) {
-      for (Eigen::Index i = 0; i < n; ++i) x[i] += o.process_noise_std * noise(rng);
-    }
+    os << " of the true system threw at sample " << k
+       << " (t = " << static_cast<double>(k) * sample_time << "): " << current_exception_text();
+    throw std::runtime_error(os.str());
   }
   return data;
 }
@@ -145,12 +167,14 @@ struct ObserverMetrics {
   int solves = 0;
   // Failure name → count: the status of every solve that did not converge, "unusable" for a
   // converged solve whose Summary is not usable(), ObserverStep::failure of every step that set
-  // one, "missing_measurement", and "non_finite_estimate" for every non-finite estimate that
-  // reached the harness (the built-in observers never publish one).
+  // one, "missing_measurement", "non_finite_estimate" for every non-finite estimate that
+  // reached the harness (the built-in observers never publish one), and "observer_threw" for
+  // every step that threw (run_observers).
   std::map<std::string, int> failures;
   std::optional<Summary> first_window;  // with its trace when the engine records one
   // Why the first failing step failed, with its k and t: the engine's status and message of
-  // an unusable solve, an observer's ObserverStep::failure_message, or a non-finite estimate.
+  // an unusable solve, an observer's ObserverStep::failure_message, a non-finite estimate, or
+  // what a step threw ("observer 'ekf' on model 'm' threw: <what()>").
   std::string first_failure;
 };
 
@@ -166,6 +190,12 @@ struct RunResult {
 // data.t[k] (required: InvalidInput when data.t does not have one time per sample).
 // `settle_index`: the first sample counted in mse_after_window (the longest
 // ObserverInfo::window's N − 1 when negative).
+// A step that throws anything but InvalidInput (a user's model, engine or observer: `throw 42`
+// included) is a failed step, as a non-finite estimate is: counted as "observer_threw", named in
+// first_failure (observer, ObserverInfo::model, k, t and the exception's printable text), the
+// observer's last estimate and signals kept for that sample (NaN when it threw at its first), and
+// the observer is stepped again at the next sample. InvalidInput from a step (a sample of the
+// wrong size: the caller's mistake) ends the run, as before.
 RunResult run_observers(const Measurements& data, std::vector<std::unique_ptr<Observer>>& observers,
                         long settle_index = -1,
                         const std::function<void(long done, long total)>& progress = {});
