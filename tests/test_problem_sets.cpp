@@ -22,6 +22,7 @@
 #include "nlobs/solvers/engine_registry.hpp"
 #include "nlobs/solvers/fixed_point_engines.hpp"
 #include "suite_command.hpp"
+#include "suite_report.hpp"
 
 namespace nlobs {
 namespace {
@@ -514,6 +515,36 @@ TEST(ProblemSets, TheTableSaysWhyARowHasNoAnswer) {
   EXPECT_NE(out.str().find("engine_threw"), std::string::npos) << out.str();
   EXPECT_NE(out.str().find("    a non-standard exception\n"), std::string::npos) << out.str();
   EXPECT_NE(out.str().find("    a user's engine failed\n"), std::string::npos) << out.str();
+}
+
+// What fuzz_suite_report checks, pinned: a start label from a user's plugin with invalid UTF-8
+// made nlohmann::json's dump() throw (the --json output ended with an exception); it is U+FFFD
+// in the JSON, the bytes as given in the CSV (quoted), escaped in the table.
+TEST(ProblemSets, TheWritersTakeAnyLabel) {
+  SuiteRow r;
+  r.set = "s";
+  r.problem = "p";
+  r.n = 1;
+  r.start = "a,\"b\"\n\xff\x1b[31m";
+  r.solver = "newton";
+  r.residual = std::numeric_limits<double>::quiet_NaN();
+  r.ns = 5e-324;
+  r.status = "engine_threw";
+  r.message = "line\r\nbreak";
+  const std::vector<SuiteRow> rows = {r};
+  std::string dumped;
+  ASSERT_NO_THROW(dumped = cli::suite_to_json(rows).dump());
+  const auto back = nlohmann::json::parse(dumped);
+  EXPECT_EQ(back[0]["start"], "a,\"b\"\n\xEF\xBF\xBD\x1b[31m");
+  EXPECT_TRUE(back[0]["residual"].is_null());
+  EXPECT_EQ(back[0]["ns"].get<double>(), 5e-324);
+  const std::string csv = cli::suite_to_csv(rows);
+  EXPECT_NE(csv.find(",\"a,\"\"b\"\"\n\xff\x1b[31m\","), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",\"line\r\nbreak\"\n"), std::string::npos) << csv;
+  std::ostringstream table;
+  cli::print_suite_tables(rows, 1e-8, table);
+  EXPECT_NE(table.str().find("start a,\"b\"\\n\\xff\\e[31m"), std::string::npos) << table.str();
+  EXPECT_NE(table.str().find("    line\\r\\nbreak\n"), std::string::npos) << table.str();
 }
 
 TEST(ProblemSets, MalformedProblemsAreRefusedNamingTheProblem) {
