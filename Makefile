@@ -49,7 +49,8 @@ fuzz:
 	@./scripts/ensure-deps.sh fuzz
 	cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER=clang++ -DNLOBS_FUZZ=ON \
 	      -DNLOBS_SANITIZE=ON -DNLOBS_BUILD_TESTS=OFF -DNLOBS_BUILD_BENCH=OFF $(CMAKE_ARGS)
-	cmake --build build-fuzz -j $(JOBS) --target fuzz_scenario fuzz_data_csv fuzz_plugin_file
+	cmake --build build-fuzz -j $(JOBS) --target fuzz_scenario fuzz_data_csv fuzz_plugin_file \
+	      fuzz_suite_report
 	./scripts/run-fuzz build-fuzz $(FUZZ_SECONDS)
 
 format: deps

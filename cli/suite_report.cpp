@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "nlobs/common/printable.hpp"
 #include "output_file.hpp"
 #include "run_support.hpp"
 
@@ -43,12 +44,17 @@ std::string number_text(double v) {
 
 void print_suite_tables(const std::vector<reference::SuiteRow>& rows, double threshold,
                         std::ostream& out) {
-  char line[320];
+  char line[400];
   std::string current;
   std::vector<std::string> order;
   std::map<std::string, int> solved, pairs;
   const bool any_error = std::any_of(
       rows.begin(), rows.end(), [](const reference::SuiteRow& r) { return !std::isnan(r.error); });
+  // Names, labels and statuses may come from a user's plugin: printed through printable (no
+  // control character, no invalid UTF-8, bounded length).
+  const auto shown = [](const std::string& text, std::size_t limit) {
+    return printable(text, limit);
+  };
   // The solver column fits the longest spec ("levenberg-marquardt:geodesic=1"), within reason.
   int width = 22;
   for (const auto& r : rows)
@@ -64,22 +70,29 @@ void print_suite_tables(const std::vector<reference::SuiteRow>& rows, double thr
           r.start.compare(1, std::string::npos, scale) == 0) {
         start += "x " + scale;
       } else {
-        start += r.start;
+        start += shown(r.start, 60);
       }
       std::snprintf(line, sizeof line, "\n%s n=%d (%s)\n  %-*s %-7s %-28s %10s %8s %8s %12s%s\n",
-                    r.problem.c_str(), r.n, start.c_str(), width, "solver", "solved", "status",
-                    "|F|2", "F evals", "J evals", "time [us]", any_error ? "  |x-x*|inf" : "");
+                    shown(r.problem, 80).c_str(), r.n, start.c_str(), width, "solver", "solved",
+                    "status", "|F|2", "F evals", "J evals", "time [us]",
+                    any_error ? "  |x-x*|inf" : "");
       out << line;
     }
+    const std::string solver = shown(r.solver, 48);
     std::snprintf(line, sizeof line, "  %-*s %-7s %-28s %10.2e %8ld %8ld %12.1f", width,
-                  r.solver.substr(0, 48).c_str(), r.solved ? "yes" : "no",
-                  r.status.substr(0, 28).c_str(), r.residual, r.f_evals, r.j_evals, r.ns / 1e3);
+                  solver.c_str(), r.solved ? "yes" : "no", shown(r.status, 28).c_str(), r.residual,
+                  r.f_evals, r.j_evals, r.ns / 1e3);
     out << line;
     if (any_error) {
       std::snprintf(line, sizeof line, " %11s", fmt(r.error, "%.2e").c_str());
       out << line;
     }
     out << '\n';
+    // A row without an answer says why on the next line.
+    if (!r.message.empty() && (r.status == "invalid_input" || r.status == "engine_threw" ||
+                               r.status == "out_of_memory")) {
+      out << "    " << shown(r.message, 200) << '\n';
+    }
     if (!pairs.count(r.solver)) order.push_back(r.solver);
     ++pairs[r.solver];
     solved[r.solver] += r.solved;
@@ -88,41 +101,66 @@ void print_suite_tables(const std::vector<reference::SuiteRow>& rows, double thr
       << (std::isnan(threshold) ? std::string("each set's threshold") : short_number(threshold))
       << " at the returned point), per solver:\n";
   for (const auto& s : order) {
-    std::snprintf(line, sizeof line, "  %-*s %3d / %d\n", width, s.substr(0, 48).c_str(), solved[s],
+    std::snprintf(line, sizeof line, "  %-*s %3d / %d\n", width, shown(s, 48).c_str(), solved[s],
                   pairs[s]);
     out << line;
   }
 }
 
+std::string valid_utf8(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = 0; i < text.size();) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c < 0x80) {
+      out += static_cast<char>(c);
+      ++i;
+      continue;
+    }
+    const std::size_t length = detail::utf8_sequence_length(text, i);
+    if (length == 0) {
+      out += "\xEF\xBF\xBD";  // U+FFFD
+      ++i;
+    } else {
+      out.append(text.substr(i, length));
+      i += length;
+    }
+  }
+  return out;
+}
+
 nlohmann::json suite_to_json(const std::vector<reference::SuiteRow>& rows) {
   nlohmann::json a = nlohmann::json::array();
   for (const auto& r : rows) {
-    a.push_back({{"set", r.set},
-                 {"problem", r.problem},
+    a.push_back({{"set", valid_utf8(r.set)},
+                 {"problem", valid_utf8(r.problem)},
                  {"n", r.n},
-                 {"start", r.start},
-                 {"start_scale", r.start_scale},
-                 {"solver", r.solver},
+                 {"start", valid_utf8(r.start)},
+                 {"start_scale", number_or_null(r.start_scale)},
+                 {"solver", valid_utf8(r.solver)},
                  {"solved", r.solved},
                  {"residual", number_or_null(r.residual)},
                  {"error", number_or_null(r.error)},
                  {"f_evals", r.f_evals},
                  {"j_evals", r.j_evals},
-                 {"ns", r.ns},
-                 {"status", r.status}});
+                 {"ns", number_or_null(r.ns)},
+                 {"status", valid_utf8(r.status)},
+                 {"message", valid_utf8(r.message)}});
   }
   return a;
 }
 
 std::string suite_to_csv(const std::vector<reference::SuiteRow>& rows) {
   std::string out =
-      "set,problem,n,start,start_scale,solver,solved,residual,error,f_evals,j_evals,ns,status\n";
+      "set,problem,n,start,start_scale,solver,solved,residual,error,f_evals,j_evals,ns,status,"
+      "message\n";
   for (const auto& r : rows) {
     out += csv_field(r.set) + ',' + csv_field(r.problem) + ',' + std::to_string(r.n) + ',' +
            csv_field(r.start) + ',' + number_text(r.start_scale) + ',' + csv_field(r.solver) + ',' +
            (r.solved ? "true" : "false") + ',' + number_text(r.residual) + ',' +
            number_text(r.error) + ',' + std::to_string(r.f_evals) + ',' +
-           std::to_string(r.j_evals) + ',' + number_text(r.ns) + ',' + csv_field(r.status) + '\n';
+           std::to_string(r.j_evals) + ',' + number_text(r.ns) + ',' + csv_field(r.status) + ',' +
+           csv_field(r.message) + '\n';
   }
   return out;
 }

@@ -3,6 +3,7 @@
 #include <iosfwd>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "nlobs/reference/problem_suite.hpp"
@@ -13,10 +14,16 @@ namespace nlobs::cli {
 void print_suite_tables(const std::vector<reference::SuiteRow>& rows, double threshold,
                         std::ostream& out);
 // Keys: set, problem, n, start, start_scale, solver, solved, residual, error, f_evals, j_evals,
-// ns, status (non-finite numbers as null).
+// ns, status, message (non-finite numbers as null; strings as valid_utf8 makes them, so that
+// dump() never throws).
 nlohmann::json suite_to_json(const std::vector<reference::SuiteRow>& rows);
-// The same columns in that order, one header line, RFC 4180 fields.
+// The same columns in that order, one header line, RFC 4180 fields (a field with a comma, quote,
+// CR or LF quoted, quotes doubled; the bytes as given), non-finite numbers empty, other numbers
+// with 17 significant digits (they read back to the same double).
 std::string suite_to_csv(const std::vector<reference::SuiteRow>& rows);
+// `text` with every byte that is not part of a valid UTF-8 sequence replaced by U+FFFD (what
+// nlohmann::json's error_handler_t::replace writes): what the JSON holds of a user's text.
+std::string valid_utf8(std::string_view text);
 // `text` to `path` through a temporary file renamed over it, so a failed write leaves an
 // earlier file as it was; "-" is stdout. Throws std::runtime_error naming the path.
 void write_text_file(const std::string& path, const std::string& text, std::ostream& stdout_);

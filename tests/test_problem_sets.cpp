@@ -7,8 +7,11 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
+#include <new>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -19,6 +22,7 @@
 #include "nlobs/solvers/engine_registry.hpp"
 #include "nlobs/solvers/fixed_point_engines.hpp"
 #include "suite_command.hpp"
+#include "suite_report.hpp"
 
 namespace nlobs {
 namespace {
@@ -71,6 +75,32 @@ class ThrowingEngine final : public Engine<Dynamic> {
   }
 };
 
+// An engine a user registered: throws something that is not a std::exception.
+class ThrowsFortyTwo final : public Engine<Dynamic> {
+ public:
+  explicit ThrowsFortyTwo(SolverOptions o) : Engine<Dynamic>(std::move(o)) {}
+  std::string_view name() const override { return "test-throws-42"; }
+  Summary solve(const FixedPointProblem<Dynamic>&, Vector<Dynamic>&) override { throw 42; }
+};
+
+// An engine a user registered that ignores its budget: evaluates G a thousand times, then
+// returns the root it was told about (x = 1 for the problems it meets here).
+class GreedyEngine final : public Engine<Dynamic> {
+ public:
+  explicit GreedyEngine(SolverOptions o) : Engine<Dynamic>(std::move(o)) {}
+  std::string_view name() const override { return "test-greedy"; }
+  Summary solve(const FixedPointProblem<Dynamic>& g, Vector<Dynamic>& x) override {
+    Vector<Dynamic> out(x.size());
+    for (int i = 0; i < 1000; ++i) g.evaluate(x, out);
+    x.setOnes();
+    Summary s;
+    s.engine = "test-greedy";
+    s.status = Status::kConverged;
+    s.function_evaluations = 1;  // and it under-reports
+    return s;
+  }
+};
+
 void register_once() {
   static const bool done = [] {
     problem_set_registry().add(
@@ -94,6 +124,20 @@ void register_once() {
                  {"test-picard"},
                  [](EngineSpecReader&, SolverOptions o) -> std::unique_ptr<Engine<Dynamic>> {
                    return std::make_unique<PicardEngine<Dynamic>>(o);
+                 }});
+    engines.add({"test-throws-42",
+                 "throws 42",
+                 {},
+                 {"test-throws-42"},
+                 [](EngineSpecReader&, SolverOptions o) -> std::unique_ptr<Engine<Dynamic>> {
+                   return std::make_unique<ThrowsFortyTwo>(o);
+                 }});
+    engines.add({"test-greedy",
+                 "ignores its budget",
+                 {},
+                 {"test-greedy"},
+                 [](EngineSpecReader&, SolverOptions o) -> std::unique_ptr<Engine<Dynamic>> {
+                   return std::make_unique<GreedyEngine>(o);
                  }});
     engines.add({"test-throws",
                  "throws",
@@ -240,6 +284,267 @@ TEST(ProblemSets, AProblemThatReturnsNanIsARowNeverASolution) {
     EXPECT_FALSE(r.status.empty());
     EXPECT_FALSE(r.status == "converged" && !(r.residual <= 1e-8)) << r.residual;
   }
+}
+
+// A start of 1e308: KINSOL's maximum step 1000 ‖u₀‖ overflowed and its options threw, which
+// ended the whole suite. Now every (solver, problem, start) is a row whatever a solver's options
+// or set-up throw, and the suite goes on.
+TEST(ProblemSets, EverySolverGivesARowForAHugeStart) {
+  TestProblem p = root_test_problem(
+      "huge", 2,
+      [](const auto& x, auto& f) {
+        f[0] = x[0] - 1.0;
+        f[1] = x[1] - 1.0;
+      },
+      {{"far", Eigen::Vector2d(1e308, -1e308)}, {"near", Eigen::Vector2d(2.0, 0.0)}});
+  const ProblemSetEntry set{.name = "huge",
+                            .problems = [p] { return std::vector<TestProblem>{p}; }};
+  const std::vector<std::string> solvers = {"kinsol:newton", "kinsol:fp",   "minpack:hybrj",
+                                            "gsl:hybridsj",  "gsl:gnewton", "newton",
+                                            "auto"};
+  SuiteOptions options;
+  options.evaluations_per_dimension = 20;
+  std::vector<SuiteRow> rows;
+  ASSERT_NO_THROW(rows = reference::run_suite(set, build_problem_set(set), solvers, options));
+  ASSERT_EQ(rows.size(), 2u * solvers.size());
+  for (const SuiteRow& r : rows) {
+    SCOPED_TRACE(r.solver + " " + r.start + " " + r.status + " " + r.message);
+    EXPECT_FALSE(r.status.empty());
+    if (r.start == "near") {
+      EXPECT_TRUE(r.solved || r.solver == "kinsol:fp");  // x + F is no contraction
+    }
+  }
+}
+
+// `throw 42` from a user's engine, or from a user's F inside our engines, used to end the
+// process (run_suite caught std::exception only): now a row, engine_threw, saying what it was.
+TEST(ProblemSets, ANonStandardExceptionIsARowNotTheEnd) {
+  register_once();
+  const ProblemSetEntry set{.name = "test-42", .problems = [] {
+                              return std::vector<TestProblem>{
+                                  root_test_problem("throws-42", 1,
+                                                    [](const auto& x, auto& f) {
+                                                      if (x[0] > 0.5) throw 42;
+                                                      f[0] = x[0] - 1.0;
+                                                    },
+                                                    {{"x0", Eigen::VectorXd::Constant(1, 0.0)}})};
+                            }};
+  const std::vector<std::string> solvers = {"test-throws-42", "newton",        "anderson",
+                                            "auto",           "minpack:hybrj", "kinsol:newton",
+                                            "kinsol:fp",      "gsl:gnewton"};
+  SuiteOptions options;
+  options.evaluations_per_dimension = 50;
+  std::vector<SuiteRow> rows;
+  ASSERT_NO_THROW(rows = reference::run_suite(set, build_problem_set(set), solvers, options));
+  ASSERT_EQ(rows.size(), solvers.size());
+  const SuiteRow& engine = row(rows, "throws-42", "x0", "test-throws-42");
+  EXPECT_EQ(engine.status, "engine_threw");
+  EXPECT_EQ(engine.message, "a non-standard exception");
+  EXPECT_FALSE(row(rows, "throws-42", "x0", "newton").solved);
+  EXPECT_EQ(row(rows, "throws-42", "x0", "newton").status, "engine_threw");
+  for (const SuiteRow& r : rows) EXPECT_FALSE(r.solved) << r.solver << " " << r.status;
+}
+
+// A known solution that is not a root, or lies outside the box, made the error column report
+// 4.0 for a solver that found the true root: refused, naming set, problem and solution index.
+TEST(ProblemSets, AKnownSolutionMustBeARootInsideTheBox) {
+  const auto message = [](TestProblem p, double threshold) -> std::string {
+    const ProblemSetEntry set{.name = "sols",
+                              .problems = [p] { return std::vector<TestProblem>{p}; },
+                              .solved_threshold = threshold};
+    try {
+      build_problem_set(set);
+    } catch (const InvalidInput& e) {
+      return e.what();
+    }
+    return "<accepted>";
+  };
+  TestProblem p = circle_and_line();
+  EXPECT_EQ(message(p, 1e-8), "<accepted>");
+  p.solutions.push_back(Eigen::Vector2d(2.0, 2.0));  // |F| = 4
+  std::string m = message(p, 1e-8);
+  EXPECT_NE(m.find("problem set 'sols'"), std::string::npos) << m;
+  EXPECT_NE(m.find("problem 'circle-line'"), std::string::npos) << m;
+  EXPECT_NE(m.find("known solution 1 is not a root"), std::string::npos) << m;
+  EXPECT_NE(m.find("|F(x*)|2 = 4 > 1e-08"), std::string::npos) << m;
+  p = circle_and_line();
+  p.solutions.insert(p.solutions.begin(), Eigen::Vector2d(-std::sqrt(2.0), -std::sqrt(2.0)));
+  m = message(p, 1e-8);  // a root, outside [0, 3]²
+  EXPECT_NE(m.find("known solution 0: x[0] is outside the bounds"), std::string::npos) << m;
+  // The published digits of a root are not a root at 1e-8; at the set's own looser threshold
+  // they are.
+  p = circle_and_line();
+  p.solutions = {Eigen::Vector2d(1.41421, 1.41421)};
+  EXPECT_NE(message(p, 1e-8).find("known solution 0 is not a root"), std::string::npos);
+  EXPECT_EQ(message(p, 1e-4), "<accepted>");
+  // F throwing at the solution is named too.
+  p = hostile();
+  p.solutions = {Eigen::VectorXd::Constant(1, 1.0)};
+  m = message(p, 1e-8);
+  EXPECT_NE(m.find("known solution 0: F throws there: the model left its domain"),
+            std::string::npos)
+      << m;
+  // The built-in sets pass (their published solutions refined to double precision).
+  for (const char* name : {"mgh", "bounded", "chua-window"}) {
+    EXPECT_NO_THROW(build_problem_set(*problem_set_registry().find(name))) << name;
+  }
+}
+
+// The budget is the same for every solver, and enforced: no row reports more F evaluations
+// than K (n + 1), and an evaluation asked for beyond it is refused (the row is max_evaluations,
+// never solved). Before: kinsol:newton used 118 687 of 7 000; at K = 1, 23 rows were solved
+// beyond their budget.
+TEST(ProblemSets, NoSolverEvaluatesFBeyondItsBudget) {
+  register_once();
+  const ProblemSelection mgh = select_problems("mgh", problem_set_registry());
+  std::vector<std::string> solvers = reference::default_suite_solvers();
+  solvers.push_back("kinsol:fp");
+  solvers.push_back("kinsol:fp-aa2");
+  for (const long k : {1L, 2L, 5L}) {
+    SuiteOptions options;
+    options.evaluations_per_dimension = k;
+    const auto rows = reference::run_suite(*mgh.set, mgh.problems, solvers, options);
+    int solved = 0;
+    for (const SuiteRow& r : rows) {
+      SCOPED_TRACE(r.solver + " " + r.problem + " n=" + std::to_string(r.n) + " " + r.start +
+                   " K=" + std::to_string(k));
+      EXPECT_LE(r.f_evals, k * (r.n + 1)) << r.status;
+      EXPECT_GE(r.f_evals, 0);
+      solved += r.solved;
+    }
+    EXPECT_GT(solved, 0) << k;  // a root within the budget is solved
+  }
+  // A user's engine that ignores the budget is stopped at it: its evaluations beyond are
+  // refused (NaN, the problem's F is not called), the row is max_evaluations, not solved,
+  // although the point it returns is the root.
+  int calls = 0;
+  TestProblem counted = root_test_problem("counted", 1,
+                                          [&calls](const auto& x, auto& f) {
+                                            ++calls;
+                                            f[0] = x[0] - 1.0;
+                                          },
+                                          {{"x0", Eigen::VectorXd::Constant(1, 0.0)}});
+  const ProblemSetEntry set{.name = "counted",
+                            .problems = [counted] { return std::vector<TestProblem>{counted}; }};
+  const auto problems = build_problem_set(set);
+  SuiteOptions options;
+  options.evaluations_per_dimension = 3;
+  calls = 0;
+  const auto rows = reference::run_suite(set, problems, {"test-greedy"}, options);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].status, "max_evaluations");
+  EXPECT_FALSE(rows[0].solved);
+  EXPECT_EQ(rows[0].f_evals, 6);  // counted at the call, not as the engine reports
+  EXPECT_LT(rows[0].residual, 1e-8);
+  EXPECT_NE(rows[0].message.find("beyond the budget of 6"), std::string::npos) << rows[0].message;
+}
+
+// The references' statuses are names in the suite's vocabulary: lowercase, no spaces (KINSOL's
+// flag names were printed as KIN_LINESEARCH_NONCONV or NONE, GSL's as gsl_strerror's
+// sentences, "input domain error" for gnewton's singular Jacobian).
+TEST(ProblemSets, ReferenceStatusesAreLowercaseNames) {
+  const ProblemSelection mgh = select_problems("mgh", problem_set_registry());
+  const auto rows =
+      reference::run_suite(*mgh.set, mgh.problems, reference::all_reference_solvers());
+  std::set<std::string> statuses;
+  for (const SuiteRow& r : rows) {
+    statuses.insert(r.status);
+    EXPECT_EQ(r.status.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_"),
+              std::string::npos)
+        << r.solver << " " << r.problem << " " << r.start << ": '" << r.status << "'";
+  }
+  EXPECT_TRUE(statuses.count("kin_linesearch_nonconv") || statuses.count("max_evaluations"));
+  EXPECT_FALSE(statuses.count("none"));
+}
+
+// n = 0, a problems() that throws (anything) or runs out of memory, and n above the dense
+// limit: refused naming the set, the problem and the numbers.
+TEST(ProblemSets, EmptyHugeAndThrowingSetsAreRefusedNamingThem) {
+  const auto message = [](std::function<std::vector<TestProblem>()> problems) -> std::string {
+    const ProblemSetEntry set{.name = "odd", .problems = std::move(problems)};
+    try {
+      build_problem_set(set);
+    } catch (const InvalidInput& e) {
+      return e.what();
+    }
+    return "<accepted>";
+  };
+  std::string m = message([] {
+    return std::vector<TestProblem>{
+        root_test_problem("nothing", 0, [](const auto&, auto&) {}, {{"s", Eigen::VectorXd(0)}})};
+  });
+  // RootProblem refuses n = 0 itself, inside the set's problems(): the set is named.
+  EXPECT_NE(m.find("problem set 'odd': building its problems threw: RootProblem: dimensions n = 0"),
+            std::string::npos)
+      << m;
+  m = message([]() -> std::vector<TestProblem> { throw std::runtime_error("no licence"); });
+  EXPECT_NE(m.find("problem set 'odd': building its problems threw: no licence"), std::string::npos)
+      << m;
+  m = message([]() -> std::vector<TestProblem> { throw 42; });
+  EXPECT_NE(m.find("problem set 'odd': building its problems threw: a non-standard exception"),
+            std::string::npos)
+      << m;
+  m = message([]() -> std::vector<TestProblem> { throw std::bad_alloc(); });
+  EXPECT_NE(m.find("problem set 'odd': building its problems ran out of memory"), std::string::npos)
+      << m;
+  const Index big = kMaxProblemDimension + 1;
+  m = message([big] {
+    return std::vector<TestProblem>{root_test_problem(
+        "big", big, [](const auto& x, auto& f) { f = x; }, {{"s", Eigen::VectorXd::Zero(big)}})};
+  });
+  EXPECT_NE(m.find("problem 'big' (n = 2001): n = 2001 is above the limit of 2000 unknowns"),
+            std::string::npos)
+      << m;
+  // A start label of control characters is echoed escaped.
+  m = message([] {
+    TestProblem p = circle_and_line();
+    p.starts[0].x = Eigen::Vector3d::Zero();
+    p.starts[0].label = "\x1b[31mred\n";
+    return std::vector<TestProblem>{p};
+  });
+  EXPECT_NE(m.find("start '\\e[31mred\\n' has size 3"), std::string::npos) << m;
+}
+
+// What the table prints of a row without an answer: its reason, on the next line.
+TEST(ProblemSets, TheTableSaysWhyARowHasNoAnswer) {
+  register_once();
+  cli::SuiteArguments args;
+  args.solvers = "test-throws-42,test-throws";
+  std::ostringstream out, err;
+  cli::run_problem_suite({"test-set/cosine"}, args, "solve", out, err);
+  EXPECT_NE(out.str().find("engine_threw"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("    a non-standard exception\n"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("    a user's engine failed\n"), std::string::npos) << out.str();
+}
+
+// What fuzz_suite_report checks, pinned: a start label from a user's plugin with invalid UTF-8
+// made nlohmann::json's dump() throw (the --json output ended with an exception); it is U+FFFD
+// in the JSON, the bytes as given in the CSV (quoted), escaped in the table.
+TEST(ProblemSets, TheWritersTakeAnyLabel) {
+  SuiteRow r;
+  r.set = "s";
+  r.problem = "p";
+  r.n = 1;
+  r.start = "a,\"b\"\n\xff\x1b[31m";
+  r.solver = "newton";
+  r.residual = std::numeric_limits<double>::quiet_NaN();
+  r.ns = 5e-324;
+  r.status = "engine_threw";
+  r.message = "line\r\nbreak";
+  const std::vector<SuiteRow> rows = {r};
+  std::string dumped;
+  ASSERT_NO_THROW(dumped = cli::suite_to_json(rows).dump());
+  const auto back = nlohmann::json::parse(dumped);
+  EXPECT_EQ(back[0]["start"], "a,\"b\"\n\xEF\xBF\xBD\x1b[31m");
+  EXPECT_TRUE(back[0]["residual"].is_null());
+  EXPECT_EQ(back[0]["ns"].get<double>(), 5e-324);
+  const std::string csv = cli::suite_to_csv(rows);
+  EXPECT_NE(csv.find(",\"a,\"\"b\"\"\n\xff\x1b[31m\","), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",\"line\r\nbreak\"\n"), std::string::npos) << csv;
+  std::ostringstream table;
+  cli::print_suite_tables(rows, 1e-8, table);
+  EXPECT_NE(table.str().find("start a,\"b\"\\n\\xff\\e[31m"), std::string::npos) << table.str();
+  EXPECT_NE(table.str().find("    line\\r\\nbreak\n"), std::string::npos) << table.str();
 }
 
 TEST(ProblemSets, MalformedProblemsAreRefusedNamingTheProblem) {
@@ -393,7 +698,7 @@ TEST(ProblemSets, TheCliPrintsTheTableJsonAndCsvOfAUsersSet) {
   ASSERT_EQ(rows.size(), 2u * 1u + 2u * 3u);  // solvers x starts
   for (const auto& r : rows) {
     for (const char* key : {"set", "problem", "n", "start", "start_scale", "solver", "solved",
-                            "residual", "error", "f_evals", "j_evals", "ns", "status"}) {
+                            "residual", "error", "f_evals", "j_evals", "ns", "status", "message"}) {
       ASSERT_TRUE(r.contains(key)) << key << " missing in " << r.dump();
     }
     // The threshold given is the one judged by.
@@ -406,7 +711,7 @@ TEST(ProblemSets, TheCliPrintsTheTableJsonAndCsvOfAUsersSet) {
   std::getline(file, header);
   EXPECT_EQ(header,
             "set,problem,n,start,start_scale,solver,solved,residual,error,f_evals,j_evals,ns,"
-            "status");
+            "status,message");
   int lines = 0;
   while (std::getline(file, line)) ++lines;
   EXPECT_EQ(lines, 8);

@@ -146,6 +146,54 @@ TEST(PseudoTransient, BudgetAndOptions) {
             std::string::npos);
 }
 
+// δ₀ below machine epsilon makes x + δF == x wherever |F| ≤ |x|: refused, naming the bound; a
+// subnormal is a number all the same (the option's check refuses it, not the parser); a tiny δ
+// was once a "converged" first step (‖p‖₂² underflowed to 0, so the step looked Newton-like).
+TEST(PseudoTransient, APseudoStepTooSmallToMoveXIsRefusedAndNeverConverged) {
+  auto& registry = EngineRegistry<>::global();
+  for (const char* spec : {"pseudo-transient:delta0=1e-300", "pseudo-transient:delta0=4e-320",
+                           "pseudo-transient:delta0=1e-17"}) {
+    const std::string m = test::message_of([&] { registry.create(spec); });
+    EXPECT_NE(m.find("initial_pseudo_step"), std::string::npos) << spec << ": " << m;
+    EXPECT_NE(m.find("2.22e-16"), std::string::npos) << spec << ": " << m;
+    EXPECT_EQ(m.find("not a finite number"), std::string::npos) << spec << ": " << m;
+  }
+  EXPECT_NE(test::message_of([] {
+              PseudoTransientEngine<1>({.initial_pseudo_step = 1e-300, .min_pseudo_step = 1e-300});
+            }).find("initial_pseudo_step"),
+            std::string::npos);
+  EXPECT_NE(test::message_of([] {
+              PseudoTransientEngine<1>({.min_pseudo_step = 1e-300});
+            }).find("min_pseudo_step"),
+            std::string::npos);
+  // Every positive finite value where one is meaningful: a subnormal tolerance, delta0 at the
+  // floor.
+  EXPECT_EQ(registry.create("newton:tol=4e-320")->name(), "newton");
+  EXPECT_EQ(registry.create("pseudo-transient:delta0=2.3e-16")->name(), "pseudo-transient");
+  EXPECT_NE(test::message_of([&] { registry.create("newton:tol=1e400"); }).find("not a finite"),
+            std::string::npos);
+
+  // x = 1e8, F = x − (1e8 + 10): at δ₀ = 2.3e-16 the step δF ≈ 2e-15 is below the spacing of x
+  // (1.5e-8), x + p == x. Such a step is no step, and no convergence: δ doubles until x moves
+  // (before: the same x at every iteration until the budget was spent). Switched evolution
+  // relaxation then grows δ only as fast as ‖F‖ falls: slowly from so small a δ₀.
+  const auto far = scalar_root([](const auto& x) { return x - (1e8 + 10.0); });
+  SolverOptions o;
+  o.stop.max_evaluations = 200;
+  Vector<1> x(1e8);
+  Summary s =
+      PseudoTransientEngine<1>({.initial_pseudo_step = 2.3e-16, .min_pseudo_step = 2.3e-16}, o)
+          .solve(far, x);
+  EXPECT_FALSE(s.converged()) << s.full_report();
+  EXPECT_EQ(s.status, Status::kMaxEvaluations);
+  EXPECT_GT(x[0], 1e8);  // it moved
+  // From δ₀ = 1e-2 (the default) the same problem is solved in a few steps.
+  x[0] = 1e8;
+  s = PseudoTransientEngine<1>({}, o).solve(far, x);
+  EXPECT_TRUE(s.converged()) << s.full_report();
+  EXPECT_NEAR(x[0], 1e8 + 10.0, 1e-6);
+}
+
 TEST(NewtonTrustRegion, ConvergesWhereThePlainStepDivergesAndIsStillNewton) {
   const auto problem = scalar_root(kAtan);
   Vector<1> x(10.0);

@@ -2,6 +2,7 @@
 #include <gsl/gsl_multiroots.h>
 
 #include <memory>
+#include <stdexcept>
 
 #include "nlobs/reference/root_reference.hpp"
 
@@ -13,6 +14,8 @@ struct Context {
   Eigen::VectorXd x, f;
   Eigen::MatrixXd j;
   long f_evals = 0, j_evals = 0;
+  long cap = 0;          // the evaluations GSL may make (check_answer takes one more)
+  bool refused = false;  // an evaluation beyond the cap was asked for
 };
 
 void load(Context* c, const gsl_vector* x) {
@@ -21,9 +24,13 @@ void load(Context* c, const gsl_vector* x) {
 
 int eval_f(const gsl_vector* x, void* p, gsl_vector* f) {
   auto* c = static_cast<Context*>(p);
+  if (c->f_evals >= c->cap) {
+    c->refused = true;
+    return GSL_EBADFUNC;  // GSL stops: iterate() returns it
+  }
   load(c, x);
-  c->problem->evaluate(c->x, c->f);
   ++c->f_evals;
+  c->problem->evaluate(c->x, c->f);
   for (Eigen::Index i = 0; i < c->f.size(); ++i) gsl_vector_set(f, i, c->f[i]);
   return c->f.allFinite() ? GSL_SUCCESS : GSL_EBADFUNC;
 }
@@ -41,8 +48,25 @@ int eval_j(const gsl_vector* x, void* p, gsl_matrix* jac) {
 
 int eval_fj(const gsl_vector* x, void* p, gsl_vector* f, gsl_matrix* jac) {
   const int a = eval_f(x, p, f);
+  if (static_cast<Context*>(p)->refused) return a;
   const int b = eval_j(x, p, jac);
   return a != GSL_SUCCESS ? a : b;
+}
+
+// GSL's error codes in the suite's vocabulary (MINPACK's names where they mean the same).
+std::string status_name(int code) {
+  switch (code) {
+    case GSL_EBADFUNC:
+      return "non_finite";
+    case GSL_EDOM:  // gnewton: gsl_linalg_LU_solve of a singular Jacobian
+      return "singular_jacobian";
+    case GSL_ENOPROG:
+      return "not_making_progress";
+    case GSL_ENOPROGJ:
+      return "not_making_progress_jacobian";
+    default:
+      return "gsl_error_" + std::to_string(code);
+  }
 }
 
 }  // namespace
@@ -51,9 +75,13 @@ ReferenceResult solve_gsl(const std::string& method, const RootProblem<Dynamic>&
                           Eigen::VectorXd& x, const ReferenceOptions& options) {
   const gsl_multiroot_fdfsolver_type* type =
       method == "gnewton" ? gsl_multiroot_fdfsolver_gnewton : gsl_multiroot_fdfsolver_hybridsj;
+  if (options.max_evaluations < 2) {
+    throw std::invalid_argument("ReferenceOptions::max_evaluations must be >= 2");
+  }
   const size_t n = static_cast<size_t>(x.size());
   Context c{&problem, Eigen::VectorXd(x.size()), Eigen::VectorXd(x.size()),
             Eigen::MatrixXd(x.size(), x.size())};
+  c.cap = options.max_evaluations - 1;
   gsl_multiroot_function_fdf fdf{&eval_f, &eval_j, &eval_fj, n, &c};
   std::unique_ptr<gsl_vector, decltype(&gsl_vector_free)> x0(gsl_vector_alloc(n), gsl_vector_free);
   for (size_t i = 0; i < n; ++i) gsl_vector_set(x0.get(), i, x[static_cast<Eigen::Index>(i)]);
@@ -64,12 +92,12 @@ ReferenceResult solve_gsl(const std::string& method, const RootProblem<Dynamic>&
   int status = gsl_multiroot_fdfsolver_set(s.get(), &fdf, x0.get());
   result.status = "max_evaluations";
   if (status != GSL_SUCCESS) {
-    result.status = "non_finite";
+    result.status = status_name(status);
   } else {
-    while (c.f_evals < options.max_evaluations) {
+    while (c.f_evals < c.cap) {
       status = gsl_multiroot_fdfsolver_iterate(s.get());
       if (status != GSL_SUCCESS) {
-        result.status = status == GSL_EBADFUNC ? "non_finite" : gsl_strerror(status);
+        result.status = c.refused ? "max_evaluations" : status_name(status);
         break;
       }
       if (gsl_multiroot_test_residual(s.get()->f, options.tolerance) == GSL_SUCCESS ||

@@ -7,6 +7,7 @@
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -28,12 +29,22 @@ struct KinsolSolver::Impl {
   Eigen::VectorXd x_in, f_out;
   Eigen::MatrixXd jac_out;
   long calls = 0;  // evaluations of F (or G), whoever asked
+  long cap = 0;    // the evaluations KINSOL may make (0: any number)
+  bool refused = false;
 
   static int residual(N_Vector u_vec, N_Vector f_vec, void* data) {
     auto* self = static_cast<Impl*>(data);
+    if (self->cap > 0 && self->calls >= self->cap) {
+      self->refused = true;
+      return -1;  // < 0: unrecoverable, KINSOL stops
+    }
     self->x_in = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(u_vec), self->n);
     ++self->calls;
-    self->function(self->x_in, self->f_out);
+    try {  // no exception may unwind through KINSOL
+      self->function(self->x_in, self->f_out);
+    } catch (...) {
+      return -1;
+    }
     Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(f_vec), self->n) = self->f_out;
     return self->f_out.allFinite() ? 0 : 1;  // > 0: recoverable error
   }
@@ -41,7 +52,11 @@ struct KinsolSolver::Impl {
                             N_Vector) {
     auto* self = static_cast<Impl*>(data);
     self->x_in = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(u_vec), self->n);
-    self->jacobian(self->x_in, self->jac_out);
+    try {
+      self->jacobian(self->x_in, self->jac_out);
+    } catch (...) {
+      return -1;
+    }
     // SUNDIALS dense matrices are column-major, like Eigen's default.
     Eigen::Map<Eigen::MatrixXd>(SUNDenseMatrix_Data(jac), self->n, self->n) = self->jac_out;
     return 0;
@@ -58,9 +73,16 @@ KinsolSolver::KinsolSolver(int n, KinsolOptions options, Function function, Jaco
   if (!(options.max_newton_step >= 0.0 && std::isfinite(options.max_newton_step))) {
     throw std::invalid_argument("KinsolOptions::max_newton_step must be finite and >= 0");
   }
+  if (options.max_evaluations != 0 && options.max_evaluations < 2) {
+    throw std::invalid_argument("KinsolOptions::max_evaluations must be 0 (no limit) or >= 2");
+  }
+  if (options.max_iterations < 1) {
+    throw std::invalid_argument("KinsolOptions::max_iterations must be >= 1");
+  }
   Impl& s = *impl_;
   s.n = n;
   s.options = options;
+  s.cap = options.max_evaluations > 0 ? options.max_evaluations - 1 : 0;
   s.function = std::move(function);
   s.jacobian = std::move(jacobian);
   s.x_in.resize(n);
@@ -112,6 +134,7 @@ KinsolResult KinsolSolver::solve(Eigen::VectorXd& x) {
   }
   KinsolResult r;
   s.calls = 0;
+  s.refused = false;
   r.flag = KINSol(s.kinsol, s.u, strategy, s.scale, s.scale);
   char* name = KINGetReturnFlagName(r.flag);
   r.flag_name = name ? name : "?";
@@ -130,6 +153,7 @@ KinsolResult KinsolSolver::solve(Eigen::VectorXd& x) {
     }
   }
   r.evaluations = s.calls;
+  r.budget_spent = s.refused;
   r.success = r.flag >= 0 && r.residual <= s.options.tolerance;
   if (r.flag >= 0 && !r.success) {
     std::ostringstream os;
@@ -145,8 +169,23 @@ KinsolResult KinsolSolver::solve(Eigen::VectorXd& x) {
 
 std::string KinsolResult::status() const {
   if (success) return "converged";
+  if (budget_spent) return "max_evaluations";
   if (flag >= 0) return std::isfinite(residual) ? "residual_above_tolerance" : "non_finite";
-  return flag_name;
+  switch (flag) {
+    case KIN_MAXITER_REACHED:
+      return "max_iterations";
+    case KIN_FIRST_SYSFUNC_ERR:
+    case KIN_REPTD_SYSFUNC_ERR:
+      return "non_finite";
+    default:
+      break;
+  }
+  // KINGetReturnFlagName says "NONE" for flags it does not know (KIN_VECTOROP_ERR,
+  // KIN_CONTEXT_ERR in SUNDIALS 6.4): the number then.
+  std::string name = flag_name;
+  if (name.rfind("KIN_", 0) != 0) name = "kin_flag_" + std::to_string(flag);
+  for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return name;
 }
 
 std::optional<KinsolStrategy> KinsolSolver::strategy(const std::string& name) {

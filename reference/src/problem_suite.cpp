@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <new>
 #include <set>
 #include <stdexcept>
 
+#include "nlobs/common/printable.hpp"
 #include "nlobs/reference/kinsol_solver.hpp"
 #include "nlobs/reference/root_reference.hpp"
 #include "nlobs/reference/timing.hpp"
@@ -18,6 +21,7 @@ namespace {
 struct Outcome {
   std::string status;
   long f_evals = 0, j_evals = 0;
+  std::string message;
 };
 
 // Each (pair, solver) is timed over ~1 ms of repeated solves, at most 201 of them: the whole
@@ -30,59 +34,116 @@ bool is_reference(const std::string& s) {
   return std::find(refs.begin(), refs.end(), s) != refs.end();
 }
 
+// Counts the evaluations of F (or G) one solve makes and refuses those beyond its budget: the
+// refused call returns NaN without calling the problem, and the row becomes max_evaluations.
+struct Meter {
+  long count = 0;
+  long cap = std::numeric_limits<long>::max();
+  bool refused = false;
+  void reset(long budget) {
+    count = 0;
+    cap = budget;
+    refused = false;
+  }
+  // True when one more evaluation is within the budget (and counts it).
+  bool take() {
+    if (count >= cap) {
+      refused = true;
+      return false;
+    }
+    ++count;
+    return true;
+  }
+};
+
 // The C libraries (MINPACK, GSL, KINSOL) must never see an exception unwind through them: their
-// copies of a user's F, ∂F and G turn one into NaN, a non-finite evaluation they report.
-RootProblem<Dynamic> guarded(const RootProblem<Dynamic>& f) {
+// copies of a user's F, ∂F and G turn one into NaN, a non-finite evaluation they report. With a
+// meter, an evaluation beyond its budget is NaN too (the references stop before, each counting
+// its own: the meter is the backstop).
+RootProblem<Dynamic> guarded(const RootProblem<Dynamic>& f, Meter* meter) {
   const RootProblem<Dynamic>* p = &f;
   return RootProblem<Dynamic>::with_jacobian(
-      [p](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
+      [p, meter](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
+        if (meter && !meter->take()) {
+          out.setConstant(p->residual_size(), std::numeric_limits<double>::quiet_NaN());
+          return;
+        }
         try {
           p->evaluate(x, out);
         } catch (...) {
-          out.setConstant(x.size(), std::numeric_limits<double>::quiet_NaN());
+          out.setConstant(p->residual_size(), std::numeric_limits<double>::quiet_NaN());
         }
       },
       [p](const Eigen::VectorXd& x, Eigen::MatrixXd& jac) {
         try {
           p->jacobian(x, jac);
         } catch (...) {
-          jac.setConstant(x.size(), x.size(), std::numeric_limits<double>::quiet_NaN());
+          jac.setConstant(p->residual_size(), x.size(), std::numeric_limits<double>::quiet_NaN());
         }
       },
       f.size(), f.residual_size(), f.jacobian_source());
 }
-FixedPointProblem<Dynamic> guarded(const FixedPointProblem<Dynamic>& g) {
+FixedPointProblem<Dynamic> guarded(const FixedPointProblem<Dynamic>& g, Meter* meter) {
   const FixedPointProblem<Dynamic>* p = &g;
   return FixedPointProblem<Dynamic>::from_map(
-      [p](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
+      [p, meter](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
+        if (meter && !meter->take()) {
+          out.setConstant(p->size(), std::numeric_limits<double>::quiet_NaN());
+          return;
+        }
         try {
           p->evaluate(x, out);
         } catch (...) {
-          out.setConstant(x.size(), std::numeric_limits<double>::quiet_NaN());
+          out.setConstant(p->size(), std::numeric_limits<double>::quiet_NaN());
         }
       },
       g.size());
 }
 
+// G for our engines (a user's among them): metered, its Jacobian kept, its exceptions left to
+// the engine (an engine that throws is a row, engine_threw).
+FixedPointProblem<Dynamic> metered(const FixedPointProblem<Dynamic>& g, Meter& meter) {
+  const FixedPointProblem<Dynamic>* p = &g;
+  auto map = [p, &meter](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
+    if (!meter.take()) {
+      out.setConstant(p->size(), std::numeric_limits<double>::quiet_NaN());
+      return;
+    }
+    p->evaluate(x, out);
+  };
+  if (!g.has_jacobian()) return FixedPointProblem<Dynamic>::from_map(map, g.size());
+  return FixedPointProblem<Dynamic>::with_jacobian(
+      map, [p](const Eigen::VectorXd& x, Eigen::MatrixXd& jac) { p->jacobian(x, jac); }, g.size(),
+      g.jacobian_source());
+}
+
+// KINSOL's options and set-up may refuse (std::invalid_argument): the caller makes that row
+// invalid_input. `budget` counts every evaluation, the references' checks of their answers
+// included.
 Outcome run_reference(const std::string& solver, const RootProblem<Dynamic>& residual,
                       const FixedPointProblem<Dynamic>& g, Eigen::VectorXd& x, long budget) {
   ReferenceOptions o;
   o.max_evaluations = budget;
   if (solver == "minpack:hybrj") {
     const ReferenceResult r = solve_minpack_hybrj(residual, x, o);
-    return {r.status, r.f_evals, r.j_evals};
+    return {r.status, r.f_evals, r.j_evals, {}};
   }
   if (solver == "gsl:hybridsj" || solver == "gsl:gnewton") {
     const ReferenceResult r = solve_gsl(solver.substr(4), residual, x, o);
-    return {r.status, r.f_evals, r.j_evals};
+    return {r.status, r.f_evals, r.j_evals, {}};
   }
   KinsolOptions ko;
   ko.strategy = KinsolSolver::strategy(solver).value_or(KinsolStrategy::kNewtonLineSearch);
   ko.tolerance = 1e-10;
+  // KINSOL counts iterations (each at least one evaluation); max_evaluations bounds the
+  // evaluations its line search and the final check add.
   ko.max_iterations = budget;
+  ko.max_evaluations = budget;
   // KINSOL's own maximum step, 1000 ‖u₀‖₂, collapses to 1 at u₀ = 0 (Watson's start, a
-  // user's zero start): the same rule measured from 1 instead (docs/solvers.md).
-  ko.max_newton_step = 1000.0 * std::max(1.0, x.norm());
+  // user's zero start): the same rule measured from 1 instead (docs/solvers.md); ‖u₀‖₂ without
+  // overflow and the product at most the largest double (a start of 1e308).
+  ko.max_newton_step = std::min(std::numeric_limits<double>::max(),
+                                1000.0 * std::max(1.0, x.allFinite() ? x.stableNorm() : 1.0));
   const int n = static_cast<int>(residual.size());
   std::unique_ptr<KinsolSolver> k;
   if (ko.strategy == KinsolStrategy::kNewtonLineSearch) {
@@ -96,7 +157,7 @@ Outcome run_reference(const std::string& solver, const RootProblem<Dynamic>& res
         n, ko, [gp](const Eigen::VectorXd& v, Eigen::VectorXd& out) { gp->evaluate(v, out); });
   }
   const KinsolResult r = k->solve(x);
-  return {r.status(), r.evaluations, r.jacobian_evaluations};
+  return {r.status(), r.evaluations, r.jacobian_evaluations, r.reason};
 }
 
 double distance_to_solutions(const TestProblem& p, const Eigen::VectorXd& x) {
@@ -229,13 +290,19 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
 
   int done = 0;
   std::vector<SuiteRow> rows;
+  Meter meter;
   for (const TestProblem& p : problems) {
     const Index n = p.size();
-    const long budget = options.evaluations_per_dimension * (n + 1);
+    // K (n + 1), saturated (K ≤ 1e6 and n ≤ kMaxProblemDimension keep it far from overflow).
+    const long budget = n + 1 > std::numeric_limits<long>::max() / options.evaluations_per_dimension
+                            ? std::numeric_limits<long>::max()
+                            : options.evaluations_per_dimension * static_cast<long>(n + 1);
     const FixedPointProblem<Dynamic> g =
         p.fixed_point ? *p.fixed_point : to_fixed_point<Dynamic>(p.residual);
-    const RootProblem<Dynamic> safe_f = guarded(p.residual);
-    const FixedPointProblem<Dynamic> safe_g = guarded(g);
+    const RootProblem<Dynamic> judge_f = guarded(p.residual, nullptr);  // the suite's own look
+    const RootProblem<Dynamic> safe_f = guarded(p.residual, &meter);
+    const FixedPointProblem<Dynamic> safe_g = guarded(g, &meter);
+    const FixedPointProblem<Dynamic> engine_g = metered(g, meter);
     for (const ProblemStart& start : p.starts) {
       if (!selected(start, options)) continue;
       for (const std::string& s : solvers) {
@@ -248,54 +315,79 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
         row.solver = s;
         Eigen::VectorXd x = start.x;
         Outcome outcome;
-        if (is_reference(s)) {
-          row.ns = mean_ns_per_call(
-              [&] {
-                x = start.x;
-                outcome = run_reference(s, safe_f, safe_g, x, budget);
-              },
-              kTimingNs, 1, kMaxTimedCalls);
-        } else {
-          SolverOptions o = base;
-          o.stop.max_evaluations = static_cast<int>(std::min<long>(budget, 1L << 30));
-          auto engine = registry.create(s, o);
-          // The problem's box reaches the engines that take bounds; the others run unbounded
-          // and are judged alike (outside_bounds).
-          if ((p.lower.size() > 0 || p.upper.size() > 0) && engine->accepts_bounds()) {
-            try {
+        meter.reset(budget);
+        // Whatever a solver's options, set-up or run throw, the row says so and the suite goes
+        // on: invalid_input (options or set-up refused, the problem's box refused),
+        // out_of_memory (std::bad_alloc), engine_threw (anything else, `throw 42` included).
+        bool setting_up = true;
+        try {
+          if (is_reference(s)) {
+            row.ns = mean_ns_per_call(
+                [&] {
+                  x = start.x;
+                  meter.reset(budget);
+                  outcome = run_reference(s, safe_f, safe_g, x, budget);
+                },
+                kTimingNs, 1, kMaxTimedCalls);
+          } else {
+            SolverOptions o = base;
+            o.stop.max_evaluations = static_cast<int>(std::min<long>(budget, 1L << 30));
+            auto engine = registry.create(s, o);
+            // The problem's box reaches the engines that take bounds; the others run unbounded
+            // and are judged alike (outside_bounds). levenberg-marquardt:geodesic=1 and a
+            // user's engine may refuse it: invalid_input.
+            if ((p.lower.size() > 0 || p.upper.size() > 0) && engine->accepts_bounds()) {
               engine->set_bounds({p.lower, p.upper});
-            } catch (const InvalidInput&) {  // levenberg-marquardt:geodesic=1, a user's engine
-              row.status = "invalid_input";  // the engine refused the box: it did not run
-              row.residual = std::numeric_limits<double>::infinity();
-              row.error = std::numeric_limits<double>::infinity();
-              rows.push_back(std::move(row));
-              continue;
             }
+            setting_up = false;
+            row.ns = mean_ns_per_call(
+                [&] {
+                  x = start.x;
+                  meter.reset(budget);
+                  const Summary sum = solve_or_report(*engine, engine_g, x);
+                  // The metered count: every evaluation of G the engine made.
+                  outcome = {std::string(to_string(sum.status)), meter.count,
+                             sum.jacobian_evaluations, sum.message};
+                },
+                kTimingNs, 1, kMaxTimedCalls);
           }
-          row.ns = mean_ns_per_call(
-              [&] {
-                x = start.x;
-                try {
-                  const Summary sum = solve_or_report(*engine, g, x);
-                  outcome = {std::string(to_string(sum.status)), sum.function_evaluations,
-                             sum.jacobian_evaluations};
-                } catch (const std::exception&) {  // a user's engine: a row, not the end
-                  outcome = {"engine_threw", 0, 0};
-                }
-              },
-              kTimingNs, 1, kMaxTimedCalls);
+        } catch (const std::bad_alloc&) {
+          outcome = {"out_of_memory", meter.count, 0, "std::bad_alloc: not enough memory"};
+          x.resize(0);
+        } catch (...) {
+          const bool refused_input = (setting_up || is_reference(s)) && [] {
+            try {
+              throw;
+            } catch (const std::invalid_argument&) {  // InvalidInput is one
+              return true;
+            } catch (...) {
+              return false;
+            }
+          }();
+          outcome = {refused_input ? "invalid_input" : "engine_threw", meter.count, 0,
+                     current_exception_text()};
+          x.resize(0);  // no answer
         }
-        Eigen::VectorXd f(n);
+        row.message = printable(outcome.message);
         if (x.size() == n && x.allFinite()) {
-          safe_f.evaluate(x, f);
+          Eigen::VectorXd f(n);
+          judge_f.evaluate(x, f);
           row.residual = f.allFinite() ? f.norm() : std::numeric_limits<double>::infinity();
         } else {
           row.residual = std::numeric_limits<double>::infinity();
         }
         row.status = outcome.status;
         const bool in_box = x.size() == n && !p.first_outside_bounds(x);
-        if (!in_box) row.status = "outside_bounds";
-        row.solved = in_box && row.residual <= threshold;
+        if (x.size() == n && !in_box) row.status = "outside_bounds";
+        // An evaluation asked for beyond the budget was refused: whatever the point, not solved.
+        if (meter.refused) {
+          row.status = "max_evaluations";
+          if (row.message.empty()) {
+            row.message = "asked for an evaluation beyond the budget of " + std::to_string(budget) +
+                          " (refused)";
+          }
+        }
+        row.solved = x.size() == n && in_box && !meter.refused && row.residual <= threshold;
         row.error =
             x.size() == n ? distance_to_solutions(p, x) : std::numeric_limits<double>::infinity();
         row.f_evals = outcome.f_evals;

@@ -1,6 +1,8 @@
 #include "nlobs/registry/problem_sets.hpp"
 
 #include <cmath>
+#include <limits>
+#include <new>
 #include <set>
 #include <sstream>
 
@@ -17,17 +19,25 @@ std::string shape(Index n) {
 
 [[noreturn]] void fail(std::string_view where, const TestProblem& p, const std::string& what) {
   std::ostringstream os;
-  os << where << ": problem '" << p.name << "' (n = " << p.residual.size() << "): " << what;
+  os << where << ": problem '" << printable(p.name, 60) << "' (n = " << p.residual.size()
+     << "): " << what;
   throw InvalidInput(os.str());
 }
 
 }  // namespace
 
-void validate_test_problem(const TestProblem& p, std::string_view where) {
+void validate_test_problem(const TestProblem& p, std::string_view where,
+                           double solution_threshold) {
   const Index n = p.residual.size();
   if (!is_registry_name(p.name)) {
     throw InvalidInput(printable(where) + ": problem name '" + printable(p.name, 60) + "' " +
                        registry_name_problem(p.name) + " (" + std::string(kRegistryNameRule) + ")");
+  }
+  if (n <= 0) fail(where, p, "it has no unknowns: n must be at least 1");
+  if (n > kMaxProblemDimension) {
+    fail(where, p,
+         "n = " + shape(n) + " is above the limit of " + shape(kMaxProblemDimension) +
+             " unknowns (every solver keeps dense n x n matrices)");
   }
   if (p.residual.residual_size() != n) {
     fail(where, p,
@@ -64,7 +74,7 @@ void validate_test_problem(const TestProblem& p, std::string_view where) {
   }
   std::set<std::string> labels;
   for (const ProblemStart& s : p.starts) {
-    const std::string which = "start '" + s.label + "'";
+    const std::string which = "start '" + printable(s.label, 60) + "'";
     if (s.label.empty()) fail(where, p, "a start without a label");
     if (!labels.insert(s.label).second) fail(where, p, which + " is listed twice");
     if (s.x.size() != n) fail(where, p, which + " has size " + shape(s.x.size()));
@@ -80,6 +90,23 @@ void validate_test_problem(const TestProblem& p, std::string_view where) {
       fail(where, p, which + " has size " + shape(p.solutions[k].size()));
     }
     if (!p.solutions[k].allFinite()) fail(where, p, which + " is not finite");
+    if (const auto i = p.first_outside_bounds(p.solutions[k])) {
+      fail(where, p, which + ": x[" + shape(*i) + "] is outside the bounds");
+    }
+    Eigen::VectorXd f(n);
+    try {
+      p.residual.evaluate(p.solutions[k], f);
+    } catch (...) {
+      fail(where, p, which + ": F throws there: " + current_exception_text());
+    }
+    const double norm =
+        f.size() == n && f.allFinite() ? f.stableNorm() : std::numeric_limits<double>::infinity();
+    if (!(norm <= solution_threshold)) {
+      std::ostringstream os;
+      os << which << " is not a root: |F(x*)|2 = " << norm << " > " << solution_threshold
+         << " (the set's threshold)";
+      fail(where, p, os.str());
+    }
   }
 }
 
@@ -101,13 +128,15 @@ std::vector<TestProblem> build_problem_set(const ProblemSetEntry& set) {
   std::vector<TestProblem> problems;
   try {  // a user's function (a plugin's): anything it throws is named by the set
     problems = set.problems();
+  } catch (const std::bad_alloc&) {
+    throw InvalidInput(where + ": building its problems ran out of memory (std::bad_alloc)");
   } catch (...) {
     throw InvalidInput(where + ": building its problems threw: " + current_exception_text());
   }
   if (problems.empty()) throw InvalidInput(where + ": it has no problems");
   std::set<std::pair<std::string, Index>> seen;
   for (const TestProblem& p : problems) {
-    validate_test_problem(p, where);
+    validate_test_problem(p, where, set.solved_threshold);
     if (!seen.insert({p.name, p.size()}).second) {
       fail(where, p, "listed twice (a name is unique per size)");
     }

@@ -4,6 +4,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <sstream>
 
 namespace nlobs {
@@ -75,7 +76,10 @@ std::optional<double> EngineSpecReader::number(const std::string& key) {
   char* end = nullptr;
   errno = 0;
   const double v = std::strtod(t->c_str(), &end);
-  if (end == t->c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
+  // ERANGE on underflow (a subnormal such as 4e-320, or 1e-400 rounded to 0) is a finite number
+  // all the same: the option's own check judges its value. Only overflow is refused here.
+  if (end == t->c_str() || *end != '\0' || !std::isfinite(v) ||
+      (errno == ERANGE && std::fabs(v) > std::numeric_limits<double>::min())) {
     fail(quoted_excerpt(key + "=" + *t) + " is not a finite number");
   }
   return v;

@@ -22,7 +22,10 @@ TestProblem ferraris_tronconi() {
                                      {"corner", Eigen::Vector2d(0.25, 1.5)}});
   p.lower = Eigen::Vector2d(0.25, 1.5);
   p.upper = Eigen::Vector2d(1.0, 2.0 * kPi);
-  p.solutions = {Eigen::Vector2d(0.29945, 2.83693), Eigen::Vector2d(0.5, kPi)};
+  // Published (Floudas 14.1.4) as (0.29945, 2.83693), where ‖F‖₂ = 1e-6: refined by Newton to
+  // double precision, as a known solution must be a root at the set's threshold.
+  p.solutions = {Eigen::Vector2d(0.29944869249092626, 2.8369277704589395),
+                 Eigen::Vector2d(0.5, kPi)};
   p.description = "Ferraris-Tronconi, two roots in [0.25, 1] x [1.5, 2 pi] (Floudas 14.1.4)";
   return p;
 }
@@ -38,7 +41,8 @@ TestProblem bullard_biegler() {
                         {{"a", Eigen::Vector2d(0.1, 1.0)}, {"b", Eigen::Vector2d(4.0, 0.01)}});
   p.lower = Eigen::Vector2d(5.49e-6, 2.196e-3);
   p.upper = Eigen::Vector2d(4.553, 18.21);
-  p.solutions = {Eigen::Vector2d(1.450e-5, 6.8933353)};
+  // Published as (1.450e-5, 6.8933353), where ‖F‖₂ = 5e-4: refined by Newton.
+  p.solutions = {Eigen::Vector2d(1.4506728712044511e-05, 6.8933528698977415)};
   p.description = "Bullard-Biegler: Powell's badly scaled system with 1.001, on a box";
   return p;
 }
@@ -53,7 +57,8 @@ TestProblem shacham_cstr() {
       {{"a", Eigen::VectorXd::Constant(1, 0.0)}, {"b", Eigen::VectorXd::Constant(1, 0.5)}});
   p.lower = Eigen::VectorXd::Constant(1, 0.0);
   p.upper = Eigen::VectorXd::Constant(1, 0.7999);
-  p.solutions = {Eigen::VectorXd::Constant(1, 0.757396)};
+  // Published as 0.757396, where |F| = 2e-5: refined by Newton.
+  p.solutions = {Eigen::VectorXd::Constant(1, 0.7573962462537539)};
   p.description = "Shacham's CSTR conversion, F undefined from x = 0.8 on";
   return p;
 }

@@ -21,7 +21,14 @@ struct KinsolOptions {
   KinsolStrategy strategy = KinsolStrategy::kFixedPoint;
   double tolerance = 1e-8;  // KINSOL's fnormtol (‖F‖∞, or ‖G(u)−u‖∞ for FP) and scsteptol
   int anderson_depth = 2;
-  long max_iterations = 10000;
+  long max_iterations = 10000;  // KINSetNumMaxIters: KINSOL counts iterations, not evaluations
+  // Every evaluation of F (or G) counts, the final check's included (KinsolResult::evaluations):
+  // KINSOL may make max_evaluations − 1 — its line search and difference-quotient Jacobian
+  // evaluate F more than once per iteration, which max_iterations does not bound — and the check
+  // takes the last one. An evaluation beyond that is refused before F is called (the callback
+  // returns −1: KINSOL stops with KIN_SYSFUNC_FAIL or a linear-solver failure) and the status is
+  // "max_evaluations". 0: no limit; otherwise at least 2.
+  long max_evaluations = 0;
   // KINSetMaxNewtonStep (Newton only): the largest scaled step ‖Δu‖₂. 0 keeps KINSOL's rule,
   // 1000 ‖u₀‖₂ but at least 1 (kinsol.c, KINSolInit), which at u₀ = 0 allows steps of length 1
   // only and ends runs with KIN_MXNEWT_5X_EXCEEDED; the suite passes 1000 max(1, ‖u₀‖₂).
@@ -46,8 +53,12 @@ struct KinsolResult {
   // so the column compares with our engines' function_evaluations.
   long evaluations = 0;
   long jacobian_evaluations = 0;  // KINGetNumJacEvals (Newton only)
-  // "converged", "non_finite" or "residual_above_tolerance" (flag >= 0 that does not stand),
-  // else KINSOL's flag name (KIN_MAXITER_REACHED, ...).
+  bool budget_spent = false;      // an evaluation beyond max_evaluations was refused
+  // "converged", "non_finite" or "residual_above_tolerance" (flag >= 0 that does not stand);
+  // "max_evaluations" (budget_spent), "max_iterations" (KIN_MAXITER_REACHED), "non_finite"
+  // (KIN_FIRST_SYSFUNC_ERR, KIN_REPTD_SYSFUNC_ERR: F not finite where KINSOL could not avoid
+  // it), else KINSOL's flag name in lowercase (kin_linesearch_nonconv, kin_mxnewt_5x_exceeded,
+  // ...; kin_flag_<number> for a flag this version does not name).
   std::string status() const;
 };
 

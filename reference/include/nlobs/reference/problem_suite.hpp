@@ -26,8 +26,16 @@ struct SuiteRow {
   double error = 0.0;
   long f_evals = 0;
   long j_evals = 0;
-  double ns = 0.0;     // wall time per solve
-  std::string status;  // the solver's own account; `outside_bounds` for a point outside the box
+  double ns = 0.0;  // wall time per solve
+  // The solver's own account; `outside_bounds` for a point outside the box; `max_evaluations`
+  // for a solver that asked for an evaluation beyond its budget (refused; never solved);
+  // `invalid_input` (a solver's options or set-up refused, the problem's box refused),
+  // `engine_threw` (any exception, `throw 42` included) or `out_of_memory` (std::bad_alloc),
+  // each a row with no answer (residual and error inf).
+  std::string status;
+  // Why, when the solver said (its Summary::message, KINSOL's reason) or threw (the exception's
+  // text): printable (nlobs::printable), at most ~200 bytes; empty otherwise.
+  std::string message;
 };
 
 struct SuiteOptions {
@@ -35,7 +43,11 @@ struct SuiteOptions {
   // (ProblemSetEntry::solved_threshold). Otherwise finite and > 0.
   double solved_threshold = std::numeric_limits<double>::quiet_NaN();
   // Every solver gets the same budget of F evaluations: evaluations_per_dimension (n + 1), at
-  // least 1.
+  // least 1. Enforced for every solver: our engines get it as StopCriteria::max_evaluations, the
+  // references as their libraries' own limits (MINPACK's maxfev, GSL's loop, KINSOL's
+  // iterations) and every evaluation is counted at the callback: one beyond the budget is
+  // refused (NaN, before F is called), the solver stops and its row is max_evaluations, not
+  // solved. f_evals never exceeds the budget.
   long evaluations_per_dimension = 1000;
   // Only the starts with these labels (empty: all); a label no problem has is an error.
   std::vector<std::string> starts{};

@@ -74,10 +74,20 @@ TestProblem fixed_point_test_problem(std::string name, Index n, G g,
                      .starts = std::move(starts)};
 }
 
-// Throws InvalidInput naming `where` and the problem: a bad name, a non-square F or one without
-// a Jacobian, a fixed-point map of another size, no start, a start, bound or solution of the
-// wrong size, a non-finite start or solution, lower > upper, a start outside the bounds.
-void validate_test_problem(const TestProblem& problem, std::string_view where);
+// The largest n a problem set may hold: every solver of the suite keeps dense n×n matrices (a
+// Jacobian, its factorisation, MINPACK's and KINSOL's copies), 32 MB each at n = 2000.
+inline constexpr Index kMaxProblemDimension = 2000;
+
+// Throws InvalidInput naming `where` and the problem: a bad name, n = 0 or n above
+// kMaxProblemDimension, a non-square F or one without a Jacobian, a fixed-point map of another
+// size, no start, a start, bound or solution of the wrong size, a non-finite start or solution,
+// lower > upper, a start outside the bounds, and a known solution (named by its index) outside
+// the bounds or not a root: ‖F(x*)‖₂ > solution_threshold, F not finite there or F throwing there
+// (the suite's error column measures the distance to the known solutions: a wrong one would
+// report a solver that found the true root as far off). build_problem_set passes the set's
+// solved_threshold.
+void validate_test_problem(const TestProblem& problem, std::string_view where,
+                           double solution_threshold = 1e-8);
 
 struct ProblemSetEntry {
   std::string name{};
@@ -90,7 +100,9 @@ struct ProblemSetEntry {
 
 NamedRegistry<ProblemSetEntry>& problem_set_registry();
 
-// The set's problems, each validated, (name, n) unique: InvalidInput "problem set 'S': …".
+// The set's problems, each validated (known solutions at the set's solved_threshold), (name, n)
+// unique: InvalidInput "problem set 'S': …", also when problems() throws (anything: its text,
+// "a non-standard exception" for `throw 42`, "not enough memory" for std::bad_alloc).
 std::vector<TestProblem> build_problem_set(const ProblemSetEntry& set);
 
 // "SET" (all its problems), "SET/NAME" (every size of NAME) or "SET/NAME:n=K": the problems it

@@ -159,7 +159,7 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
        "growing "
        "step",
        {{"flow", "residual|fixed-point: dx/dt = -F = x - G(x) or G(x) - x; default residual"},
-        {"delta0", "initial pseudo time step; default 1e-2"},
+        {"delta0", "initial pseudo time step, >= 2.22e-16 (machine epsilon); default 1e-2"},
         {"delta_max", "largest pseudo time step; default 1e12"},
         {"fd", "forward|central differences when no Jacobian; default central"}},
        {"pseudo-transient:flow=fixed-point", "pseudo-transient:flow=fixed-point,delta0=1e-4"},
@@ -175,7 +175,11 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
          }
          if (auto v = s.number("delta0")) p.initial_pseudo_step = *v;
          if (auto v = s.number("delta_max")) p.max_pseudo_step = *v;
-         if (p.min_pseudo_step > p.initial_pseudo_step) p.min_pseudo_step = p.initial_pseudo_step;
+         // δ_min follows a δ₀ below its default (δ₀ itself is checked by the engine: >= ε).
+         if (p.min_pseudo_step > p.initial_pseudo_step) {
+           p.min_pseudo_step =
+               std::max(p.initial_pseudo_step, PseudoTransientOptions::kMinPseudoStep);
+         }
          if (auto v = s.text("fd")) {
            p.finite_difference = detail::parse_finite_difference("pseudo-transient", *v);
          }

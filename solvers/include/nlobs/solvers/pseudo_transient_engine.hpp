@@ -14,11 +14,13 @@
 // A root the chosen flow leaves is not reached: the run ends without converging.
 //
 // Stop rules. Converged: StopCriteria's residual criterion, or its step criterion on a
-// Newton-like step (‖p‖ ≤ 0.01 δ ‖F‖: the step solves J p = −F to a residual of 0.01 ‖F‖). A trial
-// point where F is not finite halves δ and retries from the same iterate; δ below
-// min_pseudo_step ends the run non_finite. ‖F‖ may rise along the way (the flow is followed,
-// not ‖F‖ minimised): StopCriteria's stagnation rule is not applied; max_iterations,
-// max_evaluations and divergence_limit are.
+// Newton-like step (‖p‖ ≤ 0.01 δ ‖F‖: the step solves J p = −F to a residual of 0.01 ‖F‖; a step
+// that is small because δ is small is not Newton-like). A trial point where F is not finite
+// halves δ and retries from the same iterate; δ below min_pseudo_step ends the run non_finite.
+// A step lost to rounding (x + p == x while F ≠ 0) doubles δ and retries, without evaluating F.
+// δ₀ and δ_min are at least ε (PseudoTransientOptions::kMinPseudoStep). ‖F‖ may rise along the way
+// (the flow is followed, not ‖F‖ minimised): StopCriteria's stagnation rule is not applied;
+// max_iterations, max_evaluations and divergence_limit are.
 //
 // Bounds (Engine::set_bounds): x_{k+1} = P(x_k + p_k), the projection onto the box (a step the
 // box cut short is no step criterion); where the box holds x_k in place the flow leaves the box
@@ -43,9 +45,13 @@ struct PseudoTransientOptions {
   enum class Flow { kResidual, kFixedPoint };  // ẋ = −(G(x) − x)  or  ẋ = G(x) − x
   // On the MGH root problems the residual flow solves 30 of 57 runs, the fixed-point flow 17.
   Flow flow = Flow::kResidual;
-  double initial_pseudo_step = 1e-2;  // δ₀ > 0
-  double max_pseudo_step = 1e12;      // δ_max ≥ δ₀: beyond it the step is Newton's
-  double min_pseudo_step = 1e-12;     // δ_min ∈ (0, δ₀]: after NaN trials, give up below it
+  // δ₀ ≥ kMinPseudoStep (ε ≈ 2.2e-16): below it x + δF == x in double precision wherever
+  // |F| ≤ |x|, and the flow is not followed at all.
+  double initial_pseudo_step = 1e-2;
+  double max_pseudo_step = 1e12;  // δ_max ≥ δ₀, finite: beyond it the step is Newton's
+  double min_pseudo_step =
+      1e-12;  // δ_min ∈ [kMinPseudoStep, δ₀]: after NaN trials, give up below it
+  static constexpr double kMinPseudoStep = std::numeric_limits<double>::epsilon();
   // Used only when the problem carries no Jacobian.
   FiniteDifference finite_difference = FiniteDifference::kCentral;
 };
@@ -62,12 +68,17 @@ class PseudoTransientEngine : public Engine<N> {
          << " is invalid: " << requirement;
       throw InvalidInput(os.str());
     };
-    require(ptc_.initial_pseudo_step > 0.0 && std::isfinite(ptc_.initial_pseudo_step),
-            "initial_pseudo_step", ptc_.initial_pseudo_step, "must be finite and > 0");
+    constexpr double floor = PseudoTransientOptions::kMinPseudoStep;
+    require(ptc_.initial_pseudo_step >= floor && std::isfinite(ptc_.initial_pseudo_step),
+            "initial_pseudo_step (delta0)", ptc_.initial_pseudo_step,
+            "must be finite and >= 2.22e-16 (machine epsilon: a smaller pseudo time step is lost "
+            "to rounding, x + delta F == x wherever |F| <= |x|)");
     require(ptc_.max_pseudo_step >= ptc_.initial_pseudo_step && std::isfinite(ptc_.max_pseudo_step),
-            "max_pseudo_step", ptc_.max_pseudo_step, "must be finite and >= initial_pseudo_step");
-    require(ptc_.min_pseudo_step > 0.0 && ptc_.min_pseudo_step <= ptc_.initial_pseudo_step,
-            "min_pseudo_step", ptc_.min_pseudo_step, "must lie in (0, initial_pseudo_step]");
+            "max_pseudo_step (delta_max)", ptc_.max_pseudo_step,
+            "must be finite and >= initial_pseudo_step");
+    require(ptc_.min_pseudo_step >= floor && ptc_.min_pseudo_step <= ptc_.initial_pseudo_step,
+            "min_pseudo_step", ptc_.min_pseudo_step,
+            "must lie in [2.22e-16 (machine epsilon), initial_pseudo_step]");
     detail::require_lipschitz_for_error_bound(name(), this->options_.stop);
   }
 
@@ -83,6 +94,8 @@ class PseudoTransientEngine : public Engine<N> {
             xt_ = zero_vector<N>(), ft_ = zero_vector<N>();
   Matrix<N, N> jac_, shifted_;
   Eigen::PartialPivLU<Matrix<N, N>> lu_;
+  // Doublings of δ per iteration for steps lost to rounding: from ε to 1e12 takes 93.
+  static constexpr int kMaxLostSteps = 200;
   detail::SquareSystem<N> system_;
 };
 
@@ -122,6 +135,7 @@ Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vec
     if ((status = system_.jacobian(x_, f_, jac_, summary.message))) break;  // J_F = ∂G − I
     // Trial steps from x_k: a non-finite F(x_k + p) halves δ and tries again.
     bool stepped = false;
+    int lost_steps = 0;
     while (!status && !stepped) {
       // σ = +1: (δ⁻¹I − J) p = F;  σ = −1: (δ⁻¹I + J) p = −F.
       if (sigma > 0) {
@@ -164,6 +178,14 @@ Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vec
           break;
         }
       }
+      // A step lost to rounding (x + p == x although F ≠ 0: δ|F| below the spacing of x) is no
+      // step at all, least of all a converged one: δ doubles, without an evaluation of F, up to
+      // δ_max (where p is Newton's step and its smallness is convergence).
+      if (!projected && xt_ == x_ && delta < ptc_.max_pseudo_step && lost_steps < kMaxLostSteps) {
+        ++lost_steps;
+        delta = std::min(2.0 * delta, ptc_.max_pseudo_step);
+        continue;
+      }
       if (p_.allFinite() && system_.residual(xt_, ft_)) {
         stepped = true;
       } else {
@@ -186,7 +208,9 @@ Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vec
     const double step = p_.template lpNorm<Eigen::Infinity>();
     // Newton-like: the pseudo-time term δ⁻¹p = σ(F + Jp) is below 1 % of ‖F‖, so the step
     // solves the Newton equation to a residual of 0.01 ‖F‖.
-    const bool newton_like = !projected && p_.norm() <= 0.01 * delta * previous;
+    // stableNorm: at a tiny δ, ‖p‖₂² underflows and norm() says 0, which once passed a step of
+    // 1e-299 at δ = 1e-300 as Newton-like (and converged).
+    const bool newton_like = !projected && p_.stableNorm() <= 0.01 * delta * previous;
     status = monitor.update(step, f_.template lpNorm<Eigen::Infinity>(),
                             x_.template lpNorm<Eigen::Infinity>(), newton_like);
     if (this->options_.record_trace) {
