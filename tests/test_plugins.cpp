@@ -403,8 +403,9 @@ TEST(Plugins, RefusesAFifoADeviceAndASocketByName) {
   const Scratch scratch("special");
   const fs::path fifo = scratch.dir / "libfifo.so";
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);
-  // A writer with bytes waiting: a loader that opened the FIFO would read them and fail on
-  // them instead of hanging this test (and name them, not the FIFO).
+  // A writer holding it open with bytes waiting, as a producer would: a loader that opened the
+  // FIFO would read them and then wait for more (this test then times out: measured with the
+  // loader before the type check).
   const int writer = open(fifo.c_str(), O_RDWR | O_NONBLOCK);
   ASSERT_GE(writer, 0);
   ASSERT_EQ(write(writer, "not a library", 13), 13);

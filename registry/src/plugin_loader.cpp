@@ -80,8 +80,9 @@ void check_staged(const PluginRegistrar& staged, const std::string& source) {
   check_registry_names(staged.observer_types(), observer_type_registry(), source);
   check_registry_names(staged.problem_sets(), problem_set_registry(), source);
   for (const auto& e : staged.engines()) {
-    if (!is_registry_name(e.name))
+    if (!is_registry_name(e.name)) {
       throw InvalidInput(registry_name_refusal("engine", e.name, source));
+    }
     if (!e.make) throw InvalidInput("engine '" + e.name + "' from " + source + " has no factory");
   }
   check_names(staged.engines(), "engine", source, engine_source);
