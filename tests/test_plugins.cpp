@@ -583,9 +583,9 @@ TEST(Plugins, OneNameRuleForEveryRegistryBoundedAndPrintable) {
   const std::string longest(64, 'n');
   const std::vector<std::pair<std::string, std::string>> bad = {
       {"", "is empty"},
-      {"line\nbreak", "'line\\nbreak' from my program has '\\n' at byte 5"},
-      {"\x1b[31mred", "'\\e[31mred' from my program has '\\e' at byte 1"},
-      {"tab\there", "has '\\t' at byte 4"},
+      {"line\nbreak", "'line\\x0abreak' from my program has '\\x0a' at byte 5"},
+      {"\x1b[31mred", "'\\x1b[31mred' from my program has '\\x1b' at byte 1"},
+      {"tab\there", "has '\\x09' at byte 4"},
       {"bell\a", "has '\\x07' at byte 5"},
       {"quote'd", "has ''' at byte 6"},
       {"\"quoted\"", "has '\"' at byte 1"},
@@ -652,7 +652,7 @@ TEST(Plugins, PathsAndExceptionTextsAreEchoedPrintable) {
   const fs::path evil = scratch.dir / "dir\nnlobs: fake line \x1b[2J";
   fs::create_directories(evil);
   const std::string shown = printable((evil / "libthrowing.so").string());
-  EXPECT_TRUE(contains(shown, "dir\\nnlobs: fake line \\e[2J")) << shown;
+  EXPECT_TRUE(contains(shown, "dir\\x0anlobs: fake line \\x1b[2J")) << shown;
   // The throwing plugin: the path twice (the plugin, the source of its registration).
   fs::copy_file(test_plugin("test_plugin_throwing"), evil / "libthrowing.so");
   std::string why = refusal((evil / "libthrowing.so").string());
@@ -671,7 +671,7 @@ TEST(Plugins, PathsAndExceptionTextsAreEchoedPrintable) {
   std::ofstream(evil / "libheader.so", std::ios::binary) << header;
   why = refusal((evil / "libheader.so").string());
   EXPECT_TRUE(contains(why, "cannot be loaded: ")) << why;
-  EXPECT_TRUE(contains(why, "fake line \\e[2J/libheader.so: ")) << why;  // dlopen's message
+  EXPECT_TRUE(contains(why, "fake line \\x1b[2J/libheader.so: ")) << why;  // dlopen's message
   EXPECT_FALSE(has_control_character(why)) << why;
   // A missing file and a directory, named printable as well.
   why = refusal((evil / "libmissing.so").string());
@@ -687,9 +687,10 @@ TEST(Plugins, PathsAndExceptionTextsAreEchoedPrintable) {
     register_extensions(throws_text, "my\nprogram");
     ADD_FAILURE() << "a throwing registration was accepted";
   } catch (const InvalidInput& e) {
-    EXPECT_EQ(std::string(e.what()),
-              "my\\nprogram: its registration threw: bad\\nnlobs: error: forged\\e[0m (nothing of "
-              "it was registered)");
+    EXPECT_EQ(
+        std::string(e.what()),
+        "my\\x0aprogram: its registration threw: bad\\x0anlobs: error: forged\\x1b[0m (nothing of "
+        "it was registered)");
   }
   const auto throws_int = [](PluginRegistrar&) { throw 42; };
   try {
@@ -705,8 +706,8 @@ TEST(Plugins, PathsAndExceptionTextsAreEchoedPrintable) {
     r.add_problem_set({.name = "echo-set", .problems = [] { return std::vector<TestProblem>{}; }});
   };
   EXPECT_EQ(register_extensions(good, "my\x1b]0;title\a program").source,
-            "my\\e]0;title\\x07 program");
-  EXPECT_EQ(problem_set_registry().source("echo-set"), "my\\e]0;title\\x07 program");
+            "my\\x1b]0;title\\x07 program");
+  EXPECT_EQ(problem_set_registry().source("echo-set"), "my\\x1b]0;title\\x07 program");
 }
 
 // The CLI: --plugin (before or after the subcommand, repeatable) and NLOBS_PLUGIN_PATH.

@@ -181,7 +181,7 @@ TEST(UserExceptionsRun, AThrowingModelInAnObserversStepIsAFailedStepNamedWithIts
       const std::string who = "observer '" + m.name + "' on model 'throwing-model' threw: ";
       EXPECT_NE(m.first_failure.find(who), std::string::npos) << m.first_failure;
       const std::string text = nonstandard != 0.0 ? "a non-standard exception"
-                                                  : "the model gave up\\e[31m\\nforged line";
+                                                  : "the model gave up\\x1b[31m\\x0aforged line";
       EXPECT_NE(m.first_failure.find(who + text), std::string::npos) << m.first_failure;
       // Every later step throws too: counted, and the last good estimate is kept.
       ASSERT_TRUE(m.failures.count("observer_threw")) << m.first_failure;
@@ -211,7 +211,7 @@ TEST(UserExceptionsRun, AThrowingTrueSystemEndsTheRunNamingModelSampleAndTime) {
   // RK4 from sample 50 (t = 0.5) evaluates the field at t = 0.505 first.
   EXPECT_EQ(run_error(scenario({{"throw_after", 0.5}}, kObservers)),
             "simulate: model 'throwing-model' of the true system threw at sample 50 (t = 0.5): "
-            "the model gave up\\e[31m\\nforged line");
+            "the model gave up\\x1b[31m\\x0aforged line");
   EXPECT_EQ(run_error(scenario({{"throw_after", 0.5}, {"nonstandard", 1.0}}, kObservers)),
             "simulate: model 'throwing-model' of the true system threw at sample 50 (t = 0.5): "
             "a non-standard exception");
@@ -230,7 +230,7 @@ TEST(UserExceptionsRun, ThrowingHooksFactoriesAndBuildersAreRefusedByName) {
   expect_named(run_error(observer("parse")),
                "observer type 'throwing_observer': its parse threw: a non-standard exception");
   expect_named(run_error(observer("build")),
-               "observer type 'throwing_observer': its build threw: no\\e]0;title\\x07 observer");
+               "observer type 'throwing_observer': its build threw: no\\x1b]0;title\\x07 observer");
   try {
     observer_reports(parse_scenario(observer("report"), "test"), nullptr);
     ADD_FAILURE() << "no error";

@@ -35,8 +35,8 @@ inline std::string registry_name_problem(std::string_view name) {
   }
   for (std::size_t i = 0; i < name.size(); ++i) {
     if (!is_registry_name_character(name[i])) {
-      // printable() shows a control character as \n or \xHH; a byte of a UTF-8 character is
-      // shown as \xHH as well, since on its own it is not valid UTF-8.
+      // printable() shows a control character as \xHH; so is a byte of a UTF-8 character, which
+      // on its own is not valid UTF-8.
       const std::string shown = printable(name.substr(i, 1), 8);
       return "has '" + shown + "' at byte " + std::to_string(i + 1);
     }
