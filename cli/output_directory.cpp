@@ -22,10 +22,6 @@ namespace fs = std::filesystem;
 
 constexpr std::string_view kOldTemporarySuffix = ".tmp";  // before OutputFile's random names
 
-std::string shown(const fs::path& p) {
-  return quoted_excerpt(p.native(), 300);
-}
-
 bool is_signals_png(std::string_view name) {  // signals_<digits>.png
   constexpr std::string_view prefix = "signals_", suffix = ".png";
   if (name.size() <= prefix.size() + suffix.size() || !name.starts_with(prefix) ||

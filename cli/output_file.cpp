@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "descriptor_buffer.hpp"
+#include "nlobs/common/file_type.hpp"
 #include "nlobs/solvers/status.hpp"
 
 namespace nlobs::cli {
@@ -77,10 +78,6 @@ extern "C" void remove_temporaries_and_reraise(int signal_number) {
   ::raise(signal_number);
 }
 
-std::string shown(const fs::path& p) {
-  return quoted_excerpt(p.native(), 300);
-}
-
 std::string reason(int error) {
   return std::strerror(error != 0 ? error : EIO);
 }
@@ -108,15 +105,6 @@ struct Target {
   bool exists;
   struct stat status;
 };
-
-const char* type_name(mode_t mode) {
-  if (S_ISDIR(mode)) return "a directory";
-  if (S_ISBLK(mode)) return "a block device";
-  if (S_ISSOCK(mode)) return "a socket";
-  if (S_ISFIFO(mode)) return "a FIFO";
-  if (S_ISCHR(mode)) return "a character device";
-  return "not a regular file";
-}
 
 // How `path` is written (output_file.hpp).
 Target classify(const fs::path& path) {
@@ -151,7 +139,7 @@ Target classify(const fs::path& path) {
   }
   throw std::runtime_error("cannot write " + shown(path) + ": it is " +
                            (link ? std::string("a symbolic link to ") : std::string()) +
-                           type_name(final.st_mode) +
+                           file_type_name(final.st_mode) +
                            (S_ISDIR(final.st_mode) ? "" : ", not a file nlobs replaces"));
 }
 
@@ -169,6 +157,10 @@ void install_interrupt_cleanup() {
     if (::sigaction(s, nullptr, &previous) == 0 && previous.sa_handler == SIG_IGN) continue;
     ::sigaction(s, &action, nullptr);
   }
+}
+
+std::string shown(const fs::path& p) {
+  return quoted_excerpt(p.native(), 300);
 }
 
 void set_interruptible_child(pid_t pid) {

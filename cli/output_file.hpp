@@ -35,6 +35,9 @@ void install_interrupt_cleanup();
 // The child process the handler must stop first (gnuplot writing a temporary); 0 for none.
 void set_interruptible_child(pid_t pid);
 
+// A path as messages about output files show it: quoted, printable, at most 300 bytes.
+std::string shown(const std::filesystem::path& p);
+
 // Whether `name` (no directory) is a temporary this class makes for `final_name`
 // (`.FINAL.tmp-XXXXXX`).
 bool is_temporary_name_of(std::string_view name, std::string_view final_name);

@@ -13,10 +13,12 @@
 #include <system_error>
 #include <vector>
 
+#include "nlobs/common/file_type.hpp"
 #include "nlobs/common/printable.hpp"
 #include "nlobs/common/registry_name.hpp"
 #include "nlobs/registry/plugin.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
+#include "nlobs/solvers/status.hpp"
 #include "plugin_file.hpp"
 
 namespace nlobs {
@@ -127,10 +129,7 @@ LoadedPlugin commit(const PluginRegistrar& staged, const std::string& source) {
 // A user's text in quotes, made printable (nlobs/common/printable.hpp). Appended, not
 // `"'" + printable(text)`: GCC 12 warns of a false -Wrestrict on that form.
 std::string quoted(const std::string& text) {
-  std::string out = "'";
-  out += printable(text);
-  out += '\'';
-  return out;
+  return quoted_excerpt(text, kPrintableLimit);
 }
 
 // What a stat or fstat says a path is, when it is not a file dlopen can be given: dlopen on a
@@ -138,11 +137,7 @@ std::string quoted(const std::string& text) {
 std::string not_a_file(mode_t mode) {
   if (S_ISREG(mode)) return {};
   if (S_ISDIR(mode)) return "is a directory (NLOBS_PLUGIN_PATH takes directories)";
-  if (S_ISFIFO(mode)) return "is a FIFO, not a shared library";
-  if (S_ISCHR(mode)) return "is a character device, not a shared library";
-  if (S_ISBLK(mode)) return "is a block device, not a shared library";
-  if (S_ISSOCK(mode)) return "is a socket, not a shared library";
-  return "is not a regular file, not a shared library";
+  return std::string("is ") + file_type_name(mode) + ", not a shared library";
 }
 
 // Closes the descriptor it holds when it goes out of scope.
