@@ -12,6 +12,7 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -473,11 +474,26 @@ TEST(Plugins, ATruncatedLibraryIsRefusedByNameAtEveryLength) {
     EXPECT_TRUE(contains(why, "plugin '" + path + "' cannot be loaded: it is truncated: ")) << why;
     EXPECT_TRUE(size < 64 || contains(why, " of a " + std::to_string(size) + "-byte file")) << why;
   }
-  // Half the file: a loadable segment reaches past the cut.
-  const std::string path = scratch.write("libhalf.so", library.substr(0, half));
+  // Cut inside the last loadable segment (read from the file's own program headers: in a
+  // Debug build the debug sections make up most of the file, so half of it may hold every
+  // segment): a loadable segment reaches past the cut.
+  Elf64_Ehdr header;
+  std::memcpy(&header, library.data(), sizeof header);
+  std::size_t segments_end = 0;
+  for (int i = 0; i < header.e_phnum; ++i) {
+    Elf64_Phdr segment;
+    std::memcpy(&segment, library.data() + header.e_phoff + i * std::size_t{header.e_phentsize},
+                sizeof segment);
+    if (segment.p_type == PT_LOAD && segment.p_filesz > 0) {
+      segments_end = std::max<std::size_t>(segments_end, segment.p_offset + segment.p_filesz);
+    }
+  }
+  ASSERT_GT(segments_end, 64u);
+  const std::size_t inside = segments_end - 1;
+  const std::string path = scratch.write("libhalf.so", library.substr(0, inside));
   const std::string why = refusal(path);
   EXPECT_TRUE(contains(why, "it is truncated: its program header ")) << why;
-  EXPECT_TRUE(contains(why, " of a " + std::to_string(half) + "-byte file")) << why;
+  EXPECT_TRUE(contains(why, " of a " + std::to_string(inside) + "-byte file")) << why;
   // The last byte missing: the section header table ends the file.
   const std::string short_path =
       scratch.write("libshort.so", library.substr(0, library.size() - 1));
