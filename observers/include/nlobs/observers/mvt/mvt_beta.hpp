@@ -17,6 +17,7 @@
 #include <boost/math/tools/toms748_solve.hpp>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -181,12 +182,25 @@ class MvtBetaSolver {
       const auto stop = [&](double a, double b) {
         return std::abs(b - a) <= 4.0 * std::numeric_limits<double>::epsilon();
       };
+      // Boost.Math reports its own failures by exception: those mean "no root refined in this
+      // cell". An exception from the model inside f is the user's and goes on to the caller
+      // (the observer names it), not swallowed as a failed refinement.
+      std::exception_ptr from_model;
+      const auto guarded = [&](double b) {
+        try {
+          return f(b);
+        } catch (...) {
+          from_model = std::current_exception();
+          throw;
+        }
+      };
       try {
         const auto [a, b] = boost::math::tools::toms748_solve(
-            f, static_cast<double>(cell) / kCells, static_cast<double>(cell + 1) / kCells,
+            guarded, static_cast<double>(cell) / kCells, static_cast<double>(cell + 1) / kCells,
             grid_x[cell], grid_x[cell + 1], stop, iterations);
         for (double root : {a, b}) consider(root, residual_row(i, root));
-      } catch (const std::exception&) {  // Boost.Math reports failures by exception
+      } catch (const std::exception&) {  // (anything else came from the model: it goes on)
+        if (from_model) std::rethrow_exception(from_model);
       }
     } else {
       std::uintmax_t iterations = static_cast<std::uintmax_t>(options_.max_iterations);
