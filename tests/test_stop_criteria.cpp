@@ -3,7 +3,9 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
 
+#include "nlobs/solvers/engine_registry.hpp"
 #include "test_support.hpp"
 
 namespace nlobs {
@@ -158,6 +160,156 @@ TEST(Status, DivergedByGrowingSteps) {
   EXPECT_LT(s.iterations, 10);
 }
 
+// Hammarling's matrix square root (S. J. Hammarling, in Burkardt's test_nonlin, problems 15 and
+// 16): X² = A with A = 1e-4 I + e₁e₂ᵀ, X stored row by row, from X = I; the published root has
+// X₁₁ = X₂₂ (= X₃₃) = 0.01, X₁₂ = 50. Newton's steps grow from 0.5 to 15 while ‖F‖ falls at
+// every step: the way in to the root, not divergence.
+RootProblem<Dynamic> matrix_square_root(Index m) {
+  return RootProblem<Dynamic>::with_autodiff(
+      [m](const auto& x) {
+        using T = typename std::decay_t<decltype(x)>::Scalar;
+        Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> xm(m, m);
+        for (Index i = 0; i < m; ++i)
+          for (Index j = 0; j < m; ++j) xm(i, j) = x[i * m + j];
+        Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> f = xm * xm;
+        for (Index i = 0; i < m; ++i) f(i, i) -= 1e-4;
+        f(0, 1) -= 1.0;
+        Vector<Dynamic, T> out(m * m);
+        for (Index i = 0; i < m; ++i)
+          for (Index j = 0; j < m; ++j) out[i * m + j] = f(i, j);
+        return out;
+      },
+      m * m, m * m);
+}
+
+TEST(Status, GrowingStepsWithFallingResidualAreNotDivergence) {
+  for (Index m : {2, 3}) {
+    SCOPED_TRACE("matrix square root, m = " + std::to_string(m));
+    const FixedPointProblem<Dynamic> problem = to_fixed_point(matrix_square_root(m));
+    SolverOptions o;
+    o.stop.step_tolerance = 1e-10;
+    o.record_trace = true;
+    NewtonEngine<Dynamic> newton({}, o);
+    Vector<Dynamic> x = Eigen::MatrixXd::Identity(m, m).reshaped<Eigen::RowMajor>();
+    const Summary s = newton.solve(problem, x);
+    ASSERT_EQ(s.status, Status::kConverged) << s.full_report();
+    EXPECT_LE(s.residual_norm, 1e-8);
+    Eigen::MatrixXd published = 0.01 * Eigen::MatrixXd::Identity(m, m);
+    published(0, 1) = 50.0;
+    EXPECT_LE((x - published.reshaped<Eigen::RowMajor>()).lpNorm<Eigen::Infinity>(), 1e-10)
+        << x.transpose();
+    // The run did exercise the rule: five steps in a row that did not shrink, growing more than
+    // divergence_growth (10×) over them, with ‖F‖ falling at each.
+    bool exercised = false;
+    for (size_t k = 1; k + 5 <= s.trace.size() && !exercised; ++k) {
+      bool non_shrinking = true, falling = true;
+      for (size_t j = k; j < k + 5; ++j) {
+        non_shrinking = non_shrinking && s.trace[j].step_norm >= s.trace[j - 1].step_norm;
+        falling = falling && s.trace[j].residual_norm < s.trace[j - 1].residual_norm;
+      }
+      exercised =
+          non_shrinking && falling && s.trace[k + 4].step_norm > 10.0 * s.trace[k - 1].step_norm;
+    }
+    EXPECT_TRUE(exercised) << s.full_report();
+    // auto's first stage is that Newton: it no longer hands the problem on with a false verdict
+    // (before, dogleg and levenberg-marquardt then spent the budget); 13 evaluations at this step
+    // tolerance, as many as KINSOL and GSL's gnewton take.
+    Vector<Dynamic> xa = Eigen::MatrixXd::Identity(m, m).reshaped<Eigen::RowMajor>();
+    const Summary sa = EngineRegistry<Dynamic>::global().create("auto", o)->solve(problem, xa);
+    EXPECT_EQ(sa.status, Status::kConverged) << sa.full_report();
+    EXPECT_LE(sa.function_evaluations, 13);
+    // The paper's step-only rule (patience 1) still stops it at its first growing step.
+    SolverOptions paper = o;
+    paper.stop.stagnation_patience = 1;
+    Vector<Dynamic> xp = Eigen::MatrixXd::Identity(m, m).reshaped<Eigen::RowMajor>();
+    EXPECT_NE(NewtonEngine<Dynamic>({}, paper).solve(problem, xp).status, Status::kConverged);
+  }
+}
+
+TEST(Status, GrowingStepsWithGrowingResidualAreDivergence) {
+  // F(x) = sign(x)|x|^(1/3): Newton's map is x ← −2x, the step doubles and |F| grows by 2^(1/3)
+  // every iteration; x stays far below divergence_limit, so the growth rule must name it.
+  const auto cube_root = to_fixed_point(RootProblem<1>::with_jacobian(
+      [](const Vector<1>& x, Vector<1>& f) { f[0] = std::cbrt(x[0]); },
+      [](const Vector<1>& x, Matrix<1, 1>& j) {
+        j(0, 0) = 1.0 / (3.0 * std::cbrt(x[0]) * std::cbrt(x[0]));
+      }));
+  Vector<1> x(0.1);
+  const Summary s = NewtonEngine<1>().solve(cube_root, x);
+  EXPECT_EQ(s.status, Status::kDiverged) << s.full_report();
+  EXPECT_LT(s.iterations, 10);
+  EXPECT_LT(std::abs(x[0]), 1e3);
+}
+
+// Three quadrics in x ≈ 3.5e4 whose terms (≈ 1e9) cancel: ‖F‖ cannot go below the rounding of
+// those terms (≈ 1e-7), far above residual_tolerance, and Newton's steps there are J⁻¹ times that
+// noise, above an absolute step tolerance of 1e-12 and jittering, so that the stagnation rule
+// (five steps in a row that do not shrink) never fires either. Before the rounding-floor test this
+// instance ran to max_iterations (2000 here; 10 000 by default) — and so did 24 of 100 random
+// instances of the same form, the others stagnating after 12 iterations; now all 100 end
+// rounding_floor after at most 10 (docs/solvers.md).
+FixedPointProblem<3> cancelling_quadrics() {
+  auto f = [](const auto& x) {
+    using T = typename std::decay_t<decltype(x)>::Scalar;
+    Eigen::Matrix<T, 3, 1> out;
+    out << x[0] * x[0] - x[1] * x[2] + 0.99718480823026556 * x[1] * x[1],
+        x[1] * x[1] - x[2] * x[0] + 0.55953441682089933 * x[2] * x[2],
+        x[2] * x[2] - x[0] * x[1] + 0.47687466866338357 * x[0] * x[0];
+    return out;
+  };
+  // The constants: F at a point of no special form, shifted by a few times its rounding, so that
+  // no representable x is a root.
+  const Vector<3> near_root(35099.808103093055, 34947.217795259632, 34979.316145232522);
+  const Vector<3> c = f(near_root) + Vector<3>(-2.241785194788779e-07, 3.3949208089409421e-07,
+                                               8.7107814540936026e-07);
+  return to_fixed_point(RootProblem<3>::with_autodiff([f, c](const auto& x) {
+    using T = typename std::decay_t<decltype(x)>::Scalar;
+    return Eigen::Matrix<T, 3, 1>(f(x) - c.template cast<T>());
+  }));
+}
+
+TEST(Status, RoundingFloorEndsARunThatCannotGetCloser) {
+  SolverOptions o;
+  o.stop.step_tolerance = 1e-12;
+  o.stop.residual_tolerance = 1e-12;
+  o.record_trace = true;
+  Vector<3> x(30000.0, 40000.0, 33000.0);
+  const Summary s = NewtonEngine<3>({}, o).solve(cancelling_quadrics(), x);
+  ASSERT_EQ(s.status, Status::kRoundingFloor) << s.full_report();
+  EXPECT_EQ(to_string(s.status), "rounding_floor");
+  EXPECT_LE(s.iterations, 20);
+  EXPECT_GT(s.residual_norm, 1e-12);  // the tolerance was out of reach: the test is needed
+  EXPECT_TRUE(s.usable()) << s.unusable_reason();  // ‖F‖ meets acceptance_tolerance (1e-6)
+  EXPECT_LE(s.step_norm,
+            1e4 * std::numeric_limits<double>::epsilon() * (x.lpNorm<Eigen::Infinity>() + 1.0));
+  // With acceptance_tolerance below the floor the same answer is not usable, and says why.
+  o.stop.acceptance_tolerance = 1e-12;
+  Vector<3> y(30000.0, 40000.0, 33000.0);
+  const Summary strict = NewtonEngine<3>({}, o).solve(cancelling_quadrics(), y);
+  EXPECT_EQ(strict.status, Status::kRoundingFloor);
+  EXPECT_FALSE(strict.usable());
+  EXPECT_NE(strict.unusable_reason().find("rounding_floor with |F|"), std::string::npos)
+      << strict.unusable_reason();
+}
+
+TEST(Status, RoundingFloorIsNotSlowLinearConvergence) {
+  // Picard on G(x) = 0.99 x + 350 converges to 3.5e4 with steps that shrink 1 % per iteration:
+  // when they reach rounding level in x (7.8e-8 at 3.5e4) the residual still falls, so no floor
+  // is named until it stops falling, within a few ulps of the fixed point.
+  SolverOptions o;
+  o.stop.step_tolerance.reset();
+  o.stop.residual_tolerance = 1e-300;  // unreachable: run to the end of the sequence
+  Vector<1> x(0.0);
+  const Summary s =
+      PicardEngine<1>(o).solve(scalar_map([](double v) { return 0.99 * v + 350.0; }), x);
+  EXPECT_TRUE(s.status == Status::kRoundingFloor || s.status == Status::kRepeatedIterates)
+      << s.full_report();
+  // It stops once ‖F‖, counted in ulps of x (7.3e-12 there), no longer falls for three iterations
+  // (measured: 2.1e-8 from the fixed point); the steps reached rounding level much earlier, at
+  // 7.8e-6 from it.
+  EXPECT_NEAR(x[0], 35000.0, 1e-7);
+}
+
 TEST(Status, DivergedByLimit) {
   SolverOptions o;
   o.stop.stagnation_patience = 0;
@@ -210,10 +362,10 @@ TEST(Status, InvalidInputReportedBySolveOrReport) {
 }
 
 TEST(Status, EveryStatusHasAName) {
-  for (Status st :
-       {Status::kConverged, Status::kMaxIterations, Status::kMaxEvaluations, Status::kStagnated,
-        Status::kRepeatedIterates, Status::kDiverged, Status::kNonFinite, Status::kSingularJacobian,
-        Status::kInvalidInput, Status::kSolverFailure, Status::kBlockedByBound}) {
+  for (Status st : {Status::kConverged, Status::kMaxIterations, Status::kMaxEvaluations,
+                    Status::kStagnated, Status::kRepeatedIterates, Status::kDiverged,
+                    Status::kNonFinite, Status::kSingularJacobian, Status::kInvalidInput,
+                    Status::kSolverFailure, Status::kBlockedByBound, Status::kRoundingFloor}) {
     EXPECT_NE(to_string(st), "unknown");
   }
 }

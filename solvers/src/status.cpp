@@ -30,6 +30,8 @@ std::string_view to_string(Status status) {
       return "solver_failure";
     case Status::kBlockedByBound:
       return "blocked_by_bound";
+    case Status::kRoundingFloor:
+      return "rounding_floor";
   }
   return "unknown";
 }

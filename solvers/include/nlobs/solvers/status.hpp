@@ -13,10 +13,10 @@ enum class Status {
   kConverged,         // an enabled convergence criterion (step, residual, error bound) holds
   kMaxIterations,     // StopCriteria::max_iterations reached
   kMaxEvaluations,    // StopCriteria::max_evaluations reached
-  kStagnated,         // the step stopped shrinking (finite-precision floor, cycling)
+  kStagnated,         // the step stopped shrinking and |F| stopped falling (cycling, a floor)
   kRepeatedIterates,  // three consecutive iterates are equal (paper, Remark 8)
-  kDiverged,          // the steps grow geometrically or the iterate left divergence_limit
-  kNonFinite,         // G (or F) returned inf/NaN; the last finite iterate is returned
+  kDiverged,   // the steps grow geometrically while |F| does not fall, or x left divergence_limit
+  kNonFinite,  // G (or F) returned inf/NaN; the last finite iterate is returned
   kSingularJacobian,  // Newton: the Jacobian of F is (numerically) singular
   kInvalidInput,      // only from solve_or_report(): bad dimensions, x0 or options
   kSolverFailure,     // a backend (Ceres, NLopt) reported a failure; see Summary::message
@@ -26,6 +26,10 @@ enum class Status {
   // For the descent direction the point is a minimum of ‖F‖ on the boundary: a root in the box,
   // if any, lies elsewhere (another start; `auto`).
   kBlockedByBound,
+  // The step is at the level of rounding in x (‖Δx‖∞ ≤ 1e4 · ε · (‖x‖∞ + 1)) and ‖F‖ has stopped
+  // falling: the engine can get no closer in double precision (StopCriteria). Usable when ‖F‖
+  // meets acceptance_tolerance, like the other statuses that cut a run short.
+  kRoundingFloor,
 };
 
 // Lowercase snake_case name used in reports and JSON ("converged", "max_iterations", ...).

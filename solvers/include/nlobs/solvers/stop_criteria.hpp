@@ -24,8 +24,13 @@ struct StopCriteria {
   Combine combine = Combine::kAny;
 
   // Stagnation, eq. (72): stop when the step has not shrunk for this many consecutive
-  // iterations (1 = the paper's rule; 0 = off). If over that stretch the step grew by more
-  // than divergence_growth, the run is reported as diverged instead.
+  // iterations (1 = the paper's rule, judged on the step alone; 0 = off). If over that stretch
+  // the step grew by more than divergence_growth, the run is reported as diverged instead.
+  // Above 1 the residual is heard too: a stretch over which ‖F‖∞ fell below 0.999 × its lowest
+  // before the stretch is progress, not a verdict (growing steps on the way in to a root).
+  // Independent of these options, every engine ends at the rounding floor: three iterations in a
+  // row with a full step (not cut short by the engine) ‖Δx‖∞ ≤ 1e4 · ε · (‖x‖∞ + 1) and no
+  // such fall of ‖F‖∞ (Status::kRoundingFloor).
   int stagnation_patience = 5;
   double divergence_growth = 10.0;
   // The same two rules for non-monotone engines (Anderson; an accelerator that declares

@@ -17,9 +17,11 @@ class StopMonitor {
   // estimate_lipschitz: the engine's steps are Picard steps x_{l+1} = G(x_l), so their ratio
   // estimates the contraction factor of G. Other engines' step ratios measure their own
   // convergence, not G's Lipschitz constant, and must not feed an error bound.
-  // progress: what stagnation and divergence are judged by — the steps (monotone methods: the
-  // paper's rule, StopCriteria::stagnation_patience) or the best residual over a window
-  // (non-monotone methods such as Anderson: StopCriteria::residual_window).
+  // progress: what stagnation and divergence are judged by — the steps together with the
+  // residual (monotone methods: StopCriteria::stagnation_patience; a run of non-shrinking steps
+  // over which ‖F‖ fell is no verdict) or the best residual over a window (non-monotone methods
+  // such as Anderson: StopCriteria::residual_window). Both end at the rounding floor
+  // (Status::kRoundingFloor).
   enum class Progress { kSteps, kBestResidual };
   StopMonitor(const StopCriteria& criteria, double x0_norm, bool estimate_lipschitz,
               Progress progress = Progress::kSteps)
@@ -37,6 +39,11 @@ class StopMonitor {
                                bool step_may_converge = true) {
     ++iterations_;
     last_step_ = step;
+    // Did ‖F‖ fall by a meaningful fraction below every earlier residual? (NaN: unknown.)
+    const double best_before = lowest_residual_;
+    const bool residual_known = std::isfinite(residual);
+    const bool residual_fell = residual_known && residual < (1.0 - kMeaningfulFall) * best_before;
+    if (residual_known && residual < lowest_residual_) lowest_residual_ = residual;
     if (prev_step_ > 0.0) {
       ratios_[ratio_count_ % kRatios] = step / prev_step_;
       ++ratio_count_;
@@ -50,6 +57,18 @@ class StopMonitor {
     if (c_.stop_on_repeated_iterates && zero_steps_ >= 2) {
       return Status::kRepeatedIterates;  // x_l = x_{l−1} = x_{l−2}
     }
+    // The rounding floor: the step is at the level of rounding in x and ‖F‖ no longer falls,
+    // kFloorPatience times in a row. Newton's own step there is J⁻¹ times F's rounding noise,
+    // about ε‖x‖, so neither an absolute step tolerance below ε‖x‖ nor a residual tolerance below
+    // the noise can ever be met; without this test such a run spends its whole budget.
+    const bool rounding_step =
+        step <= kRoundingSteps * std::numeric_limits<double>::epsilon() * (iterate_norm + 1.0);
+    // Only a full step says so: a step the engine cut short (a trust region's radius, a small
+    // pseudo-time step, a damped or projected step) is small for its own reasons.
+    floor_count_ = residual_known && step_may_converge && rounding_step && !residual_fell
+                       ? floor_count_ + 1
+                       : 0;
+    if (floor_count_ >= kFloorPatience) return Status::kRoundingFloor;
     if (progress_ == Progress::kBestResidual) {
       if (residual < best_residual_) {  // (NaN: no record)
         best_residual_ = residual;
@@ -64,12 +83,26 @@ class StopMonitor {
         if (since_best_ >= c_.residual_window) return Status::kStagnated;
       }
     } else if (iterations_ > 1 && step >= prev_step_) {
-      if (non_shrinking_ == 0) run_start_step_ = prev_step_;
+      if (non_shrinking_ == 0) {
+        run_start_step_ = prev_step_;
+        run_start_residual_ = best_before;
+      }
       ++non_shrinking_;
       if (c_.stagnation_patience > 0 && non_shrinking_ >= c_.stagnation_patience) {
-        const bool grew =
-            run_start_step_ > 0.0 ? step > c_.divergence_growth * run_start_step_ : step > 0.0;
-        return grew ? Status::kDiverged : Status::kStagnated;
+        // Judged on the residual too (except by the paper's rule, patience 1, which is the step
+        // alone): steps that grow while ‖F‖ falls are the way in to a root, not away from it —
+        // Newton on X² = A (Hammarling's matrix square root) takes steps 0.5 … 15 with ‖F‖
+        // falling at each, then converges.
+        const bool residual_fell_over_run =
+            c_.stagnation_patience > 1 && residual_known &&
+            lowest_residual_ < (1.0 - kMeaningfulFall) * run_start_residual_;
+        if (residual_fell_over_run) {
+          non_shrinking_ = 0;
+        } else {
+          const bool grew =
+              run_start_step_ > 0.0 ? step > c_.divergence_growth * run_start_step_ : step > 0.0;
+          return grew ? Status::kDiverged : Status::kStagnated;
+        }
       }
     } else {
       non_shrinking_ = 0;
@@ -124,6 +157,15 @@ class StopMonitor {
 
  private:
   static constexpr int kRatios = 3;
+  // A fall of ‖F‖ counts when it goes below (1 − kMeaningfulFall) × the lowest before it: at the
+  // rounding floor ‖F‖ jitters and sets new records by hair's breadths.
+  static constexpr double kMeaningfulFall = 1e-3;
+  // A step is at the level of rounding in x when ‖Δx‖∞ ≤ kRoundingSteps · ε · (‖x‖∞ + 1):
+  // 2.2e-12 relative. An engine converging linearly with contraction L > 1 − kMeaningfulFall has
+  // a residual that no longer "falls" by this rule, so it is named at the floor there, within
+  // about 2.2e-12/(1 − L) relative of its limit (2.2e-8 at L = 0.9999).
+  static constexpr double kRoundingSteps = 1e4;
+  static constexpr int kFloorPatience = 3;
 
   bool converged(double step, double residual) const {
     int enabled = 0, met = 0;
@@ -153,6 +195,9 @@ class StopMonitor {
   double prev_step_ = 0.0;
   double last_step_ = 0.0;
   double run_start_step_ = 0.0;
+  double run_start_residual_ = std::numeric_limits<double>::infinity();
+  double lowest_residual_ = std::numeric_limits<double>::infinity();  // over every iteration
+  int floor_count_ = 0;
   int non_shrinking_ = 0;
   int zero_steps_ = 0;
   double ratios_[kRatios] = {0.0, 0.0, 0.0};
