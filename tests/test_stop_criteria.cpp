@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "nlobs/solvers/engine_registry.hpp"
@@ -168,16 +169,12 @@ RootProblem<Dynamic> matrix_square_root(Index m) {
   return RootProblem<Dynamic>::with_autodiff(
       [m](const auto& x) {
         using T = typename std::decay_t<decltype(x)>::Scalar;
-        Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> xm(m, m);
-        for (Index i = 0; i < m; ++i)
-          for (Index j = 0; j < m; ++j) xm(i, j) = x[i * m + j];
-        Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> f = xm * xm;
-        for (Index i = 0; i < m; ++i) f(i, i) -= 1e-4;
+        using RowMajor = Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+        const RowMajor xm = Eigen::Map<const RowMajor>(x.data(), m, m);
+        RowMajor f = xm * xm;
+        f.diagonal().array() -= T(1e-4);
         f(0, 1) -= 1.0;
-        Vector<Dynamic, T> out(m * m);
-        for (Index i = 0; i < m; ++i)
-          for (Index j = 0; j < m; ++j) out[i * m + j] = f(i, j);
-        return out;
+        return Vector<Dynamic, T>(f.template reshaped<Eigen::RowMajor>());
       },
       m * m, m * m);
 }
@@ -223,6 +220,26 @@ TEST(Status, GrowingStepsWithFallingResidualAreNotDivergence) {
     paper.stop.stagnation_patience = 1;
     Vector<Dynamic> xp = Eigen::MatrixXd::Identity(m, m).reshaped<Eigen::RowMajor>();
     EXPECT_NE(NewtonEngine<Dynamic>({}, paper).solve(problem, xp).status, Status::kConverged);
+  }
+}
+
+TEST(Status, AnUnknownResidualLeavesTheStepRuleAndNoFloor) {
+  // An engine that reports no residual (NaN) or a non-finite one: the step rule alone decides,
+  // and no rounding floor is named however small the steps.
+  SolverOptions o;
+  o.stop.step_tolerance.reset();
+  o.stop.residual_tolerance = 1e-300;
+  for (const double residual : {kNaN, std::numeric_limits<double>::infinity()}) {
+    StopMonitor growing(o.stop, 1.0, false);
+    std::optional<Status> end;
+    double step = 1.0;
+    for (int k = 0; k < 10 && !end; ++k, step *= 2.0) end = growing.update(step, residual, 1.0);
+    EXPECT_EQ(end, Status::kDiverged);
+    EXPECT_EQ(growing.iterations(), 6);  // first step, then patience (5) growing steps
+    StopMonitor tiny(o.stop, 1.0, false);
+    end.reset();
+    for (int k = 0; k < 10 && !end; ++k) end = tiny.update(1e-300 * (10 - k), residual, 1.0);
+    EXPECT_EQ(end, std::nullopt);  // shrinking steps, no residual: nothing to judge by
   }
 }
 

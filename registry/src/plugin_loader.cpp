@@ -126,8 +126,7 @@ LoadedPlugin commit(const PluginRegistrar& staged, const std::string& source) {
   return loaded;
 }
 
-// A user's text in quotes, made printable (nlobs/common/printable.hpp). Appended, not
-// `"'" + printable(text)`: GCC 12 warns of a false -Wrestrict on that form.
+// A user's text as the loader echoes it: quoted, printable, at most kPrintableLimit bytes.
 std::string quoted(const std::string& text) {
   return quoted_excerpt(text, kPrintableLimit);
 }

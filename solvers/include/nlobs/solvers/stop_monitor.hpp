@@ -70,13 +70,12 @@ class StopMonitor {
                        : 0;
     if (floor_count_ >= kFloorPatience) return Status::kRoundingFloor;
     if (progress_ == Progress::kBestResidual) {
-      if (residual < best_residual_) {  // (NaN: no record)
-        best_residual_ = residual;
+      if (residual < best_before) {  // a new record (NaN: none)
         since_best_ = 0;
         far_above_ = 0;
       } else {
         ++since_best_;
-        far_above_ = residual > c_.divergence_growth * best_residual_ ? far_above_ + 1 : 0;
+        far_above_ = residual > c_.divergence_growth * best_before ? far_above_ + 1 : 0;
       }
       if (c_.residual_window > 0) {
         if (far_above_ >= c_.residual_window) return Status::kDiverged;
@@ -189,7 +188,6 @@ class StopMonitor {
   double limit_;
   bool estimate_lipschitz_;
   Progress progress_;
-  double best_residual_ = std::numeric_limits<double>::infinity();
   int since_best_ = 0, far_above_ = 0;  // iterations since the best residual; run above growth×
   int iterations_ = 0;
   double prev_step_ = 0.0;
