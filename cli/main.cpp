@@ -92,13 +92,20 @@ void add_suite_options(CLI::App* app, nlobs::cli::SuiteArguments& a) {
                   "nlobs list engines)");
   app->add_option("--starts", a.starts, "Comma-separated start labels (default: all)");
   app->add_option("--threshold", a.threshold,
-                  "Solved when |F|2 <= this at the returned point (default: the set's, 1e-8)")
+                  "Solved when |D_f F|2 <= this at the returned point (D_f: the problem's "
+                  "f_scale, if any; default: the set's threshold, 1e-8)")
       ->check(finite_in(0.0, std::numeric_limits<double>::max(), "X > 0", true));
   app->add_option("--budget", a.evaluations_per_dimension,
                   "F evaluations per unknown and one (budget = this * (n + 1)); default 1000")
       ->check(CLI::Range(1L, 1000000L));
   app->add_flag("--json", a.json, "Print a JSON array instead of the tables");
   app->add_option("--csv", a.csv, "Also write the rows as CSV to FILE ('-': stdout, no table)");
+  app->add_flag("--show-x", a.show_x, "Print each row's answer x below it in the table");
+  app->add_option("--time-limit", a.time_limit_s,
+                  "Seconds each solve may take; past them its evaluations are refused and the "
+                  "row is time_limit (default: none)")
+      ->type_name("SECONDS")
+      ->check(finite_in(1e-3, 86400.0, "SECONDS in 0.001..86400"));
 }
 
 int run_command_line(int argc, char** argv) {

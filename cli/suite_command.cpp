@@ -25,6 +25,7 @@ void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArg
   reference::SuiteOptions options;
   options.solved_threshold = args.threshold;
   options.evaluations_per_dimension = args.evaluations_per_dimension;
+  options.time_limit_s = args.time_limit_s;
   options.starts =
       args.starts.empty() ? std::vector<std::string>() : reference::split_spec_list(args.starts);
   const std::vector<std::string> solvers = args.solvers.empty()
@@ -80,7 +81,7 @@ void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArg
   if (args.json) {
     out << suite_to_json(rows).dump(2) << '\n';
   } else if (args.csv != "-") {
-    print_suite_tables(rows, threshold, out);
+    print_suite_tables(rows, threshold, out, args.show_x);
   }
 }
 

@@ -14,7 +14,10 @@ struct SuiteArguments {
   double threshold = std::numeric_limits<double>::quiet_NaN();  // NaN: each set's own
   long evaluations_per_dimension = 1000;
   bool json = false;
-  std::string csv{};  // a file to write the CSV to ("-": stdout); empty: none
+  std::string csv{};    // a file to write the CSV to ("-": stdout); empty: none
+  bool show_x = false;  // the table prints each row's answer x on the line below it
+  // Wall time per solve (reference::SuiteOptions::time_limit_s); +inf: none.
+  double time_limit_s = std::numeric_limits<double>::infinity();
   // Progress on `err`: none; one line rewritten after every (problem, start) pair (a
   // terminal); or, for a log, a line per pair at most every progress_interval_s seconds, the
   // first after that long (a short suite prints none).

@@ -40,16 +40,51 @@ std::string number_text(double v) {
   return os.str();
 }
 
+// "[1, 2.5, nan, ... (12 more)]": the first components of an answer, 6 significant digits.
+std::string answer_text(const Eigen::VectorXd& x, Index max_components) {
+  std::ostringstream os;
+  os.precision(6);
+  os << '[';
+  const Index shown = std::min(x.size(), max_components);
+  for (Index i = 0; i < shown; ++i) os << (i ? ", " : "") << x[i];
+  if (shown < x.size()) os << ", ... (" << x.size() - shown << " more)";
+  os << ']';
+  return os.str();
+}
+
+bool has_scaled_residual(const reference::SuiteRow& r) {
+  return r.scaled_residual != r.residual &&
+         !(std::isnan(r.scaled_residual) && std::isnan(r.residual));
+}
+
 }  // namespace
 
+std::string answer_field(const Eigen::VectorXd& x) {
+  std::string out;
+  char text[32];
+  for (Index i = 0; i < x.size(); ++i) {
+    if (i) out += ' ';
+    if (std::isnan(x[i])) {
+      out += "nan";
+    } else if (std::isinf(x[i])) {
+      out += x[i] > 0 ? "inf" : "-inf";
+    } else {
+      std::snprintf(text, sizeof text, "%.17g", x[i]);
+      out += text;
+    }
+  }
+  return out;
+}
+
 void print_suite_tables(const std::vector<reference::SuiteRow>& rows, double threshold,
-                        std::ostream& out) {
+                        std::ostream& out, bool show_x) {
   char line[400];
   std::string current;
   std::vector<std::string> order;
   std::map<std::string, int> solved, pairs;
   const bool any_error = std::any_of(
       rows.begin(), rows.end(), [](const reference::SuiteRow& r) { return !std::isnan(r.error); });
+  const bool any_scaled = std::any_of(rows.begin(), rows.end(), has_scaled_residual);
   // Names, labels and statuses may come from a user's plugin: printed through printable (no
   // control character, no invalid UTF-8, bounded length).
   const auto shown = [](const std::string& text, std::size_t limit) {
@@ -72,10 +107,10 @@ void print_suite_tables(const std::vector<reference::SuiteRow>& rows, double thr
       } else {
         start += shown(r.start, 60);
       }
-      std::snprintf(line, sizeof line, "\n%s n=%d (%s)\n  %-*s %-7s %-28s %10s %8s %8s %12s%s\n",
+      std::snprintf(line, sizeof line, "\n%s n=%d (%s)\n  %-*s %-7s %-28s %10s %8s %8s %12s%s%s\n",
                     shown(r.problem, 80).c_str(), r.n, start.c_str(), width, "solver", "solved",
                     "status", "|F|2", "F evals", "J evals", "time [us]",
-                    any_error ? "  |x-x*|inf" : "");
+                    any_error ? "  |x-x*|inf" : "", any_scaled ? "   |D_f F|2" : "");
       out << line;
     }
     const std::string solver = shown(r.solver, 48);
@@ -87,17 +122,22 @@ void print_suite_tables(const std::vector<reference::SuiteRow>& rows, double thr
       std::snprintf(line, sizeof line, " %11s", fmt(r.error, "%.2e").c_str());
       out << line;
     }
+    if (any_scaled) {
+      std::snprintf(line, sizeof line, " %11s", fmt(r.scaled_residual, "%.2e").c_str());
+      out << line;
+    }
     out << '\n';
-    // A row without an answer says why on the next line.
+    // A row without an answer, or stopped by the time limit, says why on the next line.
     if (!r.message.empty() && (r.status == "invalid_input" || r.status == "engine_threw" ||
-                               r.status == "out_of_memory")) {
+                               r.status == "out_of_memory" || r.status == "time_limit")) {
       out << "    " << shown(r.message, 200) << '\n';
     }
+    if (show_x && r.x.size() > 0) out << "    x = " << answer_text(r.x, 8) << '\n';
     if (!pairs.count(r.solver)) order.push_back(r.solver);
     ++pairs[r.solver];
     solved[r.solver] += r.solved;
   }
-  out << "\nsolved (|F|2 <= "
+  out << "\nsolved (" << (any_scaled ? "|D_f F|2" : "|F|2") << " <= "
       << (std::isnan(threshold) ? std::string("each set's threshold") : short_number(threshold))
       << " at the returned point), per solver:\n";
   for (const auto& s : order) {
@@ -145,7 +185,14 @@ nlohmann::json suite_to_json(const std::vector<reference::SuiteRow>& rows) {
                  {"j_evals", r.j_evals},
                  {"ns", number_or_null(r.ns)},
                  {"status", valid_utf8(r.status)},
-                 {"message", valid_utf8(r.message)}});
+                 {"message", valid_utf8(r.message)},
+                 {"scaled_residual", number_or_null(r.scaled_residual)},
+                 {"x", nullptr}});
+    if (r.x.size() > 0) {
+      nlohmann::json x = nlohmann::json::array();
+      for (Index i = 0; i < r.x.size(); ++i) x.push_back(number_or_null(r.x[i]));
+      a.back()["x"] = std::move(x);
+    }
   }
   return a;
 }
@@ -153,14 +200,15 @@ nlohmann::json suite_to_json(const std::vector<reference::SuiteRow>& rows) {
 std::string suite_to_csv(const std::vector<reference::SuiteRow>& rows) {
   std::string out =
       "set,problem,n,start,start_scale,solver,solved,residual,error,f_evals,j_evals,ns,status,"
-      "message\n";
+      "message,scaled_residual,x\n";
   for (const auto& r : rows) {
     out += csv_field(r.set) + ',' + csv_field(r.problem) + ',' + std::to_string(r.n) + ',' +
            csv_field(r.start) + ',' + number_text(r.start_scale) + ',' + csv_field(r.solver) + ',' +
            (r.solved ? "true" : "false") + ',' + number_text(r.residual) + ',' +
            number_text(r.error) + ',' + std::to_string(r.f_evals) + ',' +
            std::to_string(r.j_evals) + ',' + number_text(r.ns) + ',' + csv_field(r.status) + ',' +
-           csv_field(r.message) + '\n';
+           csv_field(r.message) + ',' + number_text(r.scaled_residual) + ',' + answer_field(r.x) +
+           '\n';
   }
   return out;
 }

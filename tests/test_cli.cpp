@@ -109,6 +109,20 @@ TEST(Cli, ThresholdTakesEveryPositiveFiniteNumber) {
   EXPECT_NE(zero.out.find("'0' is not a finite number > 0"), std::string::npos) << zero.out;
 }
 
+// --show-x prints the answer under each row; --time-limit takes seconds in 0.001..86400 and a
+// run within it is unchanged (tests/test_suite_answers.cpp ends slow engines with it).
+TEST(Cli, ShowXAndTimeLimit) {
+  const CliRun shown =
+      run("solve mgh/rosenbrock --solvers newton --starts x1 --show-x --time-limit 60");
+  EXPECT_EQ(shown.status, 0) << shown.out;
+  EXPECT_NE(shown.out.find("    x = [1, 1]\n"), std::string::npos) << shown.out;
+  for (const char* bad : {"0", "nan", "-1", "1e9", "soon"}) {
+    const CliRun r = run(std::string("solve mgh/rosenbrock --time-limit ") + bad);
+    EXPECT_EQ(r.status, 1) << bad << ": " << r.out;
+    EXPECT_NE(r.out.find("--time-limit: '"), std::string::npos) << r.out;
+  }
+}
+
 // Out-of-range integers are errors naming the option and the range, before anything runs
 // (--seed -1 became 2^64 - 1, huge --steps ended in std::bad_alloc).
 TEST(Cli, OutOfRangeIntegersAreErrors) {

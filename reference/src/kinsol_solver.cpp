@@ -13,6 +13,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace nlobs::reference {
 
@@ -23,7 +24,7 @@ struct KinsolSolver::Impl {
   Jacobian jacobian;
   SUNContext context = nullptr;
   void* kinsol = nullptr;
-  N_Vector u = nullptr, scale = nullptr;
+  N_Vector u = nullptr, u_scale = nullptr, f_scale = nullptr;
   SUNMatrix matrix = nullptr;
   SUNLinearSolver linear_solver = nullptr;
   Eigen::VectorXd x_in, f_out;
@@ -79,6 +80,17 @@ KinsolSolver::KinsolSolver(int n, KinsolOptions options, Function function, Jaco
   if (options.max_iterations < 1) {
     throw std::invalid_argument("KinsolOptions::max_iterations must be >= 1");
   }
+  for (const auto& [scale, name] :
+       {std::pair{&options.u_scale, "u_scale"}, std::pair{&options.f_scale, "f_scale"}}) {
+    if (scale->size() != 0 && scale->size() != n) {
+      throw std::invalid_argument(std::string("KinsolOptions::") + name + " has size " +
+                                  std::to_string(scale->size()) + " for n = " + std::to_string(n));
+    }
+    if (!((scale->array() > 0.0).all() && scale->allFinite())) {
+      throw std::invalid_argument(std::string("KinsolOptions::") + name +
+                                  ": every entry must be finite and > 0");
+    }
+  }
   Impl& s = *impl_;
   s.n = n;
   s.options = options;
@@ -90,8 +102,16 @@ KinsolSolver::KinsolSolver(int n, KinsolOptions options, Function function, Jaco
   s.jac_out.resize(n, n);
   s.check(SUNContext_Create(nullptr, &s.context), "SUNContext_Create");
   s.u = N_VNew_Serial(n, s.context);
-  s.scale = N_VNew_Serial(n, s.context);
-  N_VConst(1.0, s.scale);
+  s.u_scale = N_VNew_Serial(n, s.context);
+  s.f_scale = N_VNew_Serial(n, s.context);
+  for (auto [vector, scale] :
+       {std::pair{s.u_scale, &options.u_scale}, std::pair{s.f_scale, &options.f_scale}}) {
+    if (scale->size() == n) {
+      Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(vector), n) = *scale;
+    } else {
+      N_VConst(1.0, vector);
+    }
+  }
   s.kinsol = KINCreate(s.context);
   if (s.kinsol == nullptr) throw std::runtime_error("KINSOL: KINCreate failed");
   s.check(KINSetErrHandlerFn(s.kinsol, &Impl::silent, nullptr), "KINSetErrHandlerFn");
@@ -119,7 +139,8 @@ KinsolSolver::~KinsolSolver() {
   if (s.linear_solver) SUNLinSolFree(s.linear_solver);
   if (s.matrix) SUNMatDestroy(s.matrix);
   N_VDestroy(s.u);
-  N_VDestroy(s.scale);
+  N_VDestroy(s.u_scale);
+  N_VDestroy(s.f_scale);
   SUNContext_Free(&s.context);
 }
 
@@ -135,7 +156,7 @@ KinsolResult KinsolSolver::solve(Eigen::VectorXd& x) {
   KinsolResult r;
   s.calls = 0;
   s.refused = false;
-  r.flag = KINSol(s.kinsol, s.u, strategy, s.scale, s.scale);
+  r.flag = KINSol(s.kinsol, s.u, strategy, s.u_scale, s.f_scale);
   char* name = KINGetReturnFlagName(r.flag);
   r.flag_name = name ? name : "?";
   free(name);
@@ -149,7 +170,9 @@ KinsolResult KinsolSolver::solve(Eigen::VectorXd& x) {
     s.function(x, s.f_out);
     const bool fixed_point = s.options.strategy != KinsolStrategy::kNewtonLineSearch;
     if (s.f_out.allFinite()) {
-      r.residual = (fixed_point ? Eigen::VectorXd(s.f_out - x) : s.f_out).lpNorm<Eigen::Infinity>();
+      Eigen::VectorXd f = fixed_point ? Eigen::VectorXd(s.f_out - x) : s.f_out;
+      if (s.options.f_scale.size() == s.n) f.array() *= s.options.f_scale.array();
+      r.residual = f.lpNorm<Eigen::Infinity>();
     }
   }
   r.evaluations = s.calls;
@@ -160,7 +183,8 @@ KinsolResult KinsolSolver::solve(Eigen::VectorXd& x) {
     if (!x.allFinite()) {
       os << "returned a point that is not finite";
     } else {
-      os << "|F| " << r.residual << " > tolerance " << s.options.tolerance;
+      os << (s.options.f_scale.size() ? "|D_f F| " : "|F| ") << r.residual << " > tolerance "
+         << s.options.tolerance;
     }
     r.reason = os.str();
   }

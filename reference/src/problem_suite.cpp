@@ -1,11 +1,13 @@
 #include "nlobs/reference/problem_suite.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>
 #include <new>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 #include "nlobs/common/printable.hpp"
@@ -34,27 +36,54 @@ bool is_reference(const std::string& s) {
   return std::find(refs.begin(), refs.end(), s) != refs.end();
 }
 
-// Counts the evaluations of F (or G) one solve makes and refuses those beyond its budget: the
-// refused call returns NaN without calling the problem, and the row becomes max_evaluations.
+// Counts the evaluations of F (or G) one solve makes and refuses those beyond its budget or past
+// its deadline: the refused call returns NaN without calling the problem, and the row becomes
+// max_evaluations or time_limit.
 struct Meter {
+  using Clock = std::chrono::steady_clock;
   long count = 0;
   long cap = std::numeric_limits<long>::max();
-  bool refused = false;
-  void reset(long budget) {
+  bool refused = false;    // an evaluation beyond the budget was asked for
+  bool timed_out = false;  // an evaluation past the deadline was asked for
+  int late_calls = 0;      // evaluations asked for past the deadline
+  bool timed = false;
+  Clock::time_point deadline{};
+  double time_limit_s = 0.0;
+  void reset(long budget, double limit_s) {
     count = 0;
     cap = budget;
-    refused = false;
+    refused = timed_out = false;
+    late_calls = 0;
+    timed = std::isfinite(limit_s);
+    time_limit_s = limit_s;
+    if (timed) {
+      deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                    std::chrono::duration<double>(limit_s));
+    }
   }
-  // True when one more evaluation is within the budget (and counts it).
+  // True when the deadline has passed (and notes it).
+  bool late() {
+    if (!timed || Clock::now() < deadline) return false;
+    timed_out = true;
+    ++late_calls;
+    return true;
+  }
+  // True when one more evaluation is within the budget and the time limit (and counts it).
   bool take() {
     if (count >= cap) {
       refused = true;
       return false;
     }
+    if (late()) return false;
     ++count;
     return true;
   }
 };
+
+// Thrown from G into our engines (never into the C libraries) when one keeps asking for
+// evaluations past the time limit: it would otherwise hold the suite.
+struct TimeLimitStop {};
+constexpr int kLateCallsBeforeStop = 10;
 
 // The C libraries (MINPACK, GSL, KINSOL) must never see an exception unwind through them: their
 // copies of a user's F, ∂F and G turn one into NaN, a non-finite evaluation they report. With a
@@ -74,7 +103,11 @@ RootProblem<Dynamic> guarded(const RootProblem<Dynamic>& f, Meter* meter) {
           out.setConstant(p->residual_size(), std::numeric_limits<double>::quiet_NaN());
         }
       },
-      [p](const Eigen::VectorXd& x, Eigen::MatrixXd& jac) {
+      [p, meter](const Eigen::VectorXd& x, Eigen::MatrixXd& jac) {
+        if (meter && meter->late()) {
+          jac.setConstant(p->residual_size(), x.size(), std::numeric_limits<double>::quiet_NaN());
+          return;
+        }
         try {
           p->jacobian(x, jac);
         } catch (...) {
@@ -106,22 +139,30 @@ FixedPointProblem<Dynamic> metered(const FixedPointProblem<Dynamic>& g, Meter& m
   const FixedPointProblem<Dynamic>* p = &g;
   auto map = [p, &meter](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
     if (!meter.take()) {
+      if (meter.late_calls > kLateCallsBeforeStop) throw TimeLimitStop{};
       out.setConstant(p->size(), std::numeric_limits<double>::quiet_NaN());
       return;
     }
     p->evaluate(x, out);
   };
   if (!g.has_jacobian()) return FixedPointProblem<Dynamic>::from_map(map, g.size());
-  return FixedPointProblem<Dynamic>::with_jacobian(
-      map, [p](const Eigen::VectorXd& x, Eigen::MatrixXd& jac) { p->jacobian(x, jac); }, g.size(),
-      g.jacobian_source());
+  auto jacobian = [p, &meter](const Eigen::VectorXd& x, Eigen::MatrixXd& jac) {
+    if (meter.late()) {
+      if (meter.late_calls > kLateCallsBeforeStop) throw TimeLimitStop{};
+      jac.setConstant(p->size(), p->size(), std::numeric_limits<double>::quiet_NaN());
+      return;
+    }
+    p->jacobian(x, jac);
+  };
+  return FixedPointProblem<Dynamic>::with_jacobian(map, jacobian, g.size(), g.jacobian_source());
 }
 
 // KINSOL's options and set-up may refuse (std::invalid_argument): the caller makes that row
 // invalid_input. `budget` counts every evaluation, the references' checks of their answers
 // included.
-Outcome run_reference(const std::string& solver, const RootProblem<Dynamic>& residual,
-                      const FixedPointProblem<Dynamic>& g, Eigen::VectorXd& x, long budget) {
+Outcome run_reference(const std::string& solver, const TestProblem& problem,
+                      const RootProblem<Dynamic>& residual, const FixedPointProblem<Dynamic>& g,
+                      Eigen::VectorXd& x, long budget) {
   ReferenceOptions o;
   o.max_evaluations = budget;
   if (solver == "minpack:hybrj") {
@@ -135,6 +176,10 @@ Outcome run_reference(const std::string& solver, const RootProblem<Dynamic>& res
   KinsolOptions ko;
   ko.strategy = KinsolSolver::strategy(solver).value_or(KinsolStrategy::kNewtonLineSearch);
   ko.tolerance = 1e-10;
+  // The problem's scaling, as KINSOL's own drivers give it (MINPACK and GSL take none: hybrj
+  // scales its variables itself, as MINPACK's driver runs it).
+  ko.u_scale = problem.u_scale;
+  ko.f_scale = problem.f_scale;
   // KINSOL counts iterations (each at least one evaluation); max_evaluations bounds the
   // evaluations its line search and the final check add.
   ko.max_iterations = budget;
@@ -259,6 +304,10 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
     throw InvalidInput("the evaluation budget per dimension must be >= 1");
   }
   if (solvers.empty()) throw InvalidInput("no solver listed");
+  if (!(options.time_limit_s > 0.0)) {
+    throw InvalidInput("the time limit per solve must be > 0 seconds (+inf: none), got " +
+                       std::to_string(options.time_limit_s));
+  }
   auto& registry = EngineRegistry<Dynamic>::global();
   SolverOptions base;
   base.stop.step_tolerance = 1e-12;
@@ -315,7 +364,7 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
         row.solver = s;
         Eigen::VectorXd x = start.x;
         Outcome outcome;
-        meter.reset(budget);
+        meter.reset(budget, options.time_limit_s);
         // Whatever a solver's options, set-up or run throw, the row says so and the suite goes
         // on: invalid_input (options or set-up refused, the problem's box refused),
         // out_of_memory (std::bad_alloc), engine_threw (anything else, `throw 42` included).
@@ -325,8 +374,8 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
             row.ns = mean_ns_per_call(
                 [&] {
                   x = start.x;
-                  meter.reset(budget);
-                  outcome = run_reference(s, safe_f, safe_g, x, budget);
+                  meter.reset(budget, options.time_limit_s);
+                  outcome = run_reference(s, p, safe_f, safe_g, x, budget);
                 },
                 kTimingNs, 1, kMaxTimedCalls);
           } else {
@@ -343,7 +392,7 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
             row.ns = mean_ns_per_call(
                 [&] {
                   x = start.x;
-                  meter.reset(budget);
+                  meter.reset(budget, options.time_limit_s);
                   const Summary sum = solve_or_report(*engine, engine_g, x);
                   // The metered count: every evaluation of G the engine made.
                   outcome = {std::string(to_string(sum.status)), meter.count,
@@ -351,6 +400,9 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
                 },
                 kTimingNs, 1, kMaxTimedCalls);
           }
+        } catch (const TimeLimitStop&) {
+          outcome = {"time_limit", meter.count, 0, ""};
+          x.resize(0);  // unwound: no answer
         } catch (const std::bad_alloc&) {
           outcome = {"out_of_memory", meter.count, 0, "std::bad_alloc: not enough memory"};
           x.resize(0);
@@ -369,25 +421,39 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
           x.resize(0);  // no answer
         }
         row.message = printable(outcome.message);
+        row.residual = row.scaled_residual = std::numeric_limits<double>::infinity();
         if (x.size() == n && x.allFinite()) {
           Eigen::VectorXd f(n);
           judge_f.evaluate(x, f);
-          row.residual = f.allFinite() ? f.norm() : std::numeric_limits<double>::infinity();
-        } else {
-          row.residual = std::numeric_limits<double>::infinity();
+          if (f.allFinite()) {
+            row.residual = f.norm();
+            row.scaled_residual = p.f_scale.size() ? p.scaled_norm(f) : row.residual;
+          }
         }
+        if (x.size() == n) row.x = x;
         row.status = outcome.status;
         const bool in_box = x.size() == n && !p.first_outside_bounds(x);
         if (x.size() == n && !in_box) row.status = "outside_bounds";
         // An evaluation asked for beyond the budget was refused: whatever the point, not solved.
-        if (meter.refused) {
+        if (meter.timed_out) {
+          row.status = "time_limit";
+          std::ostringstream why;
+          why << "asked for an evaluation after the time limit of " << options.time_limit_s
+              << " s (refused"
+              << (meter.late_calls > kLateCallsBeforeStop
+                      ? "; asked again, stopped by an exception)"
+                      : ")");
+          row.message =
+              why.str();  // what the engine said of the NaN we gave it is beside the point
+        } else if (meter.refused) {
           row.status = "max_evaluations";
           if (row.message.empty()) {
             row.message = "asked for an evaluation beyond the budget of " + std::to_string(budget) +
                           " (refused)";
           }
         }
-        row.solved = x.size() == n && in_box && !meter.refused && row.residual <= threshold;
+        row.solved = x.size() == n && in_box && !meter.refused && !meter.timed_out &&
+                     row.scaled_residual <= threshold;
         row.error =
             x.size() == n ? distance_to_solutions(p, x) : std::numeric_limits<double>::infinity();
         row.f_evals = outcome.f_evals;

@@ -72,6 +72,19 @@ void validate_test_problem(const TestProblem& p, std::string_view where,
       }
     }
   }
+  auto check_scale = [&](const Eigen::VectorXd& d, const char* name) {
+    if (d.size() != 0 && d.size() != n)
+      fail(where, p, std::string(name) + " has size " + shape(d.size()));
+    for (Index i = 0; i < d.size(); ++i) {
+      if (!(d[i] > 0.0) || !std::isfinite(d[i])) {
+        std::ostringstream os;
+        os << name << "[" << i << "] = " << d[i] << " is not finite and > 0";
+        fail(where, p, os.str());
+      }
+    }
+  };
+  check_scale(p.u_scale, "u_scale");
+  check_scale(p.f_scale, "f_scale");
   std::set<std::string> labels;
   for (const ProblemStart& s : p.starts) {
     const std::string which = "start '" + printable(s.label, 60) + "'";
@@ -99,12 +112,11 @@ void validate_test_problem(const TestProblem& p, std::string_view where,
     } catch (...) {
       fail(where, p, which + ": F throws there: " + current_exception_text());
     }
-    const double norm =
-        f.size() == n && f.allFinite() ? f.stableNorm() : std::numeric_limits<double>::infinity();
+    const double norm = f.size() == n ? p.scaled_norm(f) : std::numeric_limits<double>::infinity();
     if (!(norm <= solution_threshold)) {
       std::ostringstream os;
-      os << which << " is not a root: |F(x*)|2 = " << norm << " > " << solution_threshold
-         << " (the set's threshold)";
+      os << which << " is not a root: |" << (p.f_scale.size() ? "D_f " : "") << "F(x*)|2 = " << norm
+         << " > " << solution_threshold << " (the set's threshold)";
       fail(where, p, os.str());
     }
   }

@@ -5,6 +5,7 @@
 // sanitizer report, an exception, or output that does not read back to the same fields:
 // * CSV, read by the small RFC 4180 reader below: the header, one record per row, every string
 //   byte for byte, every finite double exactly (17 significant digits), a non-finite one empty;
+//   the answer x as space-separated components that read back exactly (nan, inf, -inf too);
 // * JSON, parsed by nlohmann::json: every string as valid_utf8 makes it (U+FFFD for a byte that
 //   is not UTF-8), every finite double exactly, a non-finite one null;
 // * the table: no control character but the line feed, no invalid UTF-8.
@@ -111,6 +112,33 @@ void check_number(const nlohmann::json& j, double v) {
   check(back == v && std::signbit(back) == std::signbit(v));
 }
 
+// The CSV's x: components separated by single spaces, each reading back to the same double
+// (any NaN as nan), none for an empty x.
+void check_answer(const std::string& cell, const Eigen::VectorXd& x) {
+  if (x.size() == 0) {
+    check(cell.empty());
+    return;
+  }
+  const char* at = cell.c_str();
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    if (i > 0) {
+      check(*at == ' ');
+      ++at;
+    }
+    check(*at != ' ' && *at != '\0');
+    char* end = nullptr;
+    const double back = std::strtod(at, &end);
+    check(end != at);
+    if (std::isnan(x[i])) {
+      check(std::isnan(back));
+    } else {
+      check(back == x[i] && std::signbit(back) == std::signbit(x[i]));
+    }
+    at = end;
+  }
+  check(*at == '\0');
+}
+
 bool valid_utf8_text(const std::string& text) {
   for (std::size_t i = 0; i < text.size();) {
     if (static_cast<unsigned char>(text[i]) < 0x80) {
@@ -144,6 +172,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t siz
     r.ns = any_double(in);
     r.status = in.ConsumeRandomLengthString(40);
     r.message = in.ConsumeRandomLengthString(300);
+    r.scaled_residual = any_double(in);
+    r.x.resize(in.ConsumeIntegralInRange<int>(0, 5));
+    for (Eigen::Index i = 0; i < r.x.size(); ++i) r.x[i] = any_double(in);
   }
 
   // CSV.
@@ -151,8 +182,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t siz
   check(read_csv(nlobs::cli::suite_to_csv(rows), records));
   check(records.size() == rows.size() + 1);
   const std::vector<std::string> header = {
-      "set",      "problem", "n",       "start",   "start_scale", "solver", "solved",
-      "residual", "error",   "f_evals", "j_evals", "ns",          "status", "message"};
+      "set",     "problem", "n",        "start",   "start_scale",
+      "solver",  "solved",  "residual", "error",   "f_evals",
+      "j_evals", "ns",      "status",   "message", "scaled_residual",
+      "x"};
   check(records[0] == header);
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const SuiteRow& r = rows[k];
@@ -166,6 +199,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t siz
     check(c[9] == std::to_string(r.f_evals) && c[10] == std::to_string(r.j_evals));
     check_number(c[11], r.ns);
     check(c[12] == r.status && c[13] == r.message);
+    check_number(c[14], r.scaled_residual);
+    check_answer(c[15], r.x);
   }
 
   // JSON: dump() must not throw (invalid UTF-8 reaches it as U+FFFD), and parses back.
@@ -184,11 +219,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t siz
     check(j.at("f_evals").get<long>() == r.f_evals && j.at("j_evals").get<long>() == r.j_evals);
     check_number(j.at("ns"), r.ns);
     check(j.at("status") == valid_utf8(r.status) && j.at("message") == valid_utf8(r.message));
+    check_number(j.at("scaled_residual"), r.scaled_residual);
+    if (r.x.size() == 0) {
+      check(j.at("x").is_null());
+    } else {
+      check(j.at("x").is_array() && j.at("x").size() == static_cast<std::size_t>(r.x.size()));
+      for (Eigen::Index i = 0; i < r.x.size(); ++i) check_number(j.at("x")[i], r.x[i]);
+    }
   }
 
   // The table: whatever the names, nothing a terminal would act on.
   std::ostringstream table;
-  nlobs::cli::print_suite_tables(rows, any_double(in), table);
+  const double threshold = any_double(in);
+  nlobs::cli::print_suite_tables(rows, threshold, table, in.ConsumeBool());
   const std::string text = table.str();
   for (std::size_t i = 0; i < text.size(); ++i) {
     const auto b = static_cast<unsigned char>(text[i]);

@@ -33,6 +33,9 @@ struct KinsolOptions {
   // 1000 ‖u₀‖₂ but at least 1 (kinsol.c, KINSolInit), which at u₀ = 0 allows steps of length 1
   // only and ends runs with KIN_MXNEWT_5X_EXCEEDED; the suite passes 1000 max(1, ‖u₀‖₂).
   double max_newton_step = 0.0;
+  // KINSol's u_scale and f_scale: its norms, fnormtol's test and the check below included, are
+  // those of D_u Δu and D_f F (D = diag(scale)). Empty: ones; otherwise of size n, finite, > 0.
+  Eigen::VectorXd u_scale{}, f_scale{};
 };
 
 struct KinsolResult {
@@ -46,7 +49,7 @@ struct KinsolResult {
   // Why success is false although flag >= 0: "returned a point that is not finite" or
   // "|F| 300 > tolerance 1e-08".
   std::string reason;
-  double residual = 0.0;  // ‖F(u)‖∞ (‖G(u) − u‖∞ for FP) at the returned u
+  double residual = 0.0;  // ‖D_f F(u)‖∞ (‖D_f (G(u) − u)‖∞ for FP) at the returned u
   long iterations = 0;    // KINGetNumNonlinSolvIters
   // Every evaluation of F (or G): KINSOL's own, those of its difference-quotient Jacobian
   // (KINGetNumFuncEvals leaves them out) and the final check above, counted at the callback,

@@ -2,8 +2,9 @@
 // `nlobs suite SET` and `nlobs solve SET/NAME`: every listed solver — engines of the registry
 // (any spec, a user's engine too) and the reference solvers — on every (problem, start) of a
 // problem set, judged the same way for all: solved when the returned point is finite, inside
-// the problem's bounds and ‖F(x)‖₂ ≤ the threshold (1e-8 unless the set or the caller says
-// otherwise).
+// the problem's bounds and ‖D_f F(x)‖₂ ≤ the threshold (1e-8 unless the set or the caller says
+// otherwise; D_f the problem's f_scale, the identity without one), within the budget and the
+// time limit.
 #include <functional>
 #include <limits>
 #include <string>
@@ -29,6 +30,8 @@ struct SuiteRow {
   double ns = 0.0;  // wall time per solve
   // The solver's own account; `outside_bounds` for a point outside the box; `max_evaluations`
   // for a solver that asked for an evaluation beyond its budget (refused; never solved);
+  // `time_limit` for one whose evaluation past SuiteOptions::time_limit_s was refused (never
+  // solved);
   // `invalid_input` (a solver's options or set-up refused, the problem's box refused),
   // `engine_threw` (any exception, `throw 42` included) or `out_of_memory` (std::bad_alloc),
   // each a row with no answer (residual and error inf).
@@ -36,6 +39,12 @@ struct SuiteRow {
   // Why, when the solver said (its Summary::message, KINSOL's reason) or threw (the exception's
   // text): printable (nlobs::printable), at most ~200 bytes; empty otherwise.
   std::string message;
+  // ‖D_f F(x)‖₂, what `solved` is judged on: residual itself when the problem has no f_scale.
+  double scaled_residual = 0.0;
+  // The returned point as the solver returned it (NaN, ±inf, 1e308 included), of size n; empty
+  // for a row without an answer (invalid_input, engine_threw, out_of_memory, a time limit that
+  // had to stop the engine by an exception).
+  Eigen::VectorXd x{};
 };
 
 struct SuiteOptions {
@@ -49,6 +58,13 @@ struct SuiteOptions {
   // refused (NaN, before F is called), the solver stops and its row is max_evaluations, not
   // solved. f_evals never exceeds the budget.
   long evaluations_per_dimension = 1000;
+  // Wall time each solve may take, in seconds (+inf: no limit; otherwise > 0). Checked at every
+  // evaluation of F, G or a Jacobian: past the limit the evaluation is refused (NaN, the problem
+  // not called), the solver stops as at its budget, and the row is `time_limit`, not solved. An
+  // engine of ours (a user's among them) that asks again ten times after a refusal is stopped by
+  // an exception (row without an answer). A single slow evaluation, or a solver computing long
+  // between two, overruns the limit by that long.
+  double time_limit_s = std::numeric_limits<double>::infinity();
   // Only the starts with these labels (empty: all); a label no problem has is an error.
   std::vector<std::string> starts{};
   // Called after each (problem, start) pair, e.g. for a progress line.

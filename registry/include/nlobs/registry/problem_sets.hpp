@@ -5,7 +5,9 @@
 // `nlobs solve SET/NAME` runs one problem. The built-in sets (chua-window, mgh) are registered
 // exactly as a user's set is (docs/extending.md).
 #include <Eigen/Core>
+#include <cmath>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -39,9 +41,21 @@ struct TestProblem {
   Eigen::VectorXd lower{}, upper{};
   // Known solutions: the suite reports the ∞-norm distance of the answer to the nearest one.
   std::vector<Eigen::VectorXd> solutions{};
+  // KINSOL's scaling (its u_scale and f_scale: the solver's norms are those of D_u x and D_f F,
+  // D = diag(scale)); each empty (all ones) or of size n, finite and > 0. The suite judges
+  // ‖D_f F(x)‖₂ (`scaled_residual`): a problem whose components live on different scales (a
+  // concentration of 1e-6 beside a temperature of 300) states what "small" means per equation.
+  Eigen::VectorXd u_scale{}, f_scale{};
   std::string description{};
 
   Index size() const { return residual.size(); }
+  // ‖D_f f‖₂ (‖f‖₂ without an f_scale), inf when f is not finite; f of size n.
+  double scaled_norm(const Eigen::VectorXd& f) const {
+    if (!f.allFinite()) return std::numeric_limits<double>::infinity();
+    const double norm =
+        f_scale.size() == f.size() ? f.cwiseProduct(f_scale).stableNorm() : f.stableNorm();
+    return std::isfinite(norm) ? norm : std::numeric_limits<double>::infinity();
+  }
   // The first component of x (of the problem's size) outside lower ≤ x ≤ upper; none inside.
   std::optional<Index> first_outside_bounds(const Eigen::VectorXd& x) const {
     for (Index i = 0; i < x.size(); ++i) {
@@ -81,8 +95,9 @@ inline constexpr Index kMaxProblemDimension = 2000;
 // Throws InvalidInput naming `where` and the problem: a bad name, n = 0 or n above
 // kMaxProblemDimension, a non-square F or one without a Jacobian, a fixed-point map of another
 // size, no start, a start, bound or solution of the wrong size, a non-finite start or solution,
-// lower > upper, a start outside the bounds, and a known solution (named by its index) outside
-// the bounds or not a root: ‖F(x*)‖₂ > solution_threshold, F not finite there or F throwing there
+// lower > upper, a start outside the bounds, a u_scale or f_scale of the wrong size or with an
+// entry not finite and > 0, and a known solution (named by its index) outside the bounds or not a
+// root: ‖D_f F(x*)‖₂ > solution_threshold, F not finite there or F throwing there
 // (the suite's error column measures the distance to the known solutions: a wrong one would
 // report a solver that found the true root as far off). build_problem_set passes the set's
 // solved_threshold.
@@ -94,7 +109,8 @@ struct ProblemSetEntry {
   std::string description{};
   // Builds the problems when a run asks for them (a set may be large or slow to set up).
   std::function<std::vector<TestProblem>()> problems{};
-  // The default of --threshold: solved when ‖F(x)‖₂ ≤ this at the returned point.
+  // The default of --threshold: solved when ‖D_f F(x)‖₂ ≤ this at the returned point (D_f the
+  // problem's f_scale, the identity without one).
   double solved_threshold = 1e-8;
 };
 

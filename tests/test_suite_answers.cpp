@@ -1,0 +1,408 @@
+// What `nlobs suite` tells a user about each answer (issue 39): the point x itself in the table,
+// JSON and CSV (NaN, inf and 1e308 included), the residual in the problem's own scaling
+// (u_scale, f_scale: KINSOL's meaning) and a per-solve time limit that ends a deliberately slow
+// engine, a slow F and every reference alike. Problems and engines nlobs does not ship.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "nlobs/reference/kinsol_solver.hpp"
+#include "nlobs/reference/problem_suite.hpp"
+#include "nlobs/registry/problem_sets.hpp"
+#include "nlobs/solvers/engine_registry.hpp"
+#include "suite_command.hpp"
+#include "suite_report.hpp"
+
+namespace nlobs {
+namespace {
+
+using reference::SuiteOptions;
+using reference::SuiteRow;
+
+// An engine a user wrote that takes its time: one evaluation of G every 2 ms, as a slow
+// simulation would, until G is not finite (then it stops, as our engines do) — or, with
+// `stubborn`, never (it ignores NaN: only an exception ends it).
+class SlowEngine final : public Engine<Dynamic> {
+ public:
+  SlowEngine(SolverOptions o, bool stubborn) : Engine<Dynamic>(std::move(o)), stubborn_(stubborn) {}
+  std::string_view name() const override { return stubborn_ ? "test-stubborn" : "test-slow"; }
+  Summary solve(const FixedPointProblem<Dynamic>& g, Vector<Dynamic>& x) override {
+    Vector<Dynamic> next(x.size());
+    Summary s;
+    s.engine = std::string(name());
+    for (;;) {
+      g.evaluate(x, next);
+      ++s.function_evaluations;
+      if (!next.allFinite() && !stubborn_) {
+        s.status = Status::kNonFinite;
+        return s;
+      }
+      if (next.allFinite()) x = 0.5 * (x + next);  // a damped Picard step: slow, but it moves
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  }
+
+ private:
+  bool stubborn_;
+};
+
+// A user's engine that returns the listed solution of mass-balance (below), 1e-12 off in x₀.
+class ListedAnswer final : public Engine<Dynamic> {
+ public:
+  explicit ListedAnswer(SolverOptions o) : Engine<Dynamic>(std::move(o)) {}
+  std::string_view name() const override { return "test-answers-listed"; }
+  Summary solve(const FixedPointProblem<Dynamic>&, Vector<Dynamic>& x) override {
+    x = Eigen::Vector2d(1.0 + 1e-12, 1.0);
+    Summary s;
+    s.status = Status::kConverged;
+    return s;
+  }
+};
+
+void register_engines_once() {
+  static const bool done = [] {
+    auto& engines = EngineRegistry<Dynamic>::global();
+    for (const bool stubborn : {false, true}) {
+      const std::string name = stubborn ? "test-stubborn" : "test-slow";
+      engines.add(
+          {name,
+           "sleeps 2 ms per evaluation",
+           {},
+           {name},
+           [stubborn](EngineSpecReader&, SolverOptions o) -> std::unique_ptr<Engine<Dynamic>> {
+             return std::make_unique<SlowEngine>(o, stubborn);
+           }});
+    }
+    engines.add({"test-answers-listed",
+                 "returns the known solution of mass-balance",
+                 {},
+                 {"test-answers-listed"},
+                 [](EngineSpecReader&, SolverOptions o) -> std::unique_ptr<Engine<Dynamic>> {
+                   return std::make_unique<ListedAnswer>(o);
+                 }});
+    return true;
+  }();
+  (void)done;
+}
+
+ProblemSetEntry set_of(const TestProblem& p) {
+  return ProblemSetEntry{.name = "answers",
+                         .problems = [p] { return std::vector<TestProblem>{p}; }};
+}
+
+const SuiteRow& row(const std::vector<SuiteRow>& rows, const std::string& solver) {
+  for (const SuiteRow& r : rows) {
+    if (r.solver == solver) return r;
+  }
+  throw std::logic_error("no row " + solver);
+}
+
+// x² = 2, x ∈ R²: two roots per component; which one a solver found is only in its answer.
+TestProblem two_roots() {
+  TestProblem p = root_test_problem("square-roots", 2,
+                                    [](const auto& x, auto& f) {
+                                      f[0] = x[0] * x[0] - 2.0;
+                                      f[1] = x[1] * x[1] - 2.0;
+                                    },
+                                    {{"mixed", Eigen::Vector2d(-1.0, 1.0)}});
+  p.solutions = {Eigen::Vector2d(std::sqrt(2.0), std::sqrt(2.0))};
+  return p;
+}
+
+TEST(SuiteAnswers, EveryRowCarriesThePointItsSolverReturned) {
+  const TestProblem p = two_roots();
+  const ProblemSetEntry set = set_of(p);
+  const auto problems = build_problem_set(set);
+  const auto rows = reference::run_suite(
+      set, problems, {"newton", "kinsol:newton", "minpack:hybrj", "gsl:gnewton"});
+  for (const SuiteRow& r : rows) {
+    SCOPED_TRACE(r.solver);
+    ASSERT_EQ(r.x.size(), 2);
+    EXPECT_TRUE(r.solved) << r.status;
+    // From (-1, 1) every solver goes to (-√2, √2): a root, but not the one listed. The error
+    // column alone says 2√2 from a known solution; x says which root it is.
+    EXPECT_NEAR(r.x[0], -std::sqrt(2.0), 1e-8);
+    EXPECT_NEAR(r.x[1], std::sqrt(2.0), 1e-8);
+    EXPECT_NEAR(r.error, 2.0 * std::sqrt(2.0), 1e-8);
+    EXPECT_EQ(r.scaled_residual, r.residual);  // no f_scale: the same number
+  }
+
+  // The CLI: JSON holds x as numbers, CSV as a field that reads back to the same doubles.
+  static const bool registered = [&set] {
+    problem_set_registry().add(set, "test_suite_answers");
+    return true;
+  }();
+  (void)registered;
+  cli::SuiteArguments args;
+  args.solvers = "newton,test-throws-nothing-registered";
+  std::ostringstream out, err;
+  EXPECT_THROW(cli::run_problem_suite({"answers"}, args, "suite", out, err), std::invalid_argument);
+  args.solvers = "newton,minpack:hybrj";
+  args.json = true;
+  const auto csv = std::filesystem::temp_directory_path() / "nlobs_test_suite_answers.csv";
+  args.csv = csv.string();
+  cli::run_problem_suite({"answers"}, args, "suite", out, err);
+  const auto json = nlohmann::json::parse(out.str());
+  ASSERT_EQ(json.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    ASSERT_TRUE(json[k]["x"].is_array()) << json[k].dump();
+    ASSERT_EQ(json[k]["x"].size(), 2u);
+    EXPECT_NEAR(json[k]["x"][0].get<double>(), -std::sqrt(2.0), 1e-8);
+    EXPECT_EQ(json[k]["scaled_residual"], json[k]["residual"]);
+  }
+  std::ifstream file(csv);
+  std::string header, line;
+  std::getline(file, header);
+  EXPECT_EQ(header,
+            "set,problem,n,start,start_scale,solver,solved,residual,error,f_evals,j_evals,ns,"
+            "status,message,scaled_residual,x");
+  std::getline(file, line);
+  const std::string x_field = line.substr(line.rfind(',') + 1);
+  char* end = nullptr;
+  const double x0 = std::strtod(x_field.c_str(), &end);
+  const double x1 = std::strtod(end, &end);
+  EXPECT_EQ(*end, '\0') << x_field;
+  EXPECT_EQ(x0, json[0]["x"][0].get<double>());  // 17 digits: the same double
+  EXPECT_EQ(x1, json[0]["x"][1].get<double>());
+  std::filesystem::remove(csv);
+
+  // The table prints the answer below each row with --show-x, and only then.
+  args = {};
+  args.solvers = "newton";
+  std::ostringstream plain, with_x;
+  cli::run_problem_suite({"answers"}, args, "suite", plain, err);
+  args.show_x = true;
+  cli::run_problem_suite({"answers"}, args, "suite", with_x, err);
+  EXPECT_EQ(plain.str().find("x = ["), std::string::npos) << plain.str();
+  EXPECT_NE(with_x.str().find("    x = [-1.41421, 1.41421]\n"), std::string::npos) << with_x.str();
+}
+
+// What the writers make of answers a solver may return: NaN, ±inf, 1e308, the smallest
+// subnormal; a long x is cut short in the table, whole in the files.
+TEST(SuiteAnswers, TheWritersTakeAnyAnswer) {
+  SuiteRow r;
+  r.set = "s";
+  r.problem = "p";
+  r.n = 12;
+  r.start = "x1";
+  r.solver = "newton";
+  r.status = "diverged";
+  r.residual = r.scaled_residual = std::numeric_limits<double>::infinity();
+  r.x = Eigen::VectorXd::LinSpaced(12, 1.0, 12.0);
+  r.x[0] = std::numeric_limits<double>::quiet_NaN();
+  r.x[1] = 1e308;
+  r.x[2] = -std::numeric_limits<double>::infinity();
+  r.x[3] = 5e-324;
+  SuiteRow none = r;
+  none.status = "engine_threw";
+  none.x.resize(0);
+  const std::vector<SuiteRow> rows = {r, none};
+
+  const auto json = nlohmann::json::parse(cli::suite_to_json(rows).dump());
+  ASSERT_EQ(json[0]["x"].size(), 12u);
+  EXPECT_TRUE(json[0]["x"][0].is_null());
+  EXPECT_EQ(json[0]["x"][1].get<double>(), 1e308);
+  EXPECT_TRUE(json[0]["x"][2].is_null());
+  EXPECT_EQ(json[0]["x"][3].get<double>(), 5e-324);
+  EXPECT_TRUE(json[1]["x"].is_null());  // no answer
+  EXPECT_TRUE(json[0]["scaled_residual"].is_null());
+
+  EXPECT_EQ(cli::answer_field(r.x.head(4)), "nan 1e+308 -inf 4.9406564584124654e-324");
+  EXPECT_EQ(cli::answer_field(Eigen::VectorXd()), "");
+  const std::string csv = cli::suite_to_csv(rows);
+  EXPECT_NE(csv.find(",nan 1e+308 -inf 4.9406564584124654e-324 5 6 7 8 9 10 11 12\n"),
+            std::string::npos)
+      << csv;
+  EXPECT_NE(csv.find(",engine_threw,,,\n"), std::string::npos) << csv;
+
+  std::ostringstream table;
+  cli::print_suite_tables(rows, 1e-8, table, true);
+  EXPECT_NE(table.str().find("x = [nan, 1e+308, -inf, 4.94066e-324, 5, 6, 7, 8, ... (4 more)]"),
+            std::string::npos)
+      << table.str();
+}
+
+// F = (1e6 (x₀ − 1), x₁ − 1): a mass balance in mg beside a fraction. 1e-12 off in x₀ is
+// 1e-6 in F₀: not solved in ‖F‖₂, solved in the problem's own scaling D_f = (1e-6, 1).
+TestProblem badly_scaled() {
+  TestProblem p = root_test_problem("mass-balance", 2,
+                                    [](const auto& x, auto& f) {
+                                      f[0] = 1e6 * (x[0] - 1.0);
+                                      f[1] = x[1] - 1.0;
+                                    },
+                                    {{"s", Eigen::Vector2d(3.0, 3.0)}});
+  p.solutions = {Eigen::Vector2d(1.0 + 1e-12, 1.0)};  // a root at the scaled threshold only
+  return p;
+}
+
+TEST(SuiteAnswers, AProblemsScalesAreItsJudgementAndReachKinsol) {
+  TestProblem p = badly_scaled();
+  // Its listed solution is a root only in the scaled norm: refused without the scale.
+  try {
+    validate_test_problem(p, "problem set 'x'");
+    FAIL() << "accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("known solution 0 is not a root: |F(x*)|2 = 1"),
+              std::string::npos)
+        << e.what();
+  }
+  p.f_scale = Eigen::Vector2d(1e-6, 1.0);
+  EXPECT_NO_THROW(validate_test_problem(p, "problem set 'x'"));
+  for (const auto& [bad, what] :
+       {std::pair{Eigen::VectorXd(Eigen::Vector3d::Ones()), "f_scale has size 3"},
+        std::pair{Eigen::VectorXd(Eigen::Vector2d(1.0, 0.0)),
+                  "f_scale[1] = 0 is not finite and > 0"},
+        std::pair{Eigen::VectorXd(Eigen::Vector2d(-1.0, 1.0)), "f_scale[0] = -1"},
+        std::pair{Eigen::VectorXd(Eigen::Vector2d(1.0, std::numeric_limits<double>::quiet_NaN())),
+                  "f_scale[1] = nan"},
+        std::pair{Eigen::VectorXd(Eigen::Vector2d(std::numeric_limits<double>::infinity(), 1.0)),
+                  "f_scale[0] = inf"}}) {
+    TestProblem q = p;
+    q.f_scale = bad;
+    try {
+      validate_test_problem(q, "problem set 'x'");
+      ADD_FAILURE() << "accepted " << what;
+    } catch (const InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+    TestProblem u = p;
+    u.u_scale = bad;
+    EXPECT_THROW(validate_test_problem(u, "problem set 'x'"), InvalidInput) << what;
+  }
+
+  // A user's answer 1e-12 off in x₀ (the listed solution, returned as is by a user's engine):
+  // judged on |D_f F|2 = 1e-12, with |F|2 = 1e-6 beside it.
+  register_engines_once();
+  const ProblemSetEntry set = set_of(p);
+  const auto rows =
+      reference::run_suite(set, build_problem_set(set), {"test-answers-listed", "kinsol:newton"});
+  const SuiteRow& listed = row(rows, "test-answers-listed");
+  EXPECT_TRUE(listed.solved);
+  EXPECT_NEAR(listed.residual, 1e-6, 1e-9);
+  EXPECT_NEAR(listed.scaled_residual, 1e-12, 1e-15);
+  EXPECT_TRUE(row(rows, "kinsol:newton").solved) << row(rows, "kinsol:newton").status;
+  std::ostringstream table;
+  cli::print_suite_tables(rows, 1e-8, table);
+  EXPECT_NE(table.str().find("|D_f F|2"), std::string::npos) << table.str();
+  EXPECT_NE(table.str().find("solved (|D_f F|2 <= 1e-8"), std::string::npos) << table.str();
+
+  // KINSOL's own stop hears f_scale: at u₀ = 2 with D_f = 1e-10, ‖D_f F(u₀)‖∞ = 1e-10 is below
+  // 0.01 fnormtol, so KINSOL takes the start (KIN_INITIAL_GUESS_OK); unscaled, it iterates to 1.
+  const auto f = [](const Eigen::VectorXd& u, Eigen::VectorXd& out) { out = u.array() - 1.0; };
+  const auto j = [](const Eigen::VectorXd& u, Eigen::MatrixXd& out) {
+    out = Eigen::MatrixXd::Identity(u.size(), u.size());
+  };
+  reference::KinsolOptions ko;
+  ko.strategy = reference::KinsolStrategy::kNewtonLineSearch;
+  ko.tolerance = 1e-6;
+  Eigen::VectorXd u = Eigen::VectorXd::Constant(1, 2.0);
+  reference::KinsolResult plain = reference::KinsolSolver(1, ko, f, j).solve(u);
+  EXPECT_TRUE(plain.success);
+  EXPECT_NEAR(u[0], 1.0, 1e-12);
+  ko.f_scale = Eigen::VectorXd::Constant(1, 1e-10);
+  u = Eigen::VectorXd::Constant(1, 2.0);
+  reference::KinsolResult scaled = reference::KinsolSolver(1, ko, f, j).solve(u);
+  EXPECT_TRUE(scaled.success);
+  EXPECT_EQ(scaled.flag_name, "KIN_INITIAL_GUESS_OK");
+  EXPECT_EQ(u[0], 2.0);
+  EXPECT_DOUBLE_EQ(scaled.residual, 1e-10);  // ‖D_f F‖∞, the check's own number
+  ko.u_scale = Eigen::VectorXd::Constant(2, 1.0);
+  EXPECT_THROW(reference::KinsolSolver(1, ko, f, j), std::invalid_argument);
+  ko.u_scale = Eigen::VectorXd::Constant(1, 0.0);
+  EXPECT_THROW(reference::KinsolSolver(1, ko, f, j), std::invalid_argument);
+}
+
+// x = G(x) with G(x) = x/2 + 1 (root 2): any engine gets there, given time.
+TestProblem halving() {
+  return fixed_point_test_problem("halving", 1,
+                                  [](const auto& x, auto& g) { g[0] = 0.5 * x[0] + 1.0; },
+                                  {{"zero", Eigen::VectorXd::Zero(1)}});
+}
+
+TEST(SuiteAnswers, ATimeLimitEndsADeliberatelySlowEngine) {
+  register_engines_once();
+  const ProblemSetEntry set = set_of(halving());
+  const auto problems = build_problem_set(set);
+  SuiteOptions options;
+  options.time_limit_s = 0.05;
+  // test-slow stops on the NaN it is given past the limit; test-stubborn ignores NaN and is
+  // stopped by an exception; without the limit neither would end (test-slow at its budget of
+  // 2000 evaluations, 4 s; test-stubborn never).
+  const auto rows = reference::run_suite(set, problems, {"test-slow", "test-stubborn"}, options);
+  for (const SuiteRow& r : rows) {
+    SCOPED_TRACE(r.solver);
+    EXPECT_EQ(r.status, "time_limit");
+    EXPECT_FALSE(r.solved);
+    // 2 ms asleep per evaluation: at most 26 evaluations fit in 50 ms.
+    EXPECT_LE(r.f_evals, 26);
+    EXPECT_GE(r.f_evals, 1);
+    EXPECT_NE(r.message.find("after the time limit of 0.05 s"), std::string::npos) << r.message;
+  }
+  // The well-behaved one keeps its answer (moving towards 2); the stubborn one has none.
+  ASSERT_EQ(row(rows, "test-slow").x.size(), 1);
+  EXPECT_GT(row(rows, "test-slow").x[0], 0.0);
+  EXPECT_EQ(row(rows, "test-stubborn").x.size(), 0);
+  EXPECT_NE(row(rows, "test-stubborn").message.find("stopped by an exception"), std::string::npos);
+
+  // A limit that is not > 0 is refused before anything runs.
+  for (double bad : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    options.time_limit_s = bad;
+    EXPECT_THROW(reference::run_suite(set, problems, {"newton"}, options), InvalidInput) << bad;
+  }
+  // The limit does not touch a run that ends within it.
+  options.time_limit_s = 10.0;
+  EXPECT_TRUE(reference::run_suite(set, problems, {"newton"}, options)[0].solved);
+}
+
+// A slow F (1 ms per evaluation) with no root: every solver, the C libraries included, would
+// spend its whole budget of 2000 evaluations (2 s each); with a 20 ms limit each stops at once.
+TEST(SuiteAnswers, ATimeLimitEndsEverySolverOnASlowProblem) {
+  int calls = 0;
+  TestProblem p = root_test_problem("slow-no-root", 1,
+                                    [&calls](const auto& x, auto& f) {
+                                      ++calls;
+                                      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+                                      f[0] = x[0] * x[0] + 1.0;
+                                    },
+                                    {{"one", Eigen::VectorXd::Ones(1)}});
+  const ProblemSetEntry set = set_of(p);
+  const auto problems = build_problem_set(set);
+  SuiteOptions options;
+  options.time_limit_s = 0.02;
+  const std::vector<std::string> solvers = {
+      "newton",        "dogleg",           "levenberg-marquardt",
+      "auto",          "pseudo-transient", "anderson",
+      "ceres",         "nlopt:LN_BOBYQA",  "minpack:hybrj",
+      "kinsol:newton", "gsl:hybridsj",     "gsl:gnewton",
+      "kinsol:fp"};
+  calls = 0;
+  const auto rows = reference::run_suite(set, problems, solvers, options);
+  ASSERT_EQ(rows.size(), solvers.size());
+  for (const SuiteRow& r : rows) {
+    SCOPED_TRACE(r.solver);
+    EXPECT_FALSE(r.solved);
+    // Within 20 ms, at most 21 evaluations of 1 ms each; a solver that gave up on its own
+    // earlier (a local minimum of |F| at 0) is its own status.
+    EXPECT_LE(r.f_evals, 21) << r.status;
+    if (r.f_evals >= 21) {
+      EXPECT_EQ(r.status, "time_limit");
+    }
+  }
+  // The problem's F itself was called at most 21 times per row (and once more to judge it).
+  EXPECT_LE(calls, static_cast<int>(solvers.size()) * 22);
+  int limited = 0;
+  for (const SuiteRow& r : rows) limited += r.status == "time_limit";
+  EXPECT_GE(limited, 1);
+}
+
+}  // namespace
+}  // namespace nlobs
