@@ -388,6 +388,10 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
             if ((p.lower.size() > 0 || p.upper.size() > 0) && engine->accepts_bounds()) {
               engine->set_bounds({p.lower, p.upper});
             }
+            // The problem's scaling likewise (the Newton-type engines; docs/solvers.md).
+            if ((p.u_scale.size() > 0 || p.f_scale.size() > 0) && engine->accepts_scaling()) {
+              engine->set_scaling({p.u_scale, p.f_scale});
+            }
             setting_up = false;
             row.ns = mean_ns_per_call(
                 [&] {

@@ -71,6 +71,7 @@ class BroydenEngine : public Engine<N> {
   std::string_view name() const override { return "broyden"; }
   const BroydenOptions& broyden_options() const { return broyden_; }
   bool accepts_bounds() const override { return true; }
+  bool accepts_scaling() const override { return true; }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
 
@@ -130,6 +131,7 @@ bool BroydenEngine<N>::search(const Vector<N>& d, double t0, bool armijo) {
 
 template <int N>
 Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
+  if (std::optional<Summary> scaled = this->solve_scaled(problem, x)) return *scaled;
   const StopCriteria& stop = this->options_.stop;
   system_.start(name(), problem, x, this->bounds_, broyden_.finite_difference,
                 stop.max_evaluations);

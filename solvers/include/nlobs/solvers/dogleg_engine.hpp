@@ -74,6 +74,7 @@ class DoglegEngine : public Engine<N> {
   std::string_view name() const override { return "dogleg"; }
   const DoglegOptions& dogleg_options() const { return dogleg_; }
   bool accepts_bounds() const override { return true; }
+  bool accepts_scaling() const override { return true; }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
 
@@ -170,6 +171,7 @@ void DoglegEngine<N>::rank_one_update() {
 
 template <int N>
 Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
+  if (std::optional<Summary> scaled = this->solve_scaled(problem, x)) return *scaled;
   StopCriteria stop = this->options_.stop;
   stop.stagnation_patience = 0;  // replaced by the trust region's own progress tests
   system_.start(name(), problem, x, this->bounds_, dogleg_.finite_difference, stop.max_evaluations);

@@ -27,6 +27,7 @@ class DynamicSizeEngine final : public Engine<N> {
   bool least_squares() const override { return engine_->least_squares(); }
   bool needs_contraction() const override { return engine_->needs_contraction(); }
   bool accepts_bounds() const override { return engine_->accepts_bounds(); }
+  bool accepts_scaling() const override { return engine_->accepts_scaling(); }
   Engine<Dynamic>& engine() { return *engine_; }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
@@ -38,6 +39,7 @@ class DynamicSizeEngine final : public Engine<N> {
     engine_->limit_evaluations(max_evaluations);
   }
   void on_set_bounds() override { engine_->set_bounds(this->bounds_); }
+  void on_set_scaling() override { engine_->set_scaling(this->scaling_); }
   std::unique_ptr<Engine<Dynamic>> engine_;
 };
 

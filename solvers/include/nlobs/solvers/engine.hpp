@@ -2,6 +2,7 @@
 // The one call shape every engine shares:  Summary s = engine.solve(problem, x);
 // x holds the initial guess on entry and the engine's answer on return.
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -9,6 +10,7 @@
 #include "nlobs/solvers/box_bounds.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
 #include "nlobs/solvers/problem.hpp"
+#include "nlobs/solvers/scaling.hpp"
 #include "nlobs/solvers/stop_criteria.hpp"
 #include "nlobs/solvers/summary.hpp"
 
@@ -80,16 +82,50 @@ class Engine {
   }
   const BoxBounds& bounds() const { return bounds_; }
 
+  // KINSOL's scaling for the solves that follow (nlobs/solvers/scaling.hpp: the engine works in
+  // x̃ = D_u x on D_f F; its tolerances and Summary norms are the scaled ones). Accepted by the
+  // Newton-type engines (newton, dogleg, levenberg-marquardt, broyden, pseudo-transient, auto);
+  // the others throw InvalidInput here, as do entries that are not finite and > 0. A scale of
+  // another size than the problem's is refused by solve(). Empty scales remove the scaling.
+  virtual bool accepts_scaling() const { return false; }
+  void set_scaling(Scaling scaling) {
+    if (!scaling.empty() && !accepts_scaling()) {
+      throw InvalidInput(std::string(name()) +
+                         " does not accept a scaling; engines that do: newton, dogleg, "
+                         "levenberg-marquardt, broyden, pseudo-transient, auto");
+    }
+    detail::validate_scaling(name(), scaling);
+    Scaling previous = std::move(scaling_);
+    scaling_ = std::move(scaling);
+    try {
+      on_set_scaling();
+    } catch (...) {  // a stage that refuses it: the engine keeps the one it had
+      scaling_ = std::move(previous);
+      throw;
+    }
+  }
+  const Scaling& scaling() const { return scaling_; }
+
  protected:
   explicit Engine(SolverOptions options) : options_(std::move(options)) { validate(options_.stop); }
   // Engines holding inner engines (DynamicSizeEngine, Newton's trust region) forward the limit.
   virtual void on_limit_evaluations(int /*max_evaluations*/) {}
   // Engines holding inner engines or a library's own copy of the box (Ceres, NLopt) take it here.
   virtual void on_set_bounds() {}
+  // Engines holding inner engines (auto's stages, Newton's trust region, DynamicSizeEngine) pass
+  // the scaling on; the others apply it themselves through solve_scaled.
+  virtual void on_set_scaling() {}
+  // For an engine that applies a scaling itself, first thing in solve(): with a scaling set (and
+  // not already inside this call), solves the scaled problem by calling solve() again, with the
+  // box in scaled variables, and returns its summary with x and the trace's points in the
+  // problem's variables; nullopt otherwise.
+  std::optional<Summary> solve_scaled(const FixedPointProblem<N>& problem, Vector<N>& x);
   SolverOptions options_;
   BoxBounds bounds_;
+  Scaling scaling_;
 
  private:
+  bool scaled_solve_running_ = false;
   std::string label_;
 };
 
@@ -183,6 +219,34 @@ void check_output_size(const FixedPointProblem<N>& problem, const Vector<N>& g) 
 }
 
 }  // namespace detail
+
+template <int N>
+std::optional<Summary> Engine<N>::solve_scaled(const FixedPointProblem<N>& problem, Vector<N>& x) {
+  if (scaling_.empty() || scaled_solve_running_) return std::nullopt;
+  detail::check_initial_guess<N>(name(), problem.size(), x);
+  Vector<N> du, df;
+  detail::scaling_for<N>(name(), scaling_, problem.size(), du, df);
+  const FixedPointProblem<N> scaled = detail::scaled_problem<N>(problem, du, df);
+  Vector<N> xs = x.cwiseProduct(du);
+  BoxBounds given = detail::scaled_bounds(bounds_, scaling_.u_scale);
+  std::swap(bounds_, given);  // the engine's box, in x̃, for this call
+  scaled_solve_running_ = true;
+  struct Restore {
+    Engine* engine;
+    BoxBounds* given;
+    ~Restore() {
+      std::swap(engine->bounds_, *given);
+      engine->scaled_solve_running_ = false;
+    }
+  } restore{this, &given};
+  Summary s = solve(scaled, xs);
+  x = xs.cwiseQuotient(du);
+  for (TraceEntry& t : s.trace) {
+    if (t.x.size() == du.size()) t.x = t.x.cwiseQuotient(Eigen::VectorXd(du));
+  }
+  return s;
+}
+
 // Compiled once in the library for its sizes (nlobs/solvers/library_sizes.hpp).
 #define NLOBS_EXTERN_ENGINE(n) extern template class Engine<n>;
 NLOBS_FOR_EACH_LIBRARY_SIZE(NLOBS_EXTERN_ENGINE)

@@ -72,6 +72,7 @@ class LevenbergMarquardtEngine : public Engine<N> {
   const LevenbergMarquardtOptions& lm_options() const { return lm_; }
   bool least_squares() const override { return true; }
   bool accepts_bounds() const override { return true; }
+  bool accepts_scaling() const override { return true; }
 
   // Square: F = G − x, J = ∂G − I.
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
@@ -522,6 +523,7 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
 
 template <int N>
 Summary LevenbergMarquardtEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
+  if (std::optional<Summary> scaled = this->solve_scaled(problem, x)) return *scaled;
   detail::check_initial_guess(name(), problem, x);
   box_.start(name(), this->bounds_, x);
   const Index n = x.size();

@@ -73,6 +73,7 @@ class NewtonEngine : public Engine<N> {
   std::string_view name() const override { return "newton"; }
   const NewtonOptions& newton_options() const { return newton_; }
   bool accepts_bounds() const override { return true; }
+  bool accepts_scaling() const override { return true; }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
 
@@ -82,6 +83,9 @@ class NewtonEngine : public Engine<N> {
   }
   void on_set_bounds() override {
     if (trust_region_) trust_region_->set_bounds(this->bounds_);
+  }
+  void on_set_scaling() override {
+    if (trust_region_) trust_region_->set_scaling(this->scaling_);
   }
   NewtonOptions newton_;
   std::optional<DoglegEngine<N>> trust_region_;
@@ -102,6 +106,7 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
     s.engine = name();
     return s;
   }
+  if (std::optional<Summary> scaled = this->solve_scaled(problem, x)) return *scaled;
   const StopCriteria& stop = this->options_.stop;
   system_.start(name(), problem, x, this->bounds_, newton_.finite_difference, stop.max_evaluations);
   const detail::Box<N>& box = system_.box();

@@ -55,6 +55,13 @@ class PolyalgorithmEngine : public Engine<N> {
                        [](const auto& s) { return s->accepts_bounds(); });
   }
 
+  // A scaling reaches every stage (each solves in the scaled variables; the stages' residuals,
+  // which auto compares, are then all ‖D_f F‖∞): accepted when every stage accepts one.
+  bool accepts_scaling() const override {
+    return std::all_of(stages_.begin(), stages_.end(),
+                       [](const auto& s) { return s->accepts_scaling(); });
+  }
+
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override {
     detail::check_initial_guess(name(), problem, x);
     const int budget = this->options_.stop.max_evaluations;
@@ -158,6 +165,17 @@ class PolyalgorithmEngine : public Engine<N> {
       for (; k < stages_.size(); ++k) stages_[k]->set_bounds(this->bounds_);
     } catch (...) {
       for (std::size_t j = 0; j < k; ++j) stages_[j]->set_bounds(previous[j]);
+      throw;
+    }
+  }
+  void on_set_scaling() override {
+    std::vector<Scaling> previous;
+    for (const auto& s : stages_) previous.push_back(s->scaling());
+    std::size_t k = 0;
+    try {
+      for (; k < stages_.size(); ++k) stages_[k]->set_scaling(this->scaling_);
+    } catch (...) {
+      for (std::size_t j = 0; j < k; ++j) stages_[j]->set_scaling(previous[j]);
       throw;
     }
   }

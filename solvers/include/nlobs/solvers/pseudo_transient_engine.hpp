@@ -85,6 +85,7 @@ class PseudoTransientEngine : public Engine<N> {
   std::string_view name() const override { return "pseudo-transient"; }
   const PseudoTransientOptions& pseudo_transient_options() const { return ptc_; }
   bool accepts_bounds() const override { return true; }
+  bool accepts_scaling() const override { return true; }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
 
@@ -101,6 +102,7 @@ class PseudoTransientEngine : public Engine<N> {
 
 template <int N>
 Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
+  if (std::optional<Summary> scaled = this->solve_scaled(problem, x)) return *scaled;
   StopCriteria stop = this->options_.stop;
   stop.stagnation_patience = 0;  // ‖F‖ and the steps may grow along the flow
   system_.start(name(), problem, x, this->bounds_, ptc_.finite_difference, stop.max_evaluations);

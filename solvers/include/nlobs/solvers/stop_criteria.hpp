@@ -12,6 +12,12 @@ enum class Combine {
 struct StopCriteria {
   // Step criterion, eq. (73): ‖x_l − x_{l−1}‖∞ ≤ step_tolerance. 1e-5 reproduces the paper.
   std::optional<double> step_tolerance = 1e-8;
+  // The step criterion relative to the iterate: ‖x_l − x_{l−1}‖∞ / (‖x_l‖∞ + 1) ≤ step_tolerance,
+  // for unknowns far from 1 in size (a tolerance of 1e-8 on x ~ 1e5 asks for 13 digits). With an
+  // engine's scaling (Engine::set_scaling) the norms are of D_u x: close to KINSOL's scaled step
+  // test max_i |Δx_i| / (|x_i| + 1/D_u,i), in the max norm of the iterate rather than per
+  // component.
+  bool relative_step = false;
   // Residual criterion: ‖G(x) − x‖∞ ≤ residual_tolerance (equals ‖F(x)‖∞ for a root problem
   // adapted with Ψ = I), evaluated at the last point where the engine evaluated G.
   std::optional<double> residual_tolerance{};

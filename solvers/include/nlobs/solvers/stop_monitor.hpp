@@ -49,7 +49,10 @@ class StopMonitor {
       ++ratio_count_;
     }
     if (iterate_norm > limit_) return Status::kDiverged;
-    if (converged(step_may_converge ? step : std::numeric_limits<double>::infinity(), residual)) {
+    constexpr double kNoStep = std::numeric_limits<double>::infinity();
+    const double relative = step / (iterate_norm + 1.0);
+    if (converged(step_may_converge ? (c_.relative_step ? relative : step) : kNoStep,
+                  step_may_converge ? step : kNoStep, residual)) {
       return Status::kConverged;
     }
 
@@ -166,13 +169,15 @@ class StopMonitor {
   static constexpr double kRoundingSteps = 1e4;
   static constexpr int kFloorPatience = 3;
 
-  bool converged(double step, double residual) const {
+  // step_test: the step the step criterion judges (relative or not); step: ‖Δx‖∞ for the error
+  // bound. Both inf for a step cut short.
+  bool converged(double step_test, double step, double residual) const {
     int enabled = 0, met = 0;
     auto test = [&](bool on, bool ok) {
       enabled += on;
       met += on && ok;
     };
-    test(c_.step_tolerance.has_value(), c_.step_tolerance && step <= *c_.step_tolerance);
+    test(c_.step_tolerance.has_value(), c_.step_tolerance && step_test <= *c_.step_tolerance);
     test(c_.residual_tolerance.has_value(),
          c_.residual_tolerance && residual <= *c_.residual_tolerance);  // NaN: false
     if (c_.error_tolerance) {

@@ -1,0 +1,114 @@
+#pragma once
+// KINSOL's scaling of a square system (KINSol's u_scale and f_scale): the engine's norms are those
+// of D_u x and D_f F, D_u = diag(u_scale), D_f = diag(f_scale). A Newton-type engine that takes
+// one (Engine::set_scaling) solves the same system in the scaled variables x̃ = D_u x,
+//   F̃(x̃) = D_f F(D_u⁻¹ x̃),   J̃ = D_f J D_u⁻¹,
+// (as a fixed-point problem G̃(x̃) = x̃ + F̃(x̃)): the Newton step is the same step, and every test
+// an engine makes of ‖F‖ and ‖Δx‖ — residual and step tolerances, the line search's and the trust
+// region's merit ½‖F‖₂², the trust region ‖Δx‖₂ ≤ Δ, stagnation, the rounding floor,
+// acceptance — is then made of ‖D_f F‖ and ‖D_u Δx‖ ([KINSOL], "Scaling"; Dennis and Schnabel
+// 1996, §7.1). Summary::residual_norm and step_norm are those scaled norms; x and the trace's
+// points are returned in the problem's own variables.
+#include <Eigen/Core>
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <tuple>
+
+#include "nlobs/solvers/box_bounds.hpp"
+#include "nlobs/solvers/problem.hpp"
+
+namespace nlobs {
+
+struct Scaling {
+  // Each empty (ones) or of the problem's size, finite and > 0.
+  Eigen::VectorXd u_scale{}, f_scale{};
+  bool empty() const { return u_scale.size() == 0 && f_scale.size() == 0; }
+};
+
+namespace detail {
+
+// Entries finite and > 0, the two of one size where both are given. Throws InvalidInput naming
+// `owner`.
+inline void validate_scaling(std::string_view owner, const Scaling& s) {
+  auto check = [owner](const Eigen::VectorXd& d, const char* name) {
+    for (Index i = 0; i < d.size(); ++i) {
+      if (!(d[i] > 0.0) || !std::isfinite(d[i])) {
+        std::ostringstream os;
+        os << owner << ": " << name << "[" << i << "] = " << d[i] << " is not finite and > 0";
+        throw InvalidInput(os.str());
+      }
+    }
+  };
+  check(s.u_scale, "u_scale");
+  check(s.f_scale, "f_scale");
+  if (s.u_scale.size() > 0 && s.f_scale.size() > 0 && s.u_scale.size() != s.f_scale.size()) {
+    std::ostringstream os;
+    os << owner << ": u_scale and f_scale differ in size (" << s.u_scale.size() << " vs "
+       << s.f_scale.size() << ")";
+    throw InvalidInput(os.str());
+  }
+}
+
+// The scales at the problem's size n (ones where a side is empty); InvalidInput for another size.
+template <int N>
+void scaling_for(std::string_view owner, const Scaling& s, Index n, Vector<N>& du, Vector<N>& df) {
+  for (const auto& [given, out, name] :
+       {std::tuple{&s.u_scale, &du, "u_scale"}, std::tuple{&s.f_scale, &df, "f_scale"}}) {
+    if (given->size() != 0 && given->size() != n) {
+      std::ostringstream os;
+      os << owner << ": " << name << " has size " << given->size()
+         << " but the problem has dimension " << n;
+      throw InvalidInput(os.str());
+    }
+    if constexpr (N == Dynamic) out->resize(n);
+    if (given->size() == n) {
+      *out = *given;
+    } else {
+      out->setOnes();
+    }
+  }
+}
+
+// G̃(x̃) = x̃ + D_f (G(x) − x) with x = D_u⁻¹ x̃, and ∂G̃ = I + D_f (∂G − I) D_u⁻¹ when G has a
+// Jacobian (else the engine differences G̃, in the scaled variables). Holds `problem` by reference.
+// One point buffer, sized here: an evaluation allocates nothing.
+template <int N>
+FixedPointProblem<N> scaled_problem(const FixedPointProblem<N>& problem, const Vector<N>& du,
+                                    const Vector<N>& df) {
+  const FixedPointProblem<N>* p = &problem;
+  const Vector<N> inverse_du = du.cwiseInverse();
+  auto map = [p, inverse_du, df, x = Vector<N>(inverse_du)](const Vector<N>& xs,
+                                                            Vector<N>& out) mutable {
+    x = xs.cwiseProduct(inverse_du);
+    p->evaluate(x, out);
+    out = xs + df.cwiseProduct(out - x);
+  };
+  if (!problem.has_jacobian())
+    return FixedPointProblem<N>::from_map(std::move(map), problem.size());
+  auto jacobian = [p, inverse_du, df, x = Vector<N>(inverse_du)](const Vector<N>& xs,
+                                                                 Matrix<N, N>& jac) mutable {
+    x = xs.cwiseProduct(inverse_du);
+    p->jacobian(x, jac);
+    jac.diagonal().array() -= 1.0;
+    jac.array().colwise() *= df.array();
+    jac.array().rowwise() *= inverse_du.transpose().array();
+    jac.diagonal().array() += 1.0;
+  };
+  return FixedPointProblem<N>::with_jacobian(std::move(map), std::move(jacobian), problem.size(),
+                                             problem.jacobian_source());
+}
+
+// lower and upper times D_u (±inf and empty sides stay as they are).
+inline BoxBounds scaled_bounds(const BoxBounds& b, const Eigen::VectorXd& du) {
+  BoxBounds out = b;
+  if (du.size() == 0) return out;
+  for (Eigen::VectorXd* side : {&out.lower, &out.upper}) {
+    if (side->size() == du.size()) *side = side->cwiseProduct(du);
+  }
+  return out;
+}
+
+}  // namespace detail
+}  // namespace nlobs
