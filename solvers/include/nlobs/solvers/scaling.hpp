@@ -6,9 +6,11 @@
 // (as a fixed-point problem G̃(x̃) = x̃ + F̃(x̃)): the Newton step is the same step, and every test
 // an engine makes of ‖F‖ and ‖Δx‖ — residual and step tolerances, the line search's and the trust
 // region's merit ½‖F‖₂², the trust region ‖Δx‖₂ ≤ Δ, stagnation, the rounding floor,
-// acceptance — is then made of ‖D_f F‖ and ‖D_u Δx‖ ([KINSOL], "Scaling"; Dennis and Schnabel
-// 1996, §7.1). Summary::residual_norm and step_norm are those scaled norms; x and the trace's
-// points are returned in the problem's own variables.
+// acceptance — is then made of ‖D_f F‖ and ‖D_u Δx‖ ([SUNDIALS05], KINSOL; [DS96] §7.1).
+// Summary::residual_norm and step_norm are those scaled norms; x and the trace's points are
+// returned in the problem's own variables. Pseudo-transient continuation, not affine invariant,
+// follows the scaled flow ẋ = −D_u⁻¹ D_f F (a mass matrix D_f⁻¹ D_u in [KK98]'s form).
+// Choose D_u so that D_u x is of order 1 and D_f so that D_f F is, as KINSOL asks.
 #include <Eigen/Core>
 #include <cmath>
 #include <sstream>
