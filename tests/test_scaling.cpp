@@ -1,19 +1,23 @@
 // KINSOL's scaling (u_scale, f_scale) in the Newton-type engines (issue 39): a system that can be
 // solved only in the scaled norm — its first equation is 1e12 times the second, so its rounding
-// floor in ‖F‖∞ is 1e-3 — solved by every Newton-type engine and by KINSOL given the same scales,
-// and by neither without them; the transformation checked against the unscaled run (Newton is
-// affine invariant: the same iterates); bounds, traces, the relative step test and misuse.
+// floor in ‖F‖∞ is about 2e-4 — solved by every Newton-type engine and by KINSOL given the same
+// scales, and by neither without them; the transformation checked against the unscaled run (Newton
+// is affine invariant: the same iterates); bounds, traces, the relative step test and misuse.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "nlobs/reference/kinsol_solver.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 #include "nlobs/solvers/fixed_point_engines.hpp"
+#include "nlobs/solvers/levenberg_marquardt_engine.hpp"
 #include "nlobs/solvers/newton_engine.hpp"
 #include "nlobs/solvers/root_adapter.hpp"
 #include "nlobs/solvers/stop_monitor.hpp"
@@ -196,8 +200,124 @@ TEST(Scaling, TheBoxHoldsInTheProblemsVariables) {
     EXPECT_EQ(engine->bounds().upper[0], 10.0);
     // A start outside the box is refused in the problem's terms.
     x[0] = 11.0;
-    EXPECT_THROW(engine->solve(g, x), InvalidInput);
+    try {
+      engine->solve(g, x);
+      ADD_FAILURE() << "accepted";
+    } catch (const InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find("x0[0] = 11 lies outside the box (upper bound 10)"),
+                std::string::npos)
+          << e.what();
+    }
   }
+}
+
+// A root on a bound, with a scale whose round trip D_u⁻¹(D_u b) rounds below b (b = 1e-4,
+// D_u = 49): every evaluation and the answer stay inside the box.
+TEST(Scaling, ARootOnABoundIsReachedInsideTheBox) {
+  // Both ways back from x̃ round below the bound at D_u = 49: (b·d)·(1/d) and (b·d)/d.
+  const double b = 1e-4, d = 49.0;
+  ASSERT_LT((b * d) * (1.0 / d), b);
+  ASSERT_LT((b * d) / d, b);
+  double lowest = std::numeric_limits<double>::infinity();
+  const auto g = to_fixed_point<Dynamic>(RootProblem<Dynamic>::with_autodiff(
+      [&lowest](const auto& x, auto& f) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(x[0])>, double>) {
+          lowest = std::min(lowest, x[0]);
+        }
+        f[0] = x[0] - 1e-4;
+      },
+      1, 1));
+  for (const std::string& spec : kNewtonType) {
+    SCOPED_TRACE(spec);
+    auto engine = EngineRegistry<Dynamic>::global().create(spec, tight());
+    engine->set_bounds({Eigen::VectorXd::Constant(1, 1e-4), Eigen::VectorXd::Constant(1, 1.0)});
+    engine->set_scaling({Eigen::VectorXd::Constant(1, 49.0), {}});
+    lowest = std::numeric_limits<double>::infinity();
+    Eigen::VectorXd x = Eigen::VectorXd::Constant(1, 0.5);
+    const Summary s = engine->solve(g, x);
+    EXPECT_TRUE(s.usable()) << s.brief_report();
+    EXPECT_GE(x[0], 1e-4);
+    EXPECT_NEAR(x[0], 1e-4, 1e-15);
+    EXPECT_GE(lowest, 1e-4);
+  }
+}
+
+// F much smaller than x: F = 1e-12 (x − 1000). Formed as G(x) − x, F carries ulp(1000)/2 ≈ 6e-14
+// of rounding, 0.06 once D_f = 1e12 multiplies it; the engines get F itself (to_fixed_point's
+// residual form) and meet 1e-10 in the scaled norm. So does the least-squares path (a square F).
+TEST(Scaling, ASmallResidualBesideALargeUnknownKeepsItsDigits) {
+  const auto f = [](const auto& x, auto& out) { out[0] = 1e-12 * (x[0] - 1000.0); };
+  const auto root = RootProblem<Dynamic>::with_autodiff(f, 1, 1);
+  const auto g = to_fixed_point<Dynamic>(root);
+  ASSERT_TRUE(g.has_residual());
+  for (const std::string& spec : kNewtonType) {
+    SCOPED_TRACE(spec);
+    auto engine = EngineRegistry<Dynamic>::global().create(spec, tight());
+    engine->set_scaling({{}, Eigen::VectorXd::Constant(1, 1e12)});
+    Eigen::VectorXd x = Eigen::VectorXd::Constant(1, 900.0);
+    const Summary s = engine->solve(g, x);
+    EXPECT_TRUE(s.converged()) << s.brief_report();
+    EXPECT_NEAR(x[0], 1000.0, 1e-9);
+    x.setConstant(900.0);
+    const Summary ls =
+        engine->solve_least_squares(RootProblem<Dynamic, Dynamic>::with_autodiff(f, 1, 1), x);
+    EXPECT_TRUE(ls.converged()) << ls.brief_report();
+    EXPECT_NEAR(x[0], 1000.0, 1e-9);
+  }
+  // Levenberg-Marquardt's least-squares path with m > n: a scaling is refused, named.
+  LevenbergMarquardtEngine<Dynamic> lm({}, tight());
+  lm.set_scaling({{}, Eigen::VectorXd::Constant(2, 1.0)});
+  Eigen::VectorXd x = Eigen::VectorXd::Constant(1, 1.0);
+  const auto tall = RootProblem<Dynamic, Dynamic>::with_autodiff(
+      [](const auto& v, auto& out) {
+        out[0] = v[0] - 1.0;
+        out[1] = v[0] - 1.0;
+      },
+      1, 2);
+  EXPECT_THROW(lm.solve_least_squares(tall, x), InvalidInput);
+}
+
+// Fixed sizes: a NewtonEngine<2> and the registry's auto at N = 2 (a DynamicSizeEngine serving
+// size 2, which passes the scaling and F itself on) solve the heat balance in its scaling.
+TEST(Scaling, FixedSizeEnginesTakeTheScalingToo) {
+  const auto g2 = to_fixed_point<2>(
+      RootProblem<2, 2>::with_autodiff([](const auto& x, auto& f) { heat_balance(x, f); }));
+  NewtonEngine<2> newton({}, tight());
+  newton.set_scaling({{}, kFScale});
+  Eigen::Vector2d x = kStart;
+  EXPECT_TRUE(newton.solve(g2, x).converged());
+  EXPECT_LT((x - kRoot).lpNorm<Eigen::Infinity>(), 1e-12);
+  for (const char* spec : {"auto", "dogleg", "levenberg-marquardt"}) {
+    auto engine = EngineRegistry<2>::global().create(spec, tight());
+    engine->set_scaling({{}, kFScale});
+    x = kStart;
+    EXPECT_TRUE(engine->solve(g2, x).converged()) << spec;
+    EXPECT_LT((x - kRoot).lpNorm<Eigen::Infinity>(), 1e-12) << spec;
+  }
+}
+
+// A scaled solve whose F throws leaves the engine as it was: its box, its scaling, and the next
+// solve scaled again.
+TEST(Scaling, AThrowingProblemLeavesTheEngineAsItWas) {
+  bool fail = true;
+  const auto g = to_fixed_point<Dynamic>(RootProblem<Dynamic>::with_autodiff(
+      [&fail](const auto& x, auto& f) {
+        if (fail) throw std::runtime_error("the model left its domain");
+        heat_balance(x, f);
+      },
+      2, 2));
+  NewtonEngine<Dynamic> newton({}, tight());
+  newton.set_bounds({Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(10.0, 10.0)});
+  newton.set_scaling({Eigen::Vector2d(0.5, 2.0), kFScale});
+  Eigen::VectorXd x = kStart;
+  EXPECT_THROW(newton.solve(g, x), std::runtime_error);
+  EXPECT_EQ(newton.bounds().upper, Eigen::VectorXd(Eigen::Vector2d(10.0, 10.0)));
+  EXPECT_EQ(newton.scaling().u_scale, Eigen::VectorXd(Eigen::Vector2d(0.5, 2.0)));
+  fail = false;
+  x = kStart;
+  const Summary s = newton.solve(g, x);
+  EXPECT_TRUE(s.converged()) << s.brief_report();
+  EXPECT_LT((x - kRoot).lpNorm<Eigen::Infinity>(), 1e-12);
 }
 
 TEST(Scaling, MisuseIsRefusedNamingWhatIsWrong) {

@@ -25,6 +25,7 @@
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
@@ -131,7 +132,12 @@ bool BroydenEngine<N>::search(const Vector<N>& d, double t0, bool armijo) {
 
 template <int N>
 Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
-  if (std::optional<Summary> scaled = this->solve_scaled(problem, x)) return *scaled;
+  if (std::optional<Summary> scaled =
+          this->solve_scaled(problem, x, [this](const FixedPointProblem<N>& p, Vector<N>& y) {
+            return BroydenEngine<N>::solve(p, y);
+          })) {
+    return std::move(*scaled);
+  }
   const StopCriteria& stop = this->options_.stop;
   system_.start(name(), problem, x, this->bounds_, broyden_.finite_difference,
                 stop.max_evaluations);

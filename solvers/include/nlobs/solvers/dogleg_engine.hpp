@@ -31,6 +31,7 @@
 #include <optional>
 #include <sstream>
 #include <string_view>
+#include <utility>
 
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
@@ -171,7 +172,12 @@ void DoglegEngine<N>::rank_one_update() {
 
 template <int N>
 Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
-  if (std::optional<Summary> scaled = this->solve_scaled(problem, x)) return *scaled;
+  if (std::optional<Summary> scaled =
+          this->solve_scaled(problem, x, [this](const FixedPointProblem<N>& p, Vector<N>& y) {
+            return DoglegEngine<N>::solve(p, y);
+          })) {
+    return std::move(*scaled);
+  }
   StopCriteria stop = this->options_.stop;
   stop.stagnation_patience = 0;  // replaced by the trust region's own progress tests
   system_.start(name(), problem, x, this->bounds_, dogleg_.finite_difference, stop.max_evaluations);

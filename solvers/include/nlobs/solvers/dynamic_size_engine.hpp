@@ -56,21 +56,41 @@ Summary DynamicSizeEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<
       out.resize(N);
       std::copy(value.data(), value.data() + N, out.data());
     };
+    // The residual form F (FixedPointProblem::residual) goes along when the problem has one.
+    const auto f = [&problem](const Vector<Dynamic>& at, Vector<Dynamic>& out) {
+      const Vector<N> point = at;
+      Vector<N> value = Vector<N>::Zero();
+      problem.residual(point, value);
+      out.resize(N);
+      std::copy(value.data(), value.data() + N, out.data());
+    };
+    const auto copy_jacobian = [](const Matrix<N, N>& j, Matrix<Dynamic, Dynamic>& jac) {
+      // Element-wise: GCC 12 warns (-Warray-bounds) on Eigen's packet copy at N = 1.
+      jac.resize(N, N);
+      std::copy(j.data(), j.data() + N * N, jac.data());
+    };
     Vector<Dynamic> xd = x;
     Summary s;
     if (problem.has_jacobian()) {
-      const auto dg = [&problem](const Vector<Dynamic>& at, Matrix<Dynamic, Dynamic>& jac) {
+      const auto dg = [&problem, copy_jacobian](const Vector<Dynamic>& at,
+                                                Matrix<Dynamic, Dynamic>& jac) {
         const Vector<N> point = at;
         Matrix<N, N> j = Matrix<N, N>::Zero();
         problem.jacobian(point, j);
-        // Element-wise: GCC 12 warns (-Warray-bounds) on Eigen's packet copy at N = 1.
-        jac.resize(N, N);
-        std::copy(j.data(), j.data() + N * N, jac.data());
+        copy_jacobian(j, jac);
       };
-      s = engine_->solve(
-          FixedPointProblem<Dynamic>::with_jacobian(g, dg, N, problem.jacobian_source()), xd);
+      const auto df = [&problem, copy_jacobian](const Vector<Dynamic>& at,
+                                                Matrix<Dynamic, Dynamic>& jac) {
+        const Vector<N> point = at;
+        Matrix<N, N> j = Matrix<N, N>::Zero();
+        problem.residual_jacobian(point, j);
+        copy_jacobian(j, jac);
+      };
+      auto dynamic = FixedPointProblem<Dynamic>::with_jacobian(g, dg, N, problem.jacobian_source());
+      s = engine_->solve(problem.has_residual() ? dynamic.with_residual(f, df) : dynamic, xd);
     } else {
-      s = engine_->solve(FixedPointProblem<Dynamic>::from_map(g, N), xd);
+      auto dynamic = FixedPointProblem<Dynamic>::from_map(g, N);
+      s = engine_->solve(problem.has_residual() ? dynamic.with_residual(f) : dynamic, xd);
     }
     if (xd.size() == N) {
       x = xd;

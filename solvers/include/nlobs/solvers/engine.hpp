@@ -1,6 +1,7 @@
 #pragma once
 // The one call shape every engine shares:  Summary s = engine.solve(problem, x);
 // x holds the initial guess on entry and the engine's answer on return.
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <sstream>
@@ -70,6 +71,9 @@ class Engine {
                          " does not accept bounds; engines that do: newton, dogleg, "
                          "levenberg-marquardt, broyden, pseudo-transient, auto, ceres, nlopt");
     }
+    if (scaled_solve_running_) {
+      throw InvalidInput(std::string(name()) + ": set_bounds during a scaled solve");
+    }
     detail::validate_box(name(), bounds.lower, bounds.upper);
     BoxBounds previous = std::move(bounds_);
     bounds_ = std::move(bounds);
@@ -89,6 +93,9 @@ class Engine {
   // another size than the problem's is refused by solve(). Empty scales remove the scaling.
   virtual bool accepts_scaling() const { return false; }
   void set_scaling(Scaling scaling) {
+    if (scaled_solve_running_) {
+      throw InvalidInput(std::string(name()) + ": set_scaling during a scaled solve");
+    }
     if (!scaling.empty() && !accepts_scaling()) {
       throw InvalidInput(std::string(name()) +
                          " does not accept a scaling; engines that do: newton, dogleg, "
@@ -116,10 +123,14 @@ class Engine {
   // the scaling on; the others apply it themselves through solve_scaled.
   virtual void on_set_scaling() {}
   // For an engine that applies a scaling itself, first thing in solve(): with a scaling set (and
-  // not already inside this call), solves the scaled problem by calling solve() again, with the
-  // box in scaled variables, and returns its summary with x and the trace's points in the
-  // problem's variables; nullopt otherwise.
-  std::optional<Summary> solve_scaled(const FixedPointProblem<N>& problem, Vector<N>& x);
+  // not already inside this call), checks x and the box in the problem's terms, solves the
+  // scaled problem by `unscaled(problem, x)` — the engine's own solve, called non-virtually — with
+  // the box in scaled variables, and returns its summary with x and the trace's points in the
+  // problem's variables (inside its box); nullopt otherwise. A scaled solve allocates (the scaled
+  // problem, the box), at fixed N too: once per solve, not per evaluation.
+  template <typename Solve>
+  std::optional<Summary> solve_scaled(const FixedPointProblem<N>& problem, Vector<N>& x,
+                                      Solve&& unscaled);
   SolverOptions options_;
   BoxBounds bounds_;
   Scaling scaling_;
@@ -142,17 +153,29 @@ Summary Engine<N>::solve_least_squares(const RootProblem<N, Dynamic>& problem, V
     problem.evaluate(v, f);
     out = v + f;
   };
+  // F itself too (FixedPointProblem::residual): the engines need not form G(x) − x.
+  const auto f = [&problem](const Vector<N>& v, Vector<N>& out) {
+    Vector<Dynamic> value(problem.residual_size());
+    problem.evaluate(v, value);
+    out = value;
+  };
   if (!problem.has_jacobian()) {
-    return solve(FixedPointProblem<N>::from_map(g, problem.size()), x);
+    return solve(FixedPointProblem<N>::from_map(g, problem.size()).with_residual(f), x);
   }
+  const auto df = [&problem](const Vector<N>& v, Matrix<N, N>& j) {
+    Matrix<Dynamic, N> d(problem.residual_size(), problem.size());
+    problem.jacobian(v, d);
+    j = d;
+  };
   const auto dg = [&problem](const Vector<N>& v, Matrix<N, N>& j) {
-    Matrix<Dynamic, N> df(problem.residual_size(), problem.size());
-    problem.jacobian(v, df);
-    j = df;
+    Matrix<Dynamic, N> d(problem.residual_size(), problem.size());
+    problem.jacobian(v, d);
+    j = d;
     j.diagonal().array() += 1.0;
   };
-  return solve(
-      FixedPointProblem<N>::with_jacobian(g, dg, problem.size(), problem.jacobian_source()), x);
+  return solve(FixedPointProblem<N>::with_jacobian(g, dg, problem.size(), problem.jacobian_source())
+                   .with_residual(f, df),
+               x);
 }
 
 // For batch drivers (CLI, benchmarks): invalid input becomes status invalid_input with the
@@ -206,44 +229,51 @@ void check_initial_guess(std::string_view engine, const FixedPointProblem<N>& pr
   check_initial_guess<N>(engine, problem.size(), x);
 }
 
-// Dynamic-size user functions may resize their output; catch a wrong size at once.
-template <int N>
-void check_output_size(const FixedPointProblem<N>& problem, const Vector<N>& g) {
-  if constexpr (N == Dynamic) {
-    if (g.size() != problem.size()) {
-      std::ostringstream os;
-      os << "G returned a vector of size " << g.size() << ", expected " << problem.size();
-      throw InvalidInput(os.str());
-    }
-  }
-}
-
 }  // namespace detail
 
 template <int N>
-std::optional<Summary> Engine<N>::solve_scaled(const FixedPointProblem<N>& problem, Vector<N>& x) {
+template <typename Solve>
+std::optional<Summary> Engine<N>::solve_scaled(const FixedPointProblem<N>& problem, Vector<N>& x,
+                                               Solve&& unscaled) {
   if (scaling_.empty() || scaled_solve_running_) return std::nullopt;
+  // Checked in the problem's own terms before anything is scaled.
   detail::check_initial_guess<N>(name(), problem.size(), x);
+  detail::require_inside_box<N>(name(), bounds_.lower, bounds_.upper, x);
   Vector<N> du, df;
   detail::scaling_for<N>(name(), scaling_, problem.size(), du, df);
-  const FixedPointProblem<N> scaled = detail::scaled_problem<N>(problem, du, df);
   Vector<N> xs = x.cwiseProduct(du);
-  BoxBounds given = detail::scaled_bounds(bounds_, scaling_.u_scale);
-  std::swap(bounds_, given);  // the engine's box, in x̃, for this call
+  if (!xs.allFinite()) {
+    throw InvalidInput(std::string(name()) +
+                       ": u_scale times the initial guess overflows (choose D_u x of order 1)");
+  }
+  const BoxBounds original = bounds_;
+  const FixedPointProblem<N> scaled = detail::scaled_problem<N>(problem, du, df, original);
+  bounds_ = detail::scaled_bounds(original, scaling_.u_scale);  // the engine's box, in x̃
   scaled_solve_running_ = true;
   struct Restore {
     Engine* engine;
-    BoxBounds* given;
+    const BoxBounds* original;
     ~Restore() {
-      std::swap(engine->bounds_, *given);
+      engine->bounds_ = *original;
       engine->scaled_solve_running_ = false;
     }
-  } restore{this, &given};
-  Summary s = solve(scaled, xs);
-  x = xs.cwiseQuotient(du);
+  } restore{this, &original};
+  Summary s = unscaled(scaled, xs);
+  // Back in the problem's variables, as the scaled map evaluated it: inside the box.
+  const auto unscale = [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
+    out = v.cwiseQuotient(Eigen::VectorXd(du));
+    for (Index i = 0; i < out.size(); ++i) {
+      if (original.lower.size() == out.size()) out[i] = std::max(out[i], original.lower[i]);
+      if (original.upper.size() == out.size()) out[i] = std::min(out[i], original.upper[i]);
+    }
+  };
+  Eigen::VectorXd answer;
+  unscale(xs, answer);
+  x = answer;
   for (TraceEntry& t : s.trace) {
-    if (t.x.size() == du.size()) t.x = t.x.cwiseQuotient(Eigen::VectorXd(du));
+    if (t.x.size() == du.size()) unscale(Eigen::VectorXd(t.x), t.x);
   }
+  s.point_finite = x.allFinite();  // D_u⁻¹ x̃ may overflow where x̃ did not
   return s;
 }
 

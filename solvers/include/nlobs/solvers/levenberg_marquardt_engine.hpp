@@ -34,6 +34,7 @@
 #include <optional>
 #include <sstream>
 #include <string_view>
+#include <utility>
 
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
@@ -523,18 +524,34 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
 
 template <int N>
 Summary LevenbergMarquardtEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
-  if (std::optional<Summary> scaled = this->solve_scaled(problem, x)) return *scaled;
+  if (std::optional<Summary> scaled =
+          this->solve_scaled(problem, x, [this](const FixedPointProblem<N>& p, Vector<N>& y) {
+            return LevenbergMarquardtEngine<N>::solve(p, y);
+          })) {
+    return std::move(*scaled);
+  }
   detail::check_initial_guess(name(), problem, x);
   box_.start(name(), this->bounds_, x);
   const Index n = x.size();
   auto residual = [&](const Vector<N>& at, ResidualVector& f) {
-    problem.evaluate(at, g_);
-    detail::check_output_size(problem, g_);
-    f = g_ - at;
+    if (problem.has_residual()) {  // F itself, not G − x (problem.hpp)
+      problem.residual(at, g_);
+      detail::check_output_size(problem, g_);
+      f = g_;
+    } else {
+      problem.evaluate(at, g_);
+      detail::check_output_size(problem, g_);
+      f = g_ - at;
+    }
     return f.allFinite();
   };
   auto jacobian = [&](const Vector<N>& at, const ResidualVector& f, JacobianMatrix& jac) {
     int spent = 0;
+    if (problem.has_jacobian() && problem.has_residual()) {
+      problem.residual_jacobian(at, r_);  // ∂F itself
+      jac = r_;
+      return spent;
+    }
     if (problem.has_jacobian()) {
       problem.jacobian(at, r_);
     } else {
@@ -552,6 +569,17 @@ Summary LevenbergMarquardtEngine<N>::solve(const FixedPointProblem<N>& problem, 
 template <int N>
 Summary LevenbergMarquardtEngine<N>::solve_least_squares(const RootProblem<N, Dynamic>& problem,
                                                          Vector<N>& x) {
+  if (!this->scaling_.empty()) {
+    // A scaling is KINSOL's, of a square system: solved as one (Engine::solve_least_squares
+    // builds it and solve() scales it); for m > n weight the residuals in F instead.
+    if (problem.residual_size() == problem.size())
+      return Engine<N>::solve_least_squares(problem, x);
+    std::ostringstream os;
+    os << name() << ": a scaling (u_scale, f_scale) applies to square systems; F maps R^"
+       << problem.size() << " to R^" << problem.residual_size()
+       << " (weight its residuals in F instead)";
+    throw InvalidInput(os.str());
+  }
   detail::check_initial_guess<N>(name(), problem.size(), x);
   box_.start(name(), this->bounds_, x);
   const Index m = problem.residual_size();

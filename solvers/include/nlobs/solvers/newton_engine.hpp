@@ -19,6 +19,7 @@
 #include <optional>
 #include <sstream>
 #include <string_view>
+#include <utility>
 
 #include "nlobs/solvers/dogleg_engine.hpp"
 #include "nlobs/solvers/engine.hpp"
@@ -106,7 +107,12 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
     s.engine = name();
     return s;
   }
-  if (std::optional<Summary> scaled = this->solve_scaled(problem, x)) return *scaled;
+  if (std::optional<Summary> scaled =
+          this->solve_scaled(problem, x, [this](const FixedPointProblem<N>& p, Vector<N>& y) {
+            return NewtonEngine<N>::solve(p, y);
+          })) {
+    return std::move(*scaled);
+  }
   const StopCriteria& stop = this->options_.stop;
   system_.start(name(), problem, x, this->bounds_, newton_.finite_difference, stop.max_evaluations);
   const detail::Box<N>& box = system_.box();

@@ -94,6 +94,23 @@ class FixedPointProblem {
   // jac = ∂G(x); only when has_jacobian().
   void jacobian(const VectorType& x, JacobianType& jac) const { dg_(x, jac); }
 
+  // The residual form F(x) = G(x) − x, when the problem knows F itself (a root problem through
+  // to_fixed_point with Ψ = I): the engines that solve F(x) = 0 evaluate it instead of forming
+  // G(x) − x, which keeps none of F's digits below ulp(x) — all of them for a residual of 1e-20
+  // beside x ~ 1e-6, and what a scaling D_f = 1e20 would magnify (scaling.hpp).
+  bool has_residual() const { return static_cast<bool>(f_); }
+  void residual(const VectorType& x, VectorType& f) const { f_(x, f); }
+  // jac = ∂F(x); only when has_residual() and has_jacobian().
+  void residual_jacobian(const VectorType& x, JacobianType& jac) const { df_(x, jac); }
+  // This problem with its residual form attached: f must be G(x) − x, df (empty without a
+  // Jacobian) ∂G − I.
+  FixedPointProblem with_residual(Map f, JacobianMap df = {}) const {
+    FixedPointProblem out = *this;
+    out.f_ = std::move(f);
+    out.df_ = std::move(df);
+    return out;
+  }
+
  private:
   FixedPointProblem(Index n, Map g, JacobianMap dg, JacobianSource source)
       : n_(n), g_(std::move(g)), dg_(std::move(dg)), source_(source) {
@@ -116,7 +133,23 @@ class FixedPointProblem {
   Map g_;
   JacobianMap dg_;
   JacobianSource source_;
+  Map f_;
+  JacobianMap df_;
 };
+
+namespace detail {
+// Dynamic-size user functions may resize their output; catch a wrong size at once.
+template <int N>
+void check_output_size(const FixedPointProblem<N>& problem, const Vector<N>& g) {
+  if constexpr (N == Dynamic) {
+    if (g.size() != problem.size()) {
+      std::ostringstream os;
+      os << "G returned a vector of size " << g.size() << ", expected " << problem.size();
+      throw InvalidInput(os.str());
+    }
+  }
+}
+}  // namespace detail
 
 // F: Rⁿ → Rᵐ (m ≥ n for least squares; m = n for engines through to_fixed_point).
 template <int N = Dynamic, int M = N>

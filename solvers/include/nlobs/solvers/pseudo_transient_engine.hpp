@@ -32,6 +32,7 @@
 #include <optional>
 #include <sstream>
 #include <string_view>
+#include <utility>
 
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
@@ -102,7 +103,12 @@ class PseudoTransientEngine : public Engine<N> {
 
 template <int N>
 Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
-  if (std::optional<Summary> scaled = this->solve_scaled(problem, x)) return *scaled;
+  if (std::optional<Summary> scaled =
+          this->solve_scaled(problem, x, [this](const FixedPointProblem<N>& p, Vector<N>& y) {
+            return PseudoTransientEngine<N>::solve(p, y);
+          })) {
+    return std::move(*scaled);
+  }
   StopCriteria stop = this->options_.stop;
   stop.stagnation_patience = 0;  // ‖F‖ and the steps may grow along the flow
   system_.start(name(), problem, x, this->bounds_, ptc_.finite_difference, stop.max_evaluations);

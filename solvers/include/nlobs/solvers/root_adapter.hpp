@@ -54,7 +54,13 @@ FixedPointProblem<N> to_fixed_point(const RootProblem<N, N>& root,
       out += x;
     }
   };
-  if (!root.has_jacobian()) return FixedPointProblem<N>::from_map(std::move(g), n);
+  // With Ψ = I the engines that solve G(x) − x = 0 get F itself (FixedPointProblem::residual).
+  const bool identity = std::holds_alternative<IdentityScaling>(psi);
+  auto f = [root](const Vec& x, Vec& out) { root.evaluate(x, out); };
+  if (!root.has_jacobian()) {
+    FixedPointProblem<N> out = FixedPointProblem<N>::from_map(std::move(g), n);
+    return identity ? out.with_residual(std::move(f)) : out;
+  }
   auto dg = [root, psi, scratch = Jac(n, n)](const Vec& x, Jac& jac) mutable {
     root.jacobian(x, scratch);
     if (const auto* m = std::get_if<Matrix<N, N>>(&psi)) {
@@ -65,8 +71,13 @@ FixedPointProblem<N> to_fixed_point(const RootProblem<N, N>& root,
     }
     jac.diagonal().array() += 1.0;
   };
-  return FixedPointProblem<N>::with_jacobian(std::move(g), std::move(dg), n,
-                                             root.jacobian_source());
+  FixedPointProblem<N> out =
+      FixedPointProblem<N>::with_jacobian(std::move(g), std::move(dg), n, root.jacobian_source());
+  if (!identity) return out;
+  return out.with_residual(std::move(f), [root](const Vec& x, Jac& jac) {
+    if constexpr (N == Dynamic) jac.resize(root.size(), root.size());
+    root.jacobian(x, jac);
+  });
 }
 
 }  // namespace nlobs

@@ -13,6 +13,7 @@
 // Choose D_u so that D_u x is of order 1 and D_f so that D_f F is, as KINSOL asks.
 #include <Eigen/Core>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -73,33 +74,68 @@ void scaling_for(std::string_view owner, const Scaling& s, Index n, Vector<N>& d
   }
 }
 
-// G̃(x̃) = x̃ + D_f (G(x) − x) with x = D_u⁻¹ x̃, and ∂G̃ = I + D_f (∂G − I) D_u⁻¹ when G has a
-// Jacobian (else the engine differences G̃, in the scaled variables). Holds `problem` by reference.
-// One point buffer, sized here: an evaluation allocates nothing.
+// F̃(x̃) = D_f F(x) with x = D_u⁻¹ x̃ held inside `box` (rounding in the round trip D_u⁻¹(D_u b)
+// must not step past a bound b), as the fixed-point problem G̃(x̃) = x̃ + F̃(x̃) with F̃ as its
+// residual form, and ∂F̃ = D_f ∂F D_u⁻¹ when the problem has a Jacobian (else the engine
+// differences G̃, in the scaled variables). F is the problem's own residual form when it has one
+// (FixedPointProblem::residual): formed as G(x) − x it would carry D_f,i·ulp(x_i) of rounding.
+// Holds `problem` by reference; point buffers sized here: an evaluation allocates nothing.
 template <int N>
 FixedPointProblem<N> scaled_problem(const FixedPointProblem<N>& problem, const Vector<N>& du,
-                                    const Vector<N>& df) {
+                                    const Vector<N>& df, const BoxBounds& box) {
   const FixedPointProblem<N>* p = &problem;
   const Vector<N> inverse_du = du.cwiseInverse();
-  auto map = [p, inverse_du, df, x = Vector<N>(inverse_du)](const Vector<N>& xs,
-                                                            Vector<N>& out) mutable {
-    x = xs.cwiseProduct(inverse_du);
-    p->evaluate(x, out);
-    out = xs + df.cwiseProduct(out - x);
+  const Index n = problem.size();
+  Vector<N> lower = Vector<N>::Constant(n, -std::numeric_limits<double>::infinity());
+  Vector<N> upper = Vector<N>::Constant(n, std::numeric_limits<double>::infinity());
+  if (box.lower.size() == n) lower = box.lower;
+  if (box.upper.size() == n) upper = box.upper;
+  // x = D_u⁻¹ x̃, inside the box; then F̃ = D_f F(x) into `out`.
+  auto scaled_f = [p, inverse_du, df, lower, upper, x = Vector<N>(inverse_du),
+                   g = Vector<N>(inverse_du)](const Vector<N>& xs, Vector<N>& out) mutable {
+    x = xs.cwiseProduct(inverse_du).cwiseMax(lower).cwiseMin(upper);
+    if (p->has_residual()) {
+      p->residual(x, out);
+      check_output_size(*p, out);
+      out = df.cwiseProduct(out);
+    } else {
+      p->evaluate(x, g);
+      check_output_size(*p, g);
+      out = df.cwiseProduct(g - x);
+    }
   };
-  if (!problem.has_jacobian())
-    return FixedPointProblem<N>::from_map(std::move(map), problem.size());
-  auto jacobian = [p, inverse_du, df, x = Vector<N>(inverse_du)](const Vector<N>& xs,
-                                                                 Matrix<N, N>& jac) mutable {
-    x = xs.cwiseProduct(inverse_du);
-    p->jacobian(x, jac);
-    jac.diagonal().array() -= 1.0;
+  auto map = [scaled_f](const Vector<N>& xs, Vector<N>& out) mutable {
+    scaled_f(xs, out);
+    out += xs;
+  };
+  if (!problem.has_jacobian()) {
+    return FixedPointProblem<N>::from_map(std::move(map), n).with_residual(std::move(scaled_f));
+  }
+  auto scaled_df = [p, inverse_du, df, lower, upper, x = Vector<N>(inverse_du)](
+                       const Vector<N>& xs, Matrix<N, N>& jac) mutable {
+    x = xs.cwiseProduct(inverse_du).cwiseMax(lower).cwiseMin(upper);
+    if (p->has_residual()) {
+      p->residual_jacobian(x, jac);
+    } else {
+      p->jacobian(x, jac);
+      if (jac.rows() == jac.cols()) jac.diagonal().array() -= 1.0;
+    }
+    if (jac.rows() != x.size() || jac.cols() != x.size()) {
+      std::ostringstream os;
+      os << "the Jacobian is " << jac.rows() << "x" << jac.cols() << ", expected " << x.size()
+         << "x" << x.size();
+      throw InvalidInput(os.str());
+    }
     jac.array().colwise() *= df.array();
     jac.array().rowwise() *= inverse_du.transpose().array();
+  };
+  auto dmap = [scaled_df](const Vector<N>& xs, Matrix<N, N>& jac) mutable {
+    scaled_df(xs, jac);
     jac.diagonal().array() += 1.0;
   };
-  return FixedPointProblem<N>::with_jacobian(std::move(map), std::move(jacobian), problem.size(),
-                                             problem.jacobian_source());
+  return FixedPointProblem<N>::with_jacobian(std::move(map), std::move(dmap), n,
+                                             problem.jacobian_source())
+      .with_residual(std::move(scaled_f), std::move(scaled_df));
 }
 
 // lower and upper times D_u (±inf and empty sides stay as they are).

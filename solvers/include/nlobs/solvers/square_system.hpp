@@ -30,10 +30,15 @@ class SquareSystem {
     if constexpr (N == Dynamic) g_.resize(x0.size()), fd_.resize(x0.size());
   }
 
-  // f = F(x) = G(x) − x; false when a value is not finite.
+  // f = F(x) = G(x) − x (the problem's own F when it has one); false when a value is not finite.
   bool residual(const Vector<N>& x, Vector<N>& f) {
-    problem_->evaluate(x, g_);
     ++evaluations_;
+    if (problem_->has_residual()) {
+      problem_->residual(x, f);
+      check_output_size(*problem_, f);
+      return f.allFinite();
+    }
+    problem_->evaluate(x, g_);
     check_output_size(*problem_, g_);
     f = g_ - x;
     return f.allFinite();
@@ -48,14 +53,18 @@ class SquareSystem {
         evaluations_ + finite_difference_cost(scheme_, x.size()) > max_evaluations_) {
       return Status::kMaxEvaluations;
     }
-    if (problem_->has_jacobian()) {
-      problem_->jacobian(x, jac);
+    if (problem_->has_jacobian() && problem_->has_residual()) {
+      problem_->residual_jacobian(x, jac);  // ∂F itself
     } else {
-      g_ = f + x;
-      evaluations_ += finite_difference_jacobian(*problem_, x, g_, jac, scheme_, fd_, &box_);
+      if (problem_->has_jacobian()) {
+        problem_->jacobian(x, jac);
+      } else {
+        g_ = f + x;
+        evaluations_ += finite_difference_jacobian(*problem_, x, g_, jac, scheme_, fd_, &box_);
+      }
+      jac.diagonal().array() -= 1.0;
     }
     ++jacobians_;
-    jac.diagonal().array() -= 1.0;
     if (!jac.allFinite()) {
       message = "the Jacobian of F is not finite";
       return Status::kNonFinite;
