@@ -82,6 +82,8 @@ void print_suite_tables(const std::vector<reference::SuiteRow>& rows, double thr
   std::string current;
   std::vector<std::string> order;
   std::map<std::string, int> solved, pairs;
+  // Per solver: the most evaluations a run made after ‖F‖ last fell, and which run.
+  std::map<std::string, std::pair<long, std::string>> idle;
   const bool any_error = std::any_of(
       rows.begin(), rows.end(), [](const reference::SuiteRow& r) { return !std::isnan(r.error); });
   const bool any_scaled = std::any_of(rows.begin(), rows.end(), has_scaled_residual);
@@ -136,15 +138,24 @@ void print_suite_tables(const std::vector<reference::SuiteRow>& rows, double thr
     if (!pairs.count(r.solver)) order.push_back(r.solver);
     ++pairs[r.solver];
     solved[r.solver] += r.solved;
+    auto& worst = idle[r.solver];
+    if (r.evals_past_progress > worst.first) {
+      worst = {r.evals_past_progress, r.problem + " n=" + std::to_string(r.n) + " " + r.start};
+    }
   }
   out << "\nsolved (" << (any_scaled ? "|D_f F|2" : "|F|2") << " <= "
       << (std::isnan(threshold) ? std::string("each set's threshold") : short_number(threshold))
       << " at the returned point), per solver:\n";
   for (const auto& s : order) {
-    std::snprintf(line, sizeof line, "  %-*s %3d / %d\n", width, shown(s, 48).c_str(), solved[s],
-                  pairs[s]);
+    const auto& worst = idle[s];
+    std::snprintf(line, sizeof line, "  %-*s %3d / %-4d idle %6ld%s%s%s\n", width,
+                  shown(s, 48).c_str(), solved[s], pairs[s], worst.first,
+                  worst.first > 0 ? " (" : "", shown(worst.second, 100).c_str(),
+                  worst.first > 0 ? ")" : "");
     out << line;
   }
+  out << "idle: the most F evaluations one run made after |F| last fell below 0.999 x its lowest "
+         "(that run; evals_past_progress in JSON and CSV)\n";
 }
 
 std::string valid_utf8(std::string_view text) {
@@ -187,7 +198,8 @@ nlohmann::json suite_to_json(const std::vector<reference::SuiteRow>& rows) {
                  {"status", valid_utf8(r.status)},
                  {"message", valid_utf8(r.message)},
                  {"scaled_residual", number_or_null(r.scaled_residual)},
-                 {"x", nullptr}});
+                 {"x", nullptr},
+                 {"evals_past_progress", r.evals_past_progress}});
     if (r.x.size() > 0) {
       nlohmann::json x = nlohmann::json::array();
       for (Index i = 0; i < r.x.size(); ++i) x.push_back(number_or_null(r.x[i]));
@@ -200,7 +212,7 @@ nlohmann::json suite_to_json(const std::vector<reference::SuiteRow>& rows) {
 std::string suite_to_csv(const std::vector<reference::SuiteRow>& rows) {
   std::string out =
       "set,problem,n,start,start_scale,solver,solved,residual,error,f_evals,j_evals,ns,status,"
-      "message,scaled_residual,x\n";
+      "message,scaled_residual,x,evals_past_progress\n";
   for (const auto& r : rows) {
     out += csv_field(r.set) + ',' + csv_field(r.problem) + ',' + std::to_string(r.n) + ',' +
            csv_field(r.start) + ',' + number_text(r.start_scale) + ',' + csv_field(r.solver) + ',' +
@@ -208,7 +220,7 @@ std::string suite_to_csv(const std::vector<reference::SuiteRow>& rows) {
            number_text(r.error) + ',' + std::to_string(r.f_evals) + ',' +
            std::to_string(r.j_evals) + ',' + number_text(r.ns) + ',' + csv_field(r.status) + ',' +
            csv_field(r.message) + ',' + number_text(r.scaled_residual) + ',' + answer_field(r.x) +
-           '\n';
+           ',' + std::to_string(r.evals_past_progress) + '\n';
   }
   return out;
 }

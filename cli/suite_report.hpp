@@ -16,8 +16,8 @@ void print_suite_tables(const std::vector<reference::SuiteRow>& rows, double thr
                         std::ostream& out, bool show_x = false);
 // Keys: set, problem, n, start, start_scale, solver, solved, residual, error, f_evals, j_evals,
 // ns, status, message, scaled_residual, x (an array of n numbers, null for a row without an
-// answer). Non-finite numbers as null; strings as valid_utf8 makes them, so that dump() never
-// throws.
+// answer), evals_past_progress. Non-finite numbers as null; strings as valid_utf8 makes them, so
+// that dump() never throws.
 nlohmann::json suite_to_json(const std::vector<reference::SuiteRow>& rows);
 // The same columns in that order, one header line, RFC 4180 fields (a field with a comma, quote,
 // CR or LF quoted, quotes doubled; the bytes as given), non-finite numbers empty, other numbers

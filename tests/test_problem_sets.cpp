@@ -540,8 +540,8 @@ TEST(ProblemSets, TheWritersTakeAnyLabel) {
   EXPECT_EQ(back[0]["ns"].get<double>(), 5e-324);
   const std::string csv = cli::suite_to_csv(rows);
   EXPECT_NE(csv.find(",\"a,\"\"b\"\"\n\xff\x1b[31m\","), std::string::npos) << csv;
-  // The columns added after message: scaled_residual, then x (empty: no answer).
-  EXPECT_NE(csv.find(",\"line\r\nbreak\",0,\n"), std::string::npos) << csv;
+  // The columns added after message: scaled_residual, x (empty: no answer), evals_past_progress.
+  EXPECT_NE(csv.find(",\"line\r\nbreak\",0,,0\n"), std::string::npos) << csv;
   std::ostringstream table;
   cli::print_suite_tables(rows, 1e-8, table);
   EXPECT_NE(table.str().find("start a,\"b\"\\x0a\\xff\\x1b[31m"), std::string::npos) << table.str();
@@ -698,9 +698,9 @@ TEST(ProblemSets, TheCliPrintsTheTableJsonAndCsvOfAUsersSet) {
   const auto rows = nlohmann::json::parse(json_out.str());
   ASSERT_EQ(rows.size(), 2u * 1u + 2u * 3u);  // solvers x starts
   for (const auto& r : rows) {
-    for (const char* key :
-         {"set", "problem", "n", "start", "start_scale", "solver", "solved", "residual", "error",
-          "f_evals", "j_evals", "ns", "status", "message", "scaled_residual", "x"}) {
+    for (const char* key : {"set", "problem", "n", "start", "start_scale", "solver", "solved",
+                            "residual", "error", "f_evals", "j_evals", "ns", "status", "message",
+                            "scaled_residual", "x", "evals_past_progress"}) {
       ASSERT_TRUE(r.contains(key)) << key << " missing in " << r.dump();
     }
     // The threshold given is the one judged by.
@@ -713,7 +713,7 @@ TEST(ProblemSets, TheCliPrintsTheTableJsonAndCsvOfAUsersSet) {
   std::getline(file, header);
   EXPECT_EQ(header,
             "set,problem,n,start,start_scale,solver,solved,residual,error,f_evals,j_evals,ns,"
-            "status,message,scaled_residual,x");
+            "status,message,scaled_residual,x,evals_past_progress");
   int lines = 0;
   while (std::getline(file, line)) ++lines;
   EXPECT_EQ(lines, 8);

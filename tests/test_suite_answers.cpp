@@ -164,9 +164,10 @@ TEST(SuiteAnswers, EveryRowCarriesThePointItsSolverReturned) {
   std::getline(file, header);
   EXPECT_EQ(header,
             "set,problem,n,start,start_scale,solver,solved,residual,error,f_evals,j_evals,ns,"
-            "status,message,scaled_residual,x");
+            "status,message,scaled_residual,x,evals_past_progress");
   std::getline(file, line);
-  const std::string x_field = line.substr(line.rfind(',') + 1);
+  const std::string before_idle = line.substr(0, line.rfind(','));
+  const std::string x_field = before_idle.substr(before_idle.rfind(',') + 1);
   char* end = nullptr;
   const double x0 = std::strtod(x_field.c_str(), &end);
   const double x1 = std::strtod(end, &end);
@@ -219,10 +220,10 @@ TEST(SuiteAnswers, TheWritersTakeAnyAnswer) {
   EXPECT_EQ(cli::answer_field(r.x.head(4)), "nan 1e+308 -inf 4.9406564584124654e-324");
   EXPECT_EQ(cli::answer_field(Eigen::VectorXd()), "");
   const std::string csv = cli::suite_to_csv(rows);
-  EXPECT_NE(csv.find(",nan 1e+308 -inf 4.9406564584124654e-324 5 6 7 8 9 10 11 12\n"),
+  EXPECT_NE(csv.find(",nan 1e+308 -inf 4.9406564584124654e-324 5 6 7 8 9 10 11 12,0\n"),
             std::string::npos)
       << csv;
-  EXPECT_NE(csv.find(",engine_threw,,,\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",engine_threw,,,,0\n"), std::string::npos) << csv;
 
   std::ostringstream table;
   cli::print_suite_tables(rows, 1e-8, table, true);
@@ -321,11 +322,77 @@ TEST(SuiteAnswers, AProblemsScalesAreItsJudgementAndReachKinsol) {
   EXPECT_THROW(reference::KinsolSolver(1, ko, f, j), std::invalid_argument);
 }
 
+// An engine a user wrote that finds the root of `halving` (2) at its second evaluation and
+// then evaluates G there thirty more times: thirty evaluations past its progress.
+class IdleEngine final : public Engine<Dynamic> {
+ public:
+  explicit IdleEngine(SolverOptions o) : Engine<Dynamic>(std::move(o)) {}
+  std::string_view name() const override { return "test-idle"; }
+  Summary solve(const FixedPointProblem<Dynamic>& g, Vector<Dynamic>& x) override {
+    Vector<Dynamic> out(x.size());
+    g.evaluate(x, out);
+    x.setConstant(2.0);
+    for (int i = 0; i < 31; ++i) g.evaluate(x, out);
+    Summary s;
+    s.status = Status::kConverged;
+    return s;
+  }
+};
+
 // x = G(x) with G(x) = x/2 + 1 (root 2): any engine gets there, given time.
 TestProblem halving() {
   return fixed_point_test_problem("halving", 1,
                                   [](const auto& x, auto& g) { g[0] = 0.5 * x[0] + 1.0; },
                                   {{"zero", Eigen::VectorXd::Zero(1)}});
+}
+
+// evals_past_progress: what a run spent after |F| last fell (the issue's "no run spends more
+// than 50 evaluations past the point where |F| stopped falling", measured per row).
+TEST(SuiteAnswers, EveryRowCountsTheEvaluationsPastItsLastProgress) {
+  static const bool registered = [] {
+    EngineRegistry<Dynamic>::global().add(
+        {"test-idle",
+         "finds the root, then evaluates there 30 more times",
+         {},
+         {"test-idle"},
+         [](EngineSpecReader&, SolverOptions o) -> std::unique_ptr<Engine<Dynamic>> {
+           return std::make_unique<IdleEngine>(o);
+         }});
+    return true;
+  }();
+  (void)registered;
+  const ProblemSetEntry set = set_of(halving());
+  const auto rows =
+      reference::run_suite(set, build_problem_set(set), {"test-idle", "newton", "minpack:hybrj"});
+  EXPECT_EQ(row(rows, "test-idle").f_evals, 32);
+  EXPECT_EQ(row(rows, "test-idle").evals_past_progress, 30);
+  // Newton on an affine G: the root at its second evaluation, and nothing after it.
+  EXPECT_TRUE(row(rows, "newton").solved);
+  EXPECT_EQ(row(rows, "newton").evals_past_progress, 0) << row(rows, "newton").f_evals;
+  EXPECT_LE(row(rows, "minpack:hybrj").evals_past_progress, row(rows, "minpack:hybrj").f_evals);
+
+  // No root (x² + 1 = 0): every evaluation after the lowest |F| counts, and the table names the
+  // worst run per solver.
+  const ProblemSetEntry none = set_of(
+      root_test_problem("no-root", 1, [](const auto& x, auto& f) { f[0] = x[0] * x[0] + 1.0; },
+                        {{"one", Eigen::VectorXd::Ones(1)}}));
+  const auto stuck =
+      reference::run_suite(none, build_problem_set(none), {"newton:linesearch=1", "minpack:hybrj"});
+  for (const SuiteRow& r : stuck) {
+    SCOPED_TRACE(r.solver);
+    EXPECT_FALSE(r.solved);
+    EXPECT_LE(r.evals_past_progress, r.f_evals);
+  }
+  // Newton's first step lands on the minimum |F| = 1 at x = 0, where J = 0 ends it at once: no
+  // evaluation past its progress. MINPACK searches on.
+  EXPECT_EQ(row(stuck, "newton:linesearch=1").evals_past_progress, 0);
+  EXPECT_EQ(row(stuck, "newton:linesearch=1").status, "singular_jacobian");
+  EXPECT_GE(row(stuck, "minpack:hybrj").evals_past_progress, 1);
+  std::ostringstream table;
+  cli::print_suite_tables(rows, 1e-8, table);
+  EXPECT_NE(table.str().find("idle     30 (halving n=1 zero)"), std::string::npos) << table.str();
+  const auto json = nlohmann::json::parse(cli::suite_to_json(rows).dump());
+  EXPECT_EQ(json[0]["evals_past_progress"], 30);
 }
 
 TEST(SuiteAnswers, ATimeLimitEndsADeliberatelySlowEngine) {

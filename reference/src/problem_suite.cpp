@@ -36,6 +36,10 @@ bool is_reference(const std::string& s) {
   return std::find(refs.begin(), refs.end(), s) != refs.end();
 }
 
+// A fall of ‖F‖ counts when it goes below (1 − this) × the lowest before it, as the engines'
+// own rule has it (StopMonitor): rounding-level jitter near a root sets no record.
+constexpr double kMeaningfulFall = 1e-3;
+
 // Counts the evaluations of F (or G) one solve makes and refuses those beyond its budget or past
 // its deadline: the refused call returns NaN without calling the problem, and the row becomes
 // max_evaluations or time_limit.
@@ -49,11 +53,19 @@ struct Meter {
   bool timed = false;
   Clock::time_point deadline{};
   double time_limit_s = 0.0;
+  // Progress: the lowest ‖D_f F‖₂ seen at an evaluated point, and the count at the last
+  // evaluation that brought it below (1 − kMeaningfulFall) × the lowest before.
+  const Eigen::VectorXd* f_scale = nullptr;
+  double lowest = std::numeric_limits<double>::infinity();
+  long last_fall = 0;
+  Eigen::VectorXd scratch, residual;
   void reset(long budget, double limit_s) {
     count = 0;
     cap = budget;
     refused = timed_out = false;
     late_calls = 0;
+    lowest = std::numeric_limits<double>::infinity();
+    last_fall = 0;
     timed = std::isfinite(limit_s);
     time_limit_s = limit_s;
     if (timed) {
@@ -68,6 +80,25 @@ struct Meter {
     ++late_calls;
     return true;
   }
+  // After the evaluation just taken: f = F(x) (NaN or inf: no progress).
+  void saw(const Eigen::VectorXd& f) {
+    if (!f.allFinite()) return;
+    double norm = f.stableNorm();
+    if (f_scale && f_scale->size() == f.size()) {
+      scratch = f.cwiseProduct(*f_scale);
+      norm = scratch.stableNorm();
+    }
+    if (norm < (1.0 - kMeaningfulFall) * lowest) last_fall = count;
+    lowest = std::min(lowest, norm);
+  }
+  // After an evaluation of G: F = G(x) − x.
+  void saw_fixed_point(const Eigen::VectorXd& x, const Eigen::VectorXd& g) {
+    if (g.size() != x.size()) return;  // the engine names a G of the wrong size
+    residual = g - x;
+    saw(residual);
+  }
+  // Evaluations made since ‖D_f F‖ last fell meaningfully (all of them if it never did).
+  long past_progress() const { return count - last_fall; }
   // True when one more evaluation is within the budget and the time limit (and counts it).
   bool take() {
     if (count >= cap) {
@@ -102,6 +133,7 @@ RootProblem<Dynamic> guarded(const RootProblem<Dynamic>& f, Meter* meter) {
         } catch (...) {
           out.setConstant(p->residual_size(), std::numeric_limits<double>::quiet_NaN());
         }
+        if (meter) meter->saw(out);
       },
       [p, meter](const Eigen::VectorXd& x, Eigen::MatrixXd& jac) {
         if (meter && meter->late()) {
@@ -129,6 +161,7 @@ FixedPointProblem<Dynamic> guarded(const FixedPointProblem<Dynamic>& g, Meter* m
         } catch (...) {
           out.setConstant(p->size(), std::numeric_limits<double>::quiet_NaN());
         }
+        if (meter) meter->saw_fixed_point(x, out);
       },
       g.size());
 }
@@ -144,6 +177,7 @@ FixedPointProblem<Dynamic> metered(const FixedPointProblem<Dynamic>& g, Meter& m
       return;
     }
     p->evaluate(x, out);
+    meter.saw_fixed_point(x, out);
   };
   if (!g.has_jacobian()) return FixedPointProblem<Dynamic>::from_map(map, g.size());
   auto jacobian = [p, &meter](const Eigen::VectorXd& x, Eigen::MatrixXd& jac) {
@@ -352,6 +386,7 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
     const RootProblem<Dynamic> safe_f = guarded(p.residual, &meter);
     const FixedPointProblem<Dynamic> safe_g = guarded(g, &meter);
     const FixedPointProblem<Dynamic> engine_g = metered(g, meter);
+    meter.f_scale = &p.f_scale;
     for (const ProblemStart& start : p.starts) {
       if (!selected(start, options)) continue;
       for (const std::string& s : solvers) {
@@ -461,6 +496,7 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
         row.error =
             x.size() == n ? distance_to_solutions(p, x) : std::numeric_limits<double>::infinity();
         row.f_evals = outcome.f_evals;
+        row.evals_past_progress = meter.past_progress();
         row.j_evals = outcome.j_evals;
         rows.push_back(std::move(row));
       }

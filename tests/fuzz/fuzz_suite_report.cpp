@@ -175,17 +175,30 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t siz
     r.scaled_residual = any_double(in);
     r.x.resize(in.ConsumeIntegralInRange<int>(0, 5));
     for (Eigen::Index i = 0; i < r.x.size(); ++i) r.x[i] = any_double(in);
+    r.evals_past_progress = in.ConsumeIntegral<long>();
   }
 
   // CSV.
   std::vector<std::vector<std::string>> records;
   check(read_csv(nlobs::cli::suite_to_csv(rows), records));
   check(records.size() == rows.size() + 1);
-  const std::vector<std::string> header = {
-      "set",     "problem", "n",        "start",   "start_scale",
-      "solver",  "solved",  "residual", "error",   "f_evals",
-      "j_evals", "ns",      "status",   "message", "scaled_residual",
-      "x"};
+  const std::vector<std::string> header = {"set",
+                                           "problem",
+                                           "n",
+                                           "start",
+                                           "start_scale",
+                                           "solver",
+                                           "solved",
+                                           "residual",
+                                           "error",
+                                           "f_evals",
+                                           "j_evals",
+                                           "ns",
+                                           "status",
+                                           "message",
+                                           "scaled_residual",
+                                           "x",
+                                           "evals_past_progress"};
   check(records[0] == header);
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const SuiteRow& r = rows[k];
@@ -201,6 +214,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t siz
     check(c[12] == r.status && c[13] == r.message);
     check_number(c[14], r.scaled_residual);
     check_answer(c[15], r.x);
+    check(c[16] == std::to_string(r.evals_past_progress));
   }
 
   // JSON: dump() must not throw (invalid UTF-8 reaches it as U+FFFD), and parses back.
@@ -220,6 +234,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t siz
     check_number(j.at("ns"), r.ns);
     check(j.at("status") == valid_utf8(r.status) && j.at("message") == valid_utf8(r.message));
     check_number(j.at("scaled_residual"), r.scaled_residual);
+    check(j.at("evals_past_progress").get<long>() == r.evals_past_progress);
     if (r.x.size() == 0) {
       check(j.at("x").is_null());
     } else {

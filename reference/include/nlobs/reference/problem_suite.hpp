@@ -45,6 +45,10 @@ struct SuiteRow {
   // for a row without an answer (invalid_input, engine_threw, out_of_memory, a time limit that
   // had to stop the engine by an exception).
   Eigen::VectorXd x{};
+  // F evaluations made after the last one at which ‖D_f F‖₂ fell below 0.999 × the lowest
+  // before it, counted at the evaluated points (difference points and line-search trials too):
+  // what a solver spent once it had stopped making progress (all of f_evals if it never did).
+  long evals_past_progress = 0;
 };
 
 struct SuiteOptions {
