@@ -179,16 +179,36 @@ FixedPointProblem<Dynamic> metered(const FixedPointProblem<Dynamic>& g, Meter& m
     p->evaluate(x, out);
     meter.saw_fixed_point(x, out);
   };
-  if (!g.has_jacobian()) return FixedPointProblem<Dynamic>::from_map(map, g.size());
-  auto jacobian = [p, &meter](const Eigen::VectorXd& x, Eigen::MatrixXd& jac) {
-    if (meter.late()) {
+  // F itself, when G carries it (FixedPointProblem::residual): metered alike, one evaluation.
+  auto residual = [p, &meter](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
+    if (!meter.take()) {
       if (meter.late_calls > kLateCallsBeforeStop) throw TimeLimitStop{};
-      jac.setConstant(p->size(), p->size(), std::numeric_limits<double>::quiet_NaN());
+      out.setConstant(p->size(), std::numeric_limits<double>::quiet_NaN());
       return;
     }
-    p->jacobian(x, jac);
+    p->residual(x, out);
+    meter.saw(out);
   };
-  return FixedPointProblem<Dynamic>::with_jacobian(map, jacobian, g.size(), g.jacobian_source());
+  // A Jacobian past the deadline is refused too (NaN).
+  const auto late = [&meter, p](Eigen::MatrixXd& jac) {
+    if (!meter.late()) return false;
+    if (meter.late_calls > kLateCallsBeforeStop) throw TimeLimitStop{};
+    jac.setConstant(p->size(), p->size(), std::numeric_limits<double>::quiet_NaN());
+    return true;
+  };
+  if (!g.has_jacobian()) {
+    auto out = FixedPointProblem<Dynamic>::from_map(map, g.size());
+    return g.has_residual() ? out.with_residual(residual) : out;
+  }
+  auto jacobian = [p, late](const Eigen::VectorXd& x, Eigen::MatrixXd& jac) {
+    if (!late(jac)) p->jacobian(x, jac);
+  };
+  auto out =
+      FixedPointProblem<Dynamic>::with_jacobian(map, jacobian, g.size(), g.jacobian_source());
+  if (!g.has_residual()) return out;
+  return out.with_residual(residual, [p, late](const Eigen::VectorXd& x, Eigen::MatrixXd& jac) {
+    if (!late(jac)) p->residual_jacobian(x, jac);
+  });
 }
 
 // KINSOL's options and set-up may refuse (std::invalid_argument): the caller makes that row
