@@ -478,8 +478,8 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
               << (meter.late_calls > kLateCallsBeforeStop
                       ? "; asked again, stopped by an exception)"
                       : ")");
-          row.message =
-              why.str();  // what the engine said of the NaN we gave it is beside the point
+          // What the engine said of the NaN it was given is beside the point.
+          row.message = why.str();
         } else if (meter.refused) {
           row.status = "max_evaluations";
           if (row.message.empty()) {
