@@ -203,6 +203,7 @@ TEST(SuiteAnswers, TheWritersTakeAnyAnswer) {
   r.x[1] = 1e308;
   r.x[2] = -std::numeric_limits<double>::infinity();
   r.x[3] = 5e-324;
+  r.x[4] = -std::numeric_limits<double>::quiet_NaN();  // printf's "-nan"
   SuiteRow none = r;
   none.status = "engine_threw";
   none.x.resize(0);
@@ -220,14 +221,14 @@ TEST(SuiteAnswers, TheWritersTakeAnyAnswer) {
   EXPECT_EQ(cli::answer_field(r.x.head(4)), "nan 1e+308 -inf 4.9406564584124654e-324");
   EXPECT_EQ(cli::answer_field(Eigen::VectorXd()), "");
   const std::string csv = cli::suite_to_csv(rows);
-  EXPECT_NE(csv.find(",nan 1e+308 -inf 4.9406564584124654e-324 5 6 7 8 9 10 11 12,0\n"),
+  EXPECT_NE(csv.find(",nan 1e+308 -inf 4.9406564584124654e-324 nan 6 7 8 9 10 11 12,0\n"),
             std::string::npos)
       << csv;
   EXPECT_NE(csv.find(",engine_threw,,,,0\n"), std::string::npos) << csv;
 
   std::ostringstream table;
   cli::print_suite_tables(rows, 1e-8, table, true);
-  EXPECT_NE(table.str().find("x = [nan, 1e+308, -inf, 4.94066e-324, 5, 6, 7, 8, ... (4 more)]"),
+  EXPECT_NE(table.str().find("x = [nan, 1e+308, -inf, 4.94066e-324, nan, 6, 7, 8, ... (4 more)]"),
             std::string::npos)
       << table.str();
 }
@@ -344,6 +345,45 @@ TestProblem halving() {
   return fixed_point_test_problem("halving", 1,
                                   [](const auto& x, auto& g) { g[0] = 0.5 * x[0] + 1.0; },
                                   {{"zero", Eigen::VectorXd::Zero(1)}});
+}
+
+// A solver that returns a point that is not finite, in a box: its own status (non_finite), not
+// outside_bounds (inf lies beyond every upper bound, but it is no point of the box's outside).
+class InfiniteAnswer final : public Engine<Dynamic> {
+ public:
+  explicit InfiniteAnswer(SolverOptions o) : Engine<Dynamic>(std::move(o)) {}
+  std::string_view name() const override { return "test-infinite"; }
+  Summary solve(const FixedPointProblem<Dynamic>&, Vector<Dynamic>& x) override {
+    x.setConstant(std::numeric_limits<double>::infinity());
+    Summary s;
+    s.status = Status::kNonFinite;
+    return s;
+  }
+};
+
+TEST(SuiteAnswers, ANonFiniteAnswerInABoxKeepsItsSolversStatus) {
+  static const bool registered = [] {
+    EngineRegistry<Dynamic>::global().add(
+        {"test-infinite",
+         "returns inf",
+         {},
+         {"test-infinite"},
+         [](EngineSpecReader&, SolverOptions o) -> std::unique_ptr<Engine<Dynamic>> {
+           return std::make_unique<InfiniteAnswer>(o);
+         }});
+    return true;
+  }();
+  (void)registered;
+  TestProblem p = two_roots();
+  p.lower = Eigen::Vector2d(-5.0, -5.0);
+  p.upper = Eigen::Vector2d(5.0, 5.0);
+  const ProblemSetEntry set = set_of(p);
+  const auto rows = reference::run_suite(set, build_problem_set(set), {"test-infinite"});
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].status, "non_finite");
+  EXPECT_FALSE(rows[0].solved);
+  ASSERT_EQ(rows[0].x.size(), 2);
+  EXPECT_TRUE(std::isinf(rows[0].x[0]));
 }
 
 // evals_past_progress: what a run spent after |F| last fell (the issue's "no run spends more
