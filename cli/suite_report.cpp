@@ -46,7 +46,14 @@ std::string answer_text(const Eigen::VectorXd& x, Index max_components) {
   os.precision(6);
   os << '[';
   const Index shown = std::min(x.size(), max_components);
-  for (Index i = 0; i < shown; ++i) os << (i ? ", " : "") << x[i];
+  for (Index i = 0; i < shown; ++i) {
+    os << (i ? ", " : "");
+    if (std::isnan(x[i])) {
+      os << "nan";  // not the C library's "-nan" for a NaN with its sign bit set
+    } else {
+      os << x[i];
+    }
+  }
   if (shown < x.size()) os << ", ... (" << x.size() - shown << " more)";
   os << ']';
   return os.str();

@@ -68,6 +68,50 @@ class ListedAnswer final : public Engine<Dynamic> {
   }
 };
 
+// An engine a user wrote that finds the root of `halving` (2) at its second evaluation and
+// then evaluates G there thirty more times: thirty evaluations past its progress.
+class IdleEngine final : public Engine<Dynamic> {
+ public:
+  explicit IdleEngine(SolverOptions o) : Engine<Dynamic>(std::move(o)) {}
+  std::string_view name() const override { return "test-idle"; }
+  Summary solve(const FixedPointProblem<Dynamic>& g, Vector<Dynamic>& x) override {
+    Vector<Dynamic> out(x.size());
+    g.evaluate(x, out);
+    x.setConstant(2.0);
+    for (int i = 0; i < 31; ++i) g.evaluate(x, out);
+    Summary s;
+    s.status = Status::kConverged;
+    return s;
+  }
+};
+
+// A solver that returns a point that is not finite, in a box: its own status (non_finite), not
+// outside_bounds (inf lies beyond every upper bound, but it is no point of the box's outside).
+class InfiniteAnswer final : public Engine<Dynamic> {
+ public:
+  explicit InfiniteAnswer(SolverOptions o) : Engine<Dynamic>(std::move(o)) {}
+  std::string_view name() const override { return "test-infinite"; }
+  Summary solve(const FixedPointProblem<Dynamic>&, Vector<Dynamic>& x) override {
+    x.setConstant(std::numeric_limits<double>::infinity());
+    Summary s;
+    s.status = Status::kNonFinite;
+    return s;
+  }
+};
+
+// A user's engine E registered under `name`, as a user registers one.
+template <typename E>
+void add_engine(EngineRegistry<Dynamic>& engines, const std::string& name, std::string what) {
+  engines.add({name,
+               std::move(what),
+               {},
+               {name},
+               [](EngineSpecReader&, SolverOptions o) -> std::unique_ptr<Engine<Dynamic>> {
+                 return std::make_unique<E>(o);
+               }});
+}
+
+// Every engine of this file, registered once.
 void register_engines_once() {
   static const bool done = [] {
     auto& engines = EngineRegistry<Dynamic>::global();
@@ -82,13 +126,11 @@ void register_engines_once() {
              return std::make_unique<SlowEngine>(o, stubborn);
            }});
     }
-    engines.add({"test-answers-listed",
-                 "returns the known solution of mass-balance",
-                 {},
-                 {"test-answers-listed"},
-                 [](EngineSpecReader&, SolverOptions o) -> std::unique_ptr<Engine<Dynamic>> {
-                   return std::make_unique<ListedAnswer>(o);
-                 }});
+    add_engine<ListedAnswer>(engines, "test-answers-listed",
+                             "returns the known solution of mass-balance");
+    add_engine<IdleEngine>(engines, "test-idle",
+                           "finds the root, then evaluates there 30 more times");
+    add_engine<InfiniteAnswer>(engines, "test-infinite", "returns inf");
     return true;
   }();
   (void)done;
@@ -203,6 +245,7 @@ TEST(SuiteAnswers, TheWritersTakeAnyAnswer) {
   r.x[1] = 1e308;
   r.x[2] = -std::numeric_limits<double>::infinity();
   r.x[3] = 5e-324;
+  r.x[4] = -std::numeric_limits<double>::quiet_NaN();  // printf's "-nan"
   SuiteRow none = r;
   none.status = "engine_threw";
   none.x.resize(0);
@@ -220,14 +263,14 @@ TEST(SuiteAnswers, TheWritersTakeAnyAnswer) {
   EXPECT_EQ(cli::answer_field(r.x.head(4)), "nan 1e+308 -inf 4.9406564584124654e-324");
   EXPECT_EQ(cli::answer_field(Eigen::VectorXd()), "");
   const std::string csv = cli::suite_to_csv(rows);
-  EXPECT_NE(csv.find(",nan 1e+308 -inf 4.9406564584124654e-324 5 6 7 8 9 10 11 12,0\n"),
+  EXPECT_NE(csv.find(",nan 1e+308 -inf 4.9406564584124654e-324 nan 6 7 8 9 10 11 12,0\n"),
             std::string::npos)
       << csv;
   EXPECT_NE(csv.find(",engine_threw,,,,0\n"), std::string::npos) << csv;
 
   std::ostringstream table;
   cli::print_suite_tables(rows, 1e-8, table, true);
-  EXPECT_NE(table.str().find("x = [nan, 1e+308, -inf, 4.94066e-324, 5, 6, 7, 8, ... (4 more)]"),
+  EXPECT_NE(table.str().find("x = [nan, 1e+308, -inf, 4.94066e-324, nan, 6, 7, 8, ... (4 more)]"),
             std::string::npos)
       << table.str();
 }
@@ -322,23 +365,6 @@ TEST(SuiteAnswers, AProblemsScalesAreItsJudgementAndReachKinsol) {
   EXPECT_THROW(reference::KinsolSolver(1, ko, f, j), std::invalid_argument);
 }
 
-// An engine a user wrote that finds the root of `halving` (2) at its second evaluation and
-// then evaluates G there thirty more times: thirty evaluations past its progress.
-class IdleEngine final : public Engine<Dynamic> {
- public:
-  explicit IdleEngine(SolverOptions o) : Engine<Dynamic>(std::move(o)) {}
-  std::string_view name() const override { return "test-idle"; }
-  Summary solve(const FixedPointProblem<Dynamic>& g, Vector<Dynamic>& x) override {
-    Vector<Dynamic> out(x.size());
-    g.evaluate(x, out);
-    x.setConstant(2.0);
-    for (int i = 0; i < 31; ++i) g.evaluate(x, out);
-    Summary s;
-    s.status = Status::kConverged;
-    return s;
-  }
-};
-
 // x = G(x) with G(x) = x/2 + 1 (root 2): any engine gets there, given time.
 TestProblem halving() {
   return fixed_point_test_problem("halving", 1,
@@ -346,21 +372,24 @@ TestProblem halving() {
                                   {{"zero", Eigen::VectorXd::Zero(1)}});
 }
 
+TEST(SuiteAnswers, ANonFiniteAnswerInABoxKeepsItsSolversStatus) {
+  register_engines_once();
+  TestProblem p = two_roots();
+  p.lower = Eigen::Vector2d(-5.0, -5.0);
+  p.upper = Eigen::Vector2d(5.0, 5.0);
+  const ProblemSetEntry set = set_of(p);
+  const auto rows = reference::run_suite(set, build_problem_set(set), {"test-infinite"});
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].status, "non_finite");
+  EXPECT_FALSE(rows[0].solved);
+  ASSERT_EQ(rows[0].x.size(), 2);
+  EXPECT_TRUE(std::isinf(rows[0].x[0]));
+}
+
 // evals_past_progress: what a run spent after |F| last fell (the issue's "no run spends more
 // than 50 evaluations past the point where |F| stopped falling", measured per row).
 TEST(SuiteAnswers, EveryRowCountsTheEvaluationsPastItsLastProgress) {
-  static const bool registered = [] {
-    EngineRegistry<Dynamic>::global().add(
-        {"test-idle",
-         "finds the root, then evaluates there 30 more times",
-         {},
-         {"test-idle"},
-         [](EngineSpecReader&, SolverOptions o) -> std::unique_ptr<Engine<Dynamic>> {
-           return std::make_unique<IdleEngine>(o);
-         }});
-    return true;
-  }();
-  (void)registered;
+  register_engines_once();
   const ProblemSetEntry set = set_of(halving());
   const auto rows =
       reference::run_suite(set, build_problem_set(set), {"test-idle", "newton", "minpack:hybrj"});

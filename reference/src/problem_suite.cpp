@@ -492,7 +492,9 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
         if (x.size() == n) row.x = x;
         row.status = outcome.status;
         const bool in_box = x.size() == n && !p.first_outside_bounds(x);
-        if (x.size() == n && !in_box) row.status = "outside_bounds";
+        // A point that is not finite keeps the solver's own account (non_finite, ...): it is no
+        // point outside the box.
+        if (x.size() == n && x.allFinite() && !in_box) row.status = "outside_bounds";
         // An evaluation asked for beyond the budget was refused: whatever the point, not solved.
         if (meter.timed_out) {
           row.status = "time_limit";
@@ -500,10 +502,10 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
           why << "asked for an evaluation after the time limit of " << options.time_limit_s
               << " s (refused"
               << (meter.late_calls > kLateCallsBeforeStop
-                      ? "; asked again, stopped by an exception)"
+                      ? "; asked ten more times, stopped by an exception)"
                       : ")");
-          row.message =
-              why.str();  // what the engine said of the NaN we gave it is beside the point
+          // What the engine said of the NaN it was given is beside the point.
+          row.message = why.str();
         } else if (meter.refused) {
           row.status = "max_evaluations";
           if (row.message.empty()) {
