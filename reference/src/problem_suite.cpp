@@ -437,11 +437,13 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
             SolverOptions o = base;
             o.stop.max_evaluations = static_cast<int>(std::min<long>(budget, 1L << 30));
             auto engine = registry.create(s, o);
-            // The problem's box reaches the engines that take bounds; the others run unbounded
-            // and are judged alike (outside_bounds). levenberg-marquardt:geodesic=1 and a
-            // user's engine may refuse it: invalid_input.
+            // The problem's box reaches the engines that take bounds (its strict sides those
+            // that take them; Ceres and NLopt the closed box); the others run unbounded and are
+            // judged alike (outside_bounds). levenberg-marquardt:geodesic=1 and a user's engine
+            // may refuse it: invalid_input.
             if ((p.lower.size() > 0 || p.upper.size() > 0) && engine->accepts_bounds()) {
-              engine->set_bounds({p.lower, p.upper});
+              engine->set_bounds(engine->accepts_strict_bounds() ? p.bounds()
+                                                                 : BoxBounds{p.lower, p.upper});
             }
             // The problem's scaling likewise (the Newton-type engines; docs/solvers.md).
             if ((p.u_scale.size() > 0 || p.f_scale.size() > 0) && engine->accepts_scaling()) {

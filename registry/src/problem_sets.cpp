@@ -72,6 +72,28 @@ void validate_test_problem(const TestProblem& p, std::string_view where,
       }
     }
   }
+  auto check_strict = [&](const StrictBounds& strict, const Eigen::VectorXd& b, const char* name,
+                          const char* side) {
+    if (strict.size() != 0 && strict.size() != b.size()) {
+      fail(where, p,
+           std::string(name) + " has " + shape(strict.size()) + " flags, " + side + " " +
+               shape(b.size()) + " bounds (one flag per bound)");
+    }
+  };
+  check_strict(p.strict_lower, p.lower, "strict_lower", "lower");
+  check_strict(p.strict_upper, p.upper, "strict_upper", "upper");
+  if (p.lower.size() == n && p.upper.size() == n) {
+    for (Index i = 0; i < n; ++i) {
+      const bool strict = (p.strict_lower.size() == n && p.strict_lower[i]) ||
+                          (p.strict_upper.size() == n && p.strict_upper[i]);
+      if (strict && p.lower[i] == p.upper[i]) {
+        std::ostringstream os;
+        os << "lower[" << i << "] = upper[" << i << "] = " << p.lower[i]
+           << " with a strict side: no x satisfies it";
+        fail(where, p, os.str());
+      }
+    }
+  }
   auto check_scale = [&](const Eigen::VectorXd& d, const char* name) {
     if (d.size() != 0 && d.size() != n)
       fail(where, p, std::string(name) + " has size " + shape(d.size()));

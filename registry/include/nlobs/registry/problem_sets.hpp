@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "nlobs/registry/named_registry.hpp"
+#include "nlobs/solvers/box_bounds.hpp"
 #include "nlobs/solvers/problem.hpp"
 
 namespace nlobs {
@@ -39,6 +40,10 @@ struct TestProblem {
   // lower ≤ x ≤ upper, each empty for no bound on that side (±inf entries allowed): a point
   // outside is not a solution (status `outside_bounds`).
   Eigen::VectorXd lower{}, upper{};
+  // Strict bounds (lower_i < x_i, x_i < upper_i; BoxBounds): one flag per bound, each empty for
+  // a closed side. A point on a strict bound is outside; the engines that take strict bounds
+  // never evaluate F there, Ceres and NLopt get the closed box.
+  StrictBounds strict_lower{}, strict_upper{};
   // Known solutions: the suite reports the ∞-norm distance of the answer to the nearest one.
   std::vector<Eigen::VectorXd> solutions{};
   // KINSOL's scaling (its u_scale and f_scale: the solver's norms are those of D_u x and D_f F,
@@ -56,11 +61,20 @@ struct TestProblem {
         f_scale.size() == f.size() ? f.cwiseProduct(f_scale).stableNorm() : f.stableNorm();
     return std::isfinite(norm) ? norm : std::numeric_limits<double>::infinity();
   }
-  // The first component of x (of the problem's size) outside lower ≤ x ≤ upper; none inside.
+  // The box as an engine takes it (Engine::set_bounds).
+  BoxBounds bounds() const { return {lower, upper, strict_lower, strict_upper}; }
+  // The first component of x (of the problem's size) outside the box (on a strict bound
+  // included); none inside.
   std::optional<Index> first_outside_bounds(const Eigen::VectorXd& x) const {
     for (Index i = 0; i < x.size(); ++i) {
-      if (lower.size() == x.size() && x[i] < lower[i]) return i;
-      if (upper.size() == x.size() && x[i] > upper[i]) return i;
+      if (lower.size() == x.size() && (x[i] < lower[i] || (strict_lower.size() == x.size() &&
+                                                           strict_lower[i] && x[i] == lower[i]))) {
+        return i;
+      }
+      if (upper.size() == x.size() && (x[i] > upper[i] || (strict_upper.size() == x.size() &&
+                                                           strict_upper[i] && x[i] == upper[i]))) {
+        return i;
+      }
     }
     return std::nullopt;
   }

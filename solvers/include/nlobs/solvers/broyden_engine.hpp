@@ -118,7 +118,7 @@ bool BroydenEngine<N>::search(const Vector<N>& d, double t0, bool armijo) {
   t_ = t0;
   for (int k = 0; k <= broyden_.max_backtracks && !system_.budget_spent(); ++k) {
     xt_ = x_ + t_ * d;
-    projected_ = box.project(xt_);
+    projected_ = box.project(xt_, x_);
     if (projected_ && xt_ == x_) return false;  // the box holds x in place along d
     if (system_.residual(xt_, ft_)) {
       const double allowed =

@@ -80,6 +80,7 @@ class CeresEngine : public Engine<N> {
   bool accepts_bounds() const override {
     return ceres_.backend != CeresOptions::Backend::kTinySolver;
   }
+  bool accepts_strict_bounds() const override { return false; }  // Ceres' box is closed
   // Which back end solve() uses (for a fixed-size problem).
   bool uses_tiny_solver() const {
     return N != Dynamic && ceres_.backend != CeresOptions::Backend::kSolver &&

@@ -256,9 +256,13 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
         status = Status::kMaxEvaluations;
         break;
       }
-      // In a box the step is P(x + p) − x: the model, the ratio and the update all use it.
+      // In a box the step is P(x + p) − x: the model, the ratio and the update all use it. The
+      // radius grows from the model's own step: a step the box cut short says nothing against
+      // the model (on a strict bound each cut is 99 % of the room left, and Δ = 2‖Dp'‖ would
+      // fall with it, 100-fold per step, leaving the free components behind).
+      const double model_pnorm = diag_.cwiseProduct(p_).norm();
       xt_ = x_ + p_;
-      const bool projected = box.project(xt_);
+      const bool projected = box.project(xt_, x_);
       if (projected) {
         p_ = xt_ - x_;
         step_was_gauss_newton_ = false;
@@ -290,8 +294,8 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
       } else {
         failures = 0;
         ++successes;
-        if (ratio >= 0.5 || successes > 1) delta = std::max(delta, pnorm / 0.5);
-        if (std::abs(ratio - 1.0) <= 0.1) delta = pnorm / 0.5;
+        if (ratio >= 0.5 || successes > 1) delta = std::max(delta, model_pnorm / 0.5);
+        if (std::abs(ratio - 1.0) <= 0.1) delta = model_pnorm / 0.5;
       }
       const bool accepted = ratio >= 1e-4;
       std::optional<Status> monitor_status;

@@ -27,6 +27,7 @@ class DynamicSizeEngine final : public Engine<N> {
   bool least_squares() const override { return engine_->least_squares(); }
   bool needs_contraction() const override { return engine_->needs_contraction(); }
   bool accepts_bounds() const override { return engine_->accepts_bounds(); }
+  bool accepts_strict_bounds() const override { return engine_->accepts_strict_bounds(); }
   bool accepts_scaling() const override { return engine_->accepts_scaling(); }
   Engine<Dynamic>& engine() { return *engine_; }
 

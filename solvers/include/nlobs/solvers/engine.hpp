@@ -65,6 +65,10 @@ class Engine {
   // Ceres and NLopt pass the box to their libraries. The others throw InvalidInput here, as do
   // bounds with lower > upper, NaN, lower = +inf or upper = −inf. Empty bounds remove the box.
   virtual bool accepts_bounds() const { return false; }
+  // Strict sides (BoxBounds::strict_lower/strict_upper: lower < x): the Newton-type engines stop
+  // a step that would reach one at a fraction of the way (nlobs/solvers/box_bounds.hpp) and never
+  // evaluate G on it; Ceres and NLopt, whose boxes are closed, refuse them at set_bounds.
+  virtual bool accepts_strict_bounds() const { return accepts_bounds(); }
   void set_bounds(BoxBounds bounds) {
     if (!bounds.empty() && !accepts_bounds()) {
       throw InvalidInput(std::string(name()) +
@@ -74,7 +78,12 @@ class Engine {
     if (scaled_solve_running_) {
       throw InvalidInput(std::string(name()) + ": set_bounds during a scaled solve");
     }
-    detail::validate_box(name(), bounds.lower, bounds.upper);
+    detail::validate_box(name(), bounds);
+    if (bounds.any_strict() && !accepts_strict_bounds()) {
+      throw InvalidInput(std::string(name()) +
+                         " keeps x in a closed box only; engines that take strict bounds: "
+                         "newton, dogleg, levenberg-marquardt, broyden, pseudo-transient, auto");
+    }
     BoxBounds previous = std::move(bounds_);
     bounds_ = std::move(bounds);
     try {
@@ -238,7 +247,7 @@ std::optional<Summary> Engine<N>::solve_scaled(const FixedPointProblem<N>& probl
   if (scaling_.empty() || scaled_solve_running_) return std::nullopt;
   // Checked in the problem's own terms before anything is scaled.
   detail::check_initial_guess<N>(name(), problem.size(), x);
-  detail::require_inside_box<N>(name(), bounds_.lower, bounds_.upper, x);
+  detail::require_inside_box<N>(name(), bounds_, x);
   Vector<N> du, df;
   detail::scaling_for<N>(name(), scaling_, problem.size(), du, df);
   Vector<N> xs = x.cwiseProduct(du);
@@ -261,12 +270,9 @@ std::optional<Summary> Engine<N>::solve_scaled(const FixedPointProblem<N>& probl
   Summary s = unscaled(scaled, xs);
   // Back in the problem's variables, as the scaled map evaluated it: inside the box. (Component
   // by component: GCC 12 warns of Eigen's packet loads at N = 1.)
-  const auto back = [&](double v, Index i) {
-    double value = v / du[i];
-    if (original.lower.size() == du.size()) value = std::max(value, original.lower[i]);
-    if (original.upper.size() == du.size()) value = std::min(value, original.upper[i]);
-    return value;
-  };
+  detail::Box<N> box;
+  box.set(original, du.size());
+  const auto back = [&](double v, Index i) { return box.clamp(i, v / du[i]); };
   for (Index i = 0; i < x.size(); ++i) x[i] = back(xs[i], i);
   for (TraceEntry& t : s.trace) {
     if (t.x.size() != du.size()) continue;

@@ -2,7 +2,8 @@
 // Finite-difference ∂G for problems without a Jacobian. Steps h_j = c · max(1, |x_j|) with
 // c = √ε (forward, error O(h)) or ∛ε (central, error O(h²)), rounded so that x_j + h_j − x_j = h_j
 // exactly.
-// Inside a box (a bounded solve) no point leaves it: a forward step that would cross a bound is
+// Inside a box (a bounded solve) no point leaves it, nor reaches a strict bound (the room towards
+// one is half the distance to it): a forward step that would cross a bound is
 // taken backwards; a central pair that would is replaced by the one-sided second-order formula
 // (−3 f(x) + 4 f(x + h) − f(x + 2h)) / 2h towards the side with room, h shrunk to fit if needed
 // (same cost, same order); a component with lower = upper gets a zero column.
@@ -51,7 +52,8 @@ int finite_difference_jacobian(F&& f, const Vector<N>& x, const Vector<M>& fx, M
     bool one_sided = false;
     if (bounded) {
       const double lo = box->lower()[j], hi = box->upper()[j];
-      const double up = hi - x[j], down = x[j] - lo;  // the room on each side, ≥ 0
+      // The room on each side, ≥ 0 (half the distance to a strict bound).
+      const double up = box->room_above(j, x[j]), down = box->room_below(j, x[j]);
       const bool forward = scheme == FiniteDifference::kForward;
       if (forward ? h > up : (h > up || h > down)) {
         direction = up >= down ? 1.0 : -1.0;
@@ -63,6 +65,14 @@ int finite_difference_jacobian(F&& f, const Vector<N>& x, const Vector<M>& fx, M
         continue;
       }
       xp[j] = std::clamp(x[j] + direction * h, lo, hi);
+      const double far = std::clamp(x[j] + 2.0 * direction * h, lo, hi);
+      if (xp[j] == x[j] || box->on_strict_bound(j, xp[j]) ||
+          (one_sided && box->on_strict_bound(j, far))) {
+        // Within a few ulps of a strict bound on the only side with room: no point to take.
+        xp[j] = x[j];
+        jac.col(j).setZero();
+        continue;
+      }
     } else {
       xp[j] = x[j] + h;
     }

@@ -336,9 +336,9 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
     gradient_.noalias() = -(jac_.transpose() * f_);
     bool bound_held = false;
     if (box_.active()) {
+      const double g_max = gradient_.template lpNorm<Eigen::Infinity>();
       for (Index k = 0; k < n; ++k) {
-        if ((x_[k] <= box_.lower()[k] && gradient_[k] < 0.0) ||
-            (x_[k] >= box_.upper()[k] && gradient_[k] > 0.0)) {
+        if (box_.held(k, x_[k], gradient_[k], g_max)) {
           jac_.col(k).setZero();
           bound_held = true;
         }
@@ -426,7 +426,7 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
         }
       }
       xt_ = x_ + p_;
-      const bool projected = box_.project(xt_);
+      const bool projected = box_.project(xt_, x_);
       if (projected) p_ = xt_ - x_;
       const double pnorm = diag_.cwiseProduct(p_).norm();
       if (projected && pnorm == 0.0) {

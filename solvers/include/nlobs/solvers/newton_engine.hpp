@@ -138,7 +138,7 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
     t = t0;
     for (int k = 0; k <= newton_.max_backtracks && !system_.budget_spent(); ++k) {
       xt_ = x_ + t * d;
-      projected = box.project(xt_);
+      projected = box.project(xt_, x_);
       held_in_place = projected && xt_ == x_;
       if (held_in_place) return false;  // every component that would move is held
       const bool finite = system_.residual(xt_, ft_);

@@ -69,6 +69,7 @@ class NloptEngine : public Engine<N> {
   bool is_global() const { return !nlopt_.algorithm.empty() && nlopt_.algorithm[0] == 'G'; }
   // set_bounds replaces NloptOptions' bounds (a global algorithm still needs a finite box).
   bool accepts_bounds() const override { return true; }
+  bool accepts_strict_bounds() const override { return false; }  // NLopt's box is closed
 
   // min ½‖G(x) − x‖₂².
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;

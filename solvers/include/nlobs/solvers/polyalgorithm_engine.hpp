@@ -54,6 +54,10 @@ class PolyalgorithmEngine : public Engine<N> {
     return std::all_of(stages_.begin(), stages_.end(),
                        [](const auto& s) { return s->accepts_bounds(); });
   }
+  bool accepts_strict_bounds() const override {
+    return std::all_of(stages_.begin(), stages_.end(),
+                       [](const auto& s) { return s->accepts_strict_bounds(); });
+  }
 
   // A scaling reaches every stage (each solves in the scaled variables; the stages' residuals,
   // which auto compares, are then all ‖D_f F‖∞): accepted when every stage accepts one.

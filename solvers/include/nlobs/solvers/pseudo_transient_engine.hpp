@@ -177,7 +177,7 @@ Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vec
         break;
       }
       xt_ = x_ + p_;
-      projected = box.project(xt_);
+      projected = box.project(xt_, x_);
       if (projected && xt_ == x_) {
         if (const std::optional<Index> i = box.blocking(x_, p_)) {
           summary.message = box.blocked_message(*i, x_, f_.template lpNorm<Eigen::Infinity>(),

@@ -86,14 +86,12 @@ FixedPointProblem<N> scaled_problem(const FixedPointProblem<N>& problem, const V
   const FixedPointProblem<N>* p = &problem;
   const Vector<N> inverse_du = du.cwiseInverse();
   const Index n = problem.size();
-  Vector<N> lower = Vector<N>::Constant(n, -std::numeric_limits<double>::infinity());
-  Vector<N> upper = Vector<N>::Constant(n, std::numeric_limits<double>::infinity());
-  if (box.lower.size() == n) lower = box.lower;
-  if (box.upper.size() == n) upper = box.upper;
-  // x = D_u⁻¹ x̃, inside the box; then F̃ = D_f F(x) into `out`.
-  auto scaled_f = [p, inverse_du, df, lower, upper, x = Vector<N>(inverse_du),
-                   g = Vector<N>(inverse_du)](const Vector<N>& xs, Vector<N>& out) mutable {
-    x = xs.cwiseProduct(inverse_du).cwiseMax(lower).cwiseMin(upper);
+  Box<N> limits;
+  limits.set(box, n);
+  // x = D_u⁻¹ x̃, inside the box (off its strict sides); then F̃ = D_f F(x) into `out`.
+  auto scaled_f = [p, inverse_du, df, limits, x = Vector<N>(inverse_du), g = Vector<N>(inverse_du)](
+                      const Vector<N>& xs, Vector<N>& out) mutable {
+    for (Index i = 0; i < x.size(); ++i) x[i] = limits.clamp(i, xs[i] * inverse_du[i]);
     if (p->has_residual()) {
       p->residual(x, out);
       check_output_size(*p, out);
@@ -111,9 +109,9 @@ FixedPointProblem<N> scaled_problem(const FixedPointProblem<N>& problem, const V
   if (!problem.has_jacobian()) {
     return FixedPointProblem<N>::from_map(std::move(map), n).with_residual(std::move(scaled_f));
   }
-  auto scaled_df = [p, inverse_du, df, lower, upper, x = Vector<N>(inverse_du)](
+  auto scaled_df = [p, inverse_du, df, limits, x = Vector<N>(inverse_du)](
                        const Vector<N>& xs, Matrix<N, N>& jac) mutable {
-    x = xs.cwiseProduct(inverse_du).cwiseMax(lower).cwiseMin(upper);
+    for (Index i = 0; i < x.size(); ++i) x[i] = limits.clamp(i, xs[i] * inverse_du[i]);
     if (p->has_residual()) {
       p->residual_jacobian(x, jac);
     } else {

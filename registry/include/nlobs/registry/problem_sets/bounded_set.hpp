@@ -10,8 +10,8 @@
 //     10⁴ x1 x2 − 1 = 0, e^{−x1} + e^{−x2} − 1.001 = 0, on [5.49e−6, 4.553] × [2.196e−3, 18.21];
 //     root (1.450e−5, 6.8933353).
 //   shacham-cstr (n = 1): conversion in an isothermal CSTR [Sha86]:
-//     x/(1 − x) − 5 ln(0.4(1 − x)/(0.4 − 0.5x)) + 4.45977 = 0 on [0, 0.7999]; F is undefined
-//     from 0.8 on (NaN in (0.8, 1)); root 0.757396.
+//     x/(1 − x) − 5 ln(0.4(1 − x)/(0.4 − 0.5x)) + 4.45977 = 0 on [0, 0.8), a strict upper
+//     bound: F is undefined from 0.8 on (−inf at 0.8, NaN in (0.8, 1)); root 0.757396.
 #include "nlobs/registry/problem_sets.hpp"
 
 namespace nlobs {

@@ -1,0 +1,290 @@
+// Strict bounds (BoxBounds::strict_lower/strict_upper: lower < x, KINSOL's constraints ±2) on
+// every Newton-type engine: a problem whose F is undefined on its bound (ln c) solved without
+// one evaluation on or past it — AD and finite-difference Jacobians, scaled and unscaled — where
+// the closed box evaluates ln 0; a root past a strict bound ends blocked_by_bound naming it; bad
+// strict bounds refused with the engine's box kept; the suite judges a point on a strict bound
+// outside. Problems nlobs does not ship.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "nlobs/reference/problem_suite.hpp"
+#include "nlobs/registry/problem_sets.hpp"
+#include "nlobs/registry/problem_sets/bounded_set.hpp"
+#include "nlobs/solvers/builtin_engines.hpp"
+#include "test_support.hpp"
+
+namespace nlobs {
+namespace {
+
+const std::vector<std::string> kStrictEngines = {
+    "newton",  "newton:linesearch=1", "newton:trustregion=1", "dogleg",
+    "broyden", "levenberg-marquardt", "pseudo-transient",     "auto"};
+
+SolverOptions tight() {
+  SolverOptions o = test::tolerance(1e-12);
+  o.stop.residual_tolerance = 1e-10;
+  o.stop.max_evaluations = 5000;
+  return o;
+}
+
+// Three species in equilibrium: ln cᵢ + cᵢ + 0.1 Σ_{j≠i} cⱼ = aᵢ, defined for c > 0 only. The
+// roots are small (c₀ ≈ 6e-3): from c = 5 a Newton step lands far below zero.
+constexpr int kSpecies = 3;
+RootProblem<Dynamic> equilibrium() {
+  return RootProblem<Dynamic>::with_autodiff(
+      [](const auto& c, auto& out) {
+        using std::log;
+        const double a[kSpecies] = {-5.0, -2.0, 1.0};
+        for (int i = 0; i < kSpecies; ++i) {
+          out[i] = log(c[i]) + c[i] - a[i];
+          for (int j = 0; j < kSpecies; ++j) {
+            if (j != i) out[i] += 0.1 * c[j];
+          }
+        }
+      },
+      kSpecies, kSpecies);
+}
+
+BoxBounds positive(bool strict) {
+  BoxBounds b{Eigen::VectorXd::Zero(kSpecies), Eigen::VectorXd()};
+  if (strict) b.strict_lower = StrictBounds::Constant(kSpecies, true);
+  return b;
+}
+
+// G(x) = x + F(x), counting the points with some cᵢ ≤ 0; with_jacobian = false leaves the
+// Jacobian to the engines' differences.
+FixedPointProblem<Dynamic> counting(const RootProblem<Dynamic>& f, int& on_or_past_bound,
+                                    bool with_jacobian) {
+  auto g = [&f, &on_or_past_bound](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
+    if ((x.array() <= 0.0).any()) ++on_or_past_bound;
+    out.resize(x.size());
+    f.evaluate(x, out);
+    out += x;
+  };
+  if (!with_jacobian) return FixedPointProblem<Dynamic>::from_map(g, f.size());
+  auto dg = [&f, &on_or_past_bound](const Eigen::VectorXd& x, Eigen::MatrixXd& jac) {
+    if ((x.array() <= 0.0).any()) ++on_or_past_bound;
+    f.jacobian(x, jac);
+    jac += Eigen::MatrixXd::Identity(x.size(), x.size());
+  };
+  return FixedPointProblem<Dynamic>::with_jacobian(g, dg, f.size());
+}
+
+TEST(StrictBounds, EveryEngineSolvesWithoutEvaluatingOnTheBound) {
+  const RootProblem<Dynamic> f = equilibrium();
+  for (const bool scaled : {false, true}) {
+    for (const bool with_jacobian : {true, false}) {
+      for (const std::string& spec : kStrictEngines) {
+        // The scaled flow of pseudo-transient is D_u = 100 times slower in c₀ (docs/solvers.md,
+        // "Scaling"): 2985 iterations with AD, past the budget with differences.
+        if (scaled && spec == "pseudo-transient") continue;
+        const std::string run =
+            spec + (with_jacobian ? " (AD)" : " (differences)") + (scaled ? " scaled" : "");
+        auto engine = EngineRegistry<Dynamic>::global().create(spec, tight());
+        engine->set_bounds(positive(true));
+        // D_u of the roots' orders: the scaled solve's D_u⁻¹ x̃ must stay off the bound too.
+        if (scaled) engine->set_scaling({Eigen::Vector3d(100.0, 10.0, 1.0), Eigen::VectorXd()});
+        int on_bound = 0;
+        Eigen::VectorXd c = Eigen::VectorXd::Constant(kSpecies, 5.0);
+        const Summary s = engine->solve(counting(f, on_bound, with_jacobian), c);
+        EXPECT_EQ(on_bound, 0) << run;
+        EXPECT_TRUE(s.usable()) << run << ": " << s.brief_report() << " " << s.message;
+        EXPECT_TRUE((c.array() > 0.0).all()) << run << ": " << c.transpose();
+        Eigen::VectorXd fc(kSpecies);
+        f.evaluate(c, fc);
+        EXPECT_LT(fc.norm(), 1e-8) << run << ": " << c.transpose();
+      }
+    }
+  }
+}
+
+// What the strict side prevents: the closed box [0, ∞) lets Newton's first step land on c = 0,
+// where ln 0 = −∞.
+TEST(StrictBounds, TheClosedBoxEvaluatesOnTheBoundWhereTheStrictOneDoesNot) {
+  const RootProblem<Dynamic> f = equilibrium();
+  for (const bool strict : {false, true}) {
+    auto engine = EngineRegistry<Dynamic>::global().create("newton", tight());
+    engine->set_bounds(positive(strict));
+    int on_bound = 0;
+    Eigen::VectorXd c = Eigen::VectorXd::Constant(kSpecies, 5.0);
+    const Summary s = engine->solve(counting(f, on_bound, true), c);
+    if (strict) {
+      EXPECT_EQ(on_bound, 0);
+      EXPECT_TRUE(s.converged()) << s.brief_report();
+    } else {
+      EXPECT_GT(on_bound, 0) << s.brief_report();
+    }
+  }
+}
+
+TEST(StrictBounds, ARootPastAStrictBoundEndsBlockedByBoundNamingIt) {
+  // F(x) = (x₁ + 1 + 0.1 x₁², x₂ − 2) on x₁ > 0: the root (−1, 2) lies past the strict bound;
+  // steps towards it stop short of 0, each closer, until the room left is negligible.
+  const auto f = RootProblem<2>::with_autodiff([](const auto& x) {
+    using T = typename std::decay_t<decltype(x)>::Scalar;
+    Eigen::Matrix<T, 2, 1> out;
+    out << x[0] + 1.0 + 0.1 * x[0] * x[0], x[1] - 2.0;
+    return out;
+  });
+  for (const std::string& spec : kStrictEngines) {
+    auto engine = EngineRegistry<2>::global().create(spec, tight());
+    BoxBounds box{Eigen::Vector2d(0.0, -10.0), Eigen::Vector2d(10.0, 10.0)};
+    box.strict_lower = StrictBounds::Constant(2, false);
+    box.strict_lower[0] = true;
+    engine->set_bounds(box);
+    int on_bound = 0;
+    const auto g = FixedPointProblem<2>::with_jacobian(
+        [&](const Vector<2>& x, Vector<2>& out) {
+          if (x[0] <= 0.0) ++on_bound;
+          f.evaluate(x, out);
+          out += x;
+        },
+        [&](const Vector<2>& x, Matrix<2, 2>& jac) {
+          f.jacobian(x, jac);
+          jac += Matrix<2, 2>::Identity();
+        });
+    Vector<2> x(3.0, 0.0);
+    const Summary s = engine->solve(g, x);
+    EXPECT_EQ(on_bound, 0) << spec;
+    EXPECT_GT(x[0], 0.0) << spec;
+    EXPECT_LT(x[0], 1e-4) << spec;
+    EXPECT_EQ(s.status, Status::kBlockedByBound)
+        << spec << ": " << s.brief_report() << " at " << x.transpose();
+    EXPECT_NE(s.message.find("next to its strict lower bound 0"), std::string::npos)
+        << spec << ": " << s.message;
+    // Once x₁ is held, pseudo-transient's flow takes ~700 small steps to settle x₂ (as in a
+    // closed box; auto runs it last); the others stop within a few dozen evaluations.
+    const bool flow = spec == "pseudo-transient" || spec == "auto";
+    EXPECT_LT(s.function_evaluations, flow ? 1000 : 100) << spec;
+  }
+}
+
+TEST(StrictBounds, BadStrictBoundsAreRefusedAndTheEngineKeepsItsBox) {
+  auto engine = EngineRegistry<Dynamic>::global().create("newton", tight());
+  engine->set_bounds(positive(true));
+  BoxBounds wrong_size = positive(true);
+  wrong_size.strict_lower = StrictBounds::Constant(2, true);
+  EXPECT_NE(test::message_of([&] {
+              engine->set_bounds(wrong_size);
+            }).find("strict_lower has 2 flags, lower_bounds 3 bounds"),
+            std::string::npos);
+  BoxBounds without_bound;
+  without_bound.strict_upper = StrictBounds::Constant(3, true);
+  EXPECT_NE(test::message_of([&] {
+              engine->set_bounds(without_bound);
+            }).find("strict_upper has 3 flags, upper_bounds 0 bounds"),
+            std::string::npos);
+  BoxBounds empty_interior{Eigen::Vector3d(0.0, 1.0, 0.0), Eigen::Vector3d(1.0, 1.0, 1.0)};
+  empty_interior.strict_upper = StrictBounds::Constant(3, false);
+  empty_interior.strict_upper[1] = true;
+  EXPECT_NE(test::message_of([&] {
+              engine->set_bounds(empty_interior);
+            }).find("lower_bounds[1] = upper_bounds[1] = 1 with a strict side"),
+            std::string::npos);
+  ASSERT_EQ(engine->bounds().strict_lower.size(), kSpecies);  // the box it had
+  EXPECT_TRUE(engine->bounds().strict_lower.all());
+
+  // A start on a strict bound is refused at solve, naming the component, scaled or not.
+  const FixedPointProblem<Dynamic> g = to_fixed_point(equilibrium());
+  for (const bool scaled : {false, true}) {
+    if (scaled) engine->set_scaling({Eigen::Vector3d(100.0, 10.0, 1.0), Eigen::VectorXd()});
+    Eigen::VectorXd on_bound(3);
+    on_bound << 1.0, 0.0, 1.0;
+    const std::string message = test::message_of([&] { engine->solve(g, on_bound); });
+    EXPECT_NE(message.find("x0[1] = 0 lies on its strict lower bound"), std::string::npos)
+        << message;
+    EXPECT_EQ(on_bound[1], 0.0);
+  }
+
+  // Ceres' and NLopt's boxes are closed: they refuse strict sides and keep their box.
+  for (const char* spec : {"ceres", "nlopt:LD_SLSQP"}) {
+    auto closed_only = EngineRegistry<Dynamic>::global().create(spec, tight());
+    EXPECT_TRUE(closed_only->accepts_bounds()) << spec;
+    EXPECT_FALSE(closed_only->accepts_strict_bounds()) << spec;
+    EXPECT_NE(test::message_of([&] {
+                closed_only->set_bounds(positive(true));
+              }).find("keeps x in a closed box only"),
+              std::string::npos)
+        << spec;
+    EXPECT_TRUE(closed_only->bounds().empty()) << spec;
+  }
+  EXPECT_TRUE(EngineRegistry<Dynamic>::global().create("auto")->accepts_strict_bounds());
+  EXPECT_FALSE(
+      EngineRegistry<Dynamic>::global().create("auto:order=newton/ceres")->accepts_strict_bounds());
+}
+
+TEST(StrictBounds, ProblemSetsCarryThemAndTheSuiteJudgesTheBoundOutside) {
+  TestProblem p{.name = "equilibrium",
+                .residual = equilibrium(),
+                .starts = {{"fives", Eigen::VectorXd::Constant(kSpecies, 5.0)}}};
+  p.lower = Eigen::VectorXd::Zero(kSpecies);
+  p.strict_lower = StrictBounds::Constant(kSpecies, true);
+  EXPECT_TRUE(p.first_outside_bounds(Eigen::Vector3d(1.0, 1e-300, 1.0)) == std::nullopt);
+  EXPECT_EQ(p.first_outside_bounds(Eigen::Vector3d(1.0, 0.0, 1.0)), Index{1});
+  ProblemSetEntry set;
+  set.name = "strict-test";
+  set.problems = [p] { return std::vector<TestProblem>{p}; };
+  const std::vector<TestProblem> problems = build_problem_set(set);
+  const auto rows = reference::run_suite(set, problems, {"newton", "auto", "minpack:hybrj"});
+  ASSERT_EQ(rows.size(), 3U);
+  for (const reference::SuiteRow& row : rows) {
+    if (row.solver == "minpack:hybrj") continue;  // unbounded, judged alike
+    EXPECT_TRUE(row.solved) << row.solver << ": " << row.status << " " << row.message;
+  }
+
+  // A start on a strict bound, or strict flags that do not fit, are the set's errors.
+  ProblemSetEntry bad = set;
+  bad.problems = [p] {
+    TestProblem q = p;
+    q.starts = {{"on-bound", Eigen::Vector3d(1.0, 0.0, 1.0)}};
+    return std::vector<TestProblem>{q};
+  };
+  EXPECT_NE(test::message_of([&] { build_problem_set(bad); }).find("on-bound"), std::string::npos);
+  bad.problems = [p] {
+    TestProblem q = p;
+    q.strict_lower = StrictBounds::Constant(2, true);
+    return std::vector<TestProblem>{q};
+  };
+  EXPECT_NE(test::message_of([&] {
+              build_problem_set(bad);
+            }).find("strict_lower has 2 flags, lower 3 bounds"),
+            std::string::npos);
+}
+
+TEST(StrictBounds, ShachamsReactorOnItsOpenInterval) {
+  // x < 0.8 strictly: at 0.8 the log's argument divides by zero. From 0.5 Newton's step lands at
+  // 2.0; it stops at 0.8 − 0.01 · 0.3 and converges to 0.757396.
+  const std::vector<TestProblem> problems = build_problem_set(bounded_problem_set());
+  const TestProblem& p = problems.back();
+  ASSERT_EQ(p.name, "shacham-cstr");
+  ASSERT_EQ(p.strict_upper.size(), 1);
+  EXPECT_TRUE(p.strict_upper[0]);
+  NewtonEngine<> newton({}, tight());
+  newton.set_bounds(p.bounds());
+  int at_or_past = 0;
+  const auto f = p.residual;
+  const auto g = FixedPointProblem<Dynamic>::with_jacobian(
+      [&](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
+        if (x[0] >= 0.8) ++at_or_past;
+        out.resize(1);
+        f.evaluate(x, out);
+        out += x;
+      },
+      [&](const Eigen::VectorXd& x, Eigen::MatrixXd& jac) {
+        f.jacobian(x, jac);
+        jac(0, 0) += 1.0;
+      },
+      1);
+  Eigen::VectorXd x = Eigen::VectorXd::Constant(1, 0.5);
+  const Summary s = newton.solve(g, x);
+  EXPECT_TRUE(s.converged()) << s.brief_report();
+  EXPECT_NEAR(x[0], 0.7573962462537539, 1e-9);
+  EXPECT_EQ(at_or_past, 0);
+}
+
+}  // namespace
+}  // namespace nlobs
