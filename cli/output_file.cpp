@@ -11,6 +11,7 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <iostream>
 #include <mutex>
 #include <stdexcept>
 #include <vector>
@@ -97,14 +98,29 @@ mode_t new_file_mode() {
   return mode;
 }
 
-enum class Kind { kReplace, kInPlace };
+enum class Kind { kReplace, kInPlace, kStandardStream };
 
 struct Target {
   Kind kind;
   fs::path file;  // the file replaced (a link's target) or written in place
   bool exists;
   struct stat status;
+  int descriptor = -1;  // kStandardStream: STDOUT_FILENO or STDERR_FILENO
 };
+
+// STDOUT_FILENO or STDERR_FILENO when `st` is the file this process's standard output or error
+// writes to (`--csv /dev/stdout > rows.csv`, or `--csv rows.csv > rows.csv`); else -1. Such a
+// file is written through that descriptor: replacing it would leave the shell's redirection
+// writing to an unlinked file and the user with half of the output.
+int standard_stream_of(const struct stat& st) {
+  for (const int fd : {STDOUT_FILENO, STDERR_FILENO}) {
+    struct stat stream {};
+    if (::fstat(fd, &stream) == 0 && stream.st_dev == st.st_dev && stream.st_ino == st.st_ino) {
+      return fd;
+    }
+  }
+  return -1;
+}
 
 // How `path` is written (output_file.hpp).
 Target classify(const fs::path& path) {
@@ -124,6 +140,11 @@ Target classify(const fs::path& path) {
                                  "through a link only to an existing file)");
       }
       fail("cannot write", path, errno);
+    }
+  }
+  if (!S_ISDIR(final.st_mode)) {
+    if (const int fd = standard_stream_of(final); fd >= 0) {
+      return {Kind::kStandardStream, path, true, final, fd};
     }
   }
   if (S_ISREG(final.st_mode)) {
@@ -205,7 +226,14 @@ OutputFile::OutputFile(const fs::path& path) : state_(std::make_unique<State>())
   s.path = path;
   const Target target = classify(path);
   s.file = target.file;
-  if (target.kind == Kind::kInPlace) {
+  if (target.kind == Kind::kStandardStream) {
+    // A duplicate shares the stream's file offset (and O_APPEND): the content lands after what
+    // the process printed so far, as if printed itself. What std::cout holds goes first.
+    std::cout.flush();
+    std::cerr.flush();
+    s.fd = ::fcntl(target.descriptor, F_DUPFD_CLOEXEC, 3);
+    if (s.fd < 0) fail("cannot write", path, errno);
+  } else if (target.kind == Kind::kInPlace) {
     // O_NONBLOCK: a FIFO with no reader fails at once (ENXIO) instead of blocking for ever;
     // blocking writes again afterwards. No O_TRUNC, no O_CREAT: nothing is replaced.
     s.fd = ::open(path.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC | O_NONBLOCK);
@@ -273,6 +301,7 @@ bool OutputFile::empty() const {
 void OutputFile::commit() {
   State& s = *state_;
   const fs::path& written = s.temporary.empty() ? s.path : s.temporary;
+  if (s.temporary.empty()) std::cout.flush();  // in place: what was printed before comes first
   s.out.flush();
   if (!s.buffer.drain()) fail("writing", written, s.buffer.error());
   if (!s.temporary.empty() && ::fsync(s.fd) != 0) fail("writing", written, errno);

@@ -10,6 +10,10 @@
 //   A replaced file keeps its permission bits (and, when nlobs runs as root, its owner);
 // * a symbolic link to a regular file: the file it points to is replaced as above, in its own
 //   directory; the link stays a link;
+// * the file this process's standard output or error writes to (`--csv /dev/stdout > rows.csv`,
+//   `--csv rows.csv > rows.csv`), whatever it is: written through a duplicate of that descriptor,
+//   after what the process printed, never replaced (that would leave the redirection writing to
+//   an unlinked file);
 // * a FIFO or a character device (a pipe `>(gzip > x)`, /dev/stdout, /dev/null): written in
 //   place, never replaced; a FIFO nobody reads is refused at once instead of blocking;
 // * a directory, a block device, a socket, a link to none of the above or to nothing: refused,

@@ -13,6 +13,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 #include <string>
 
@@ -160,6 +161,38 @@ TEST(OutputFile, DevicesAreWrittenNotReplaced) {
   const std::string full = error_writing("/dev/full", std::string(200000, 'x'));
   EXPECT_TRUE(contains(full, "writing '/dev/full': No space left on device")) << full;
   EXPECT_TRUE(fs::is_character_file("/dev/full"));
+}
+
+// `--csv /dev/stdout > rows.csv` (or `--csv rows.csv > rows.csv`): the file the shell redirected
+// standard output to is written through that descriptor, after what was printed, and keeps its
+// inode; replacing it left the table in an unlinked file and rows.csv holding the CSV alone.
+TEST(OutputFile, TheFileStandardOutputWritesToIsAppendedToNotReplaced) {
+  const fs::path dir = scratch("stdout");
+  fs::create_directories(dir);
+  const fs::path file = dir / "rows.csv";
+  for (const fs::path& name : {fs::path("/dev/stdout"), file}) {
+    std::cout.flush();
+    const int saved = ::dup(STDOUT_FILENO);
+    ASSERT_GE(saved, 0);
+    const int redirected = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ASSERT_GE(redirected, 0);
+    struct stat before {};
+    ASSERT_EQ(::fstat(redirected, &before), 0);
+    ASSERT_GE(::dup2(redirected, STDOUT_FILENO), 0);
+    ::close(redirected);
+    std::cout << "table\n";
+    const std::string error = error_writing(name, "rows\n");
+    std::cout << "footer\n";
+    std::cout.flush();
+    ::dup2(saved, STDOUT_FILENO);
+    ::close(saved);
+    EXPECT_EQ(error, "") << name;
+    struct stat after {};
+    ASSERT_EQ(::stat(file.c_str(), &after), 0);
+    EXPECT_EQ(after.st_ino, before.st_ino) << name;
+    EXPECT_EQ(read(file), "table\nrows\nfooter\n") << name;
+    EXPECT_EQ(entries(dir), 1U) << name;
+  }
 }
 
 // A disk that fills up (here: a file size limit) fails the commit with the system's reason and
