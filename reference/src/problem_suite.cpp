@@ -20,6 +20,22 @@
 namespace nlobs::reference {
 namespace {
 
+// The largest closed box inside the problem's: each strict bound one ulp inward. For the engines
+// whose boxes are closed (Ceres, NLopt): they never evaluate F on a strict bound either.
+BoxBounds closed_inside(const TestProblem& p) {
+  BoxBounds box{p.lower, p.upper};
+  const double inf = std::numeric_limits<double>::infinity();
+  for (Index i = 0; i < p.strict_lower.size(); ++i) {
+    if (p.strict_lower[i] && std::isfinite(box.lower[i]))
+      box.lower[i] = std::nextafter(box.lower[i], inf);
+  }
+  for (Index i = 0; i < p.strict_upper.size(); ++i) {
+    if (p.strict_upper[i] && std::isfinite(box.upper[i]))
+      box.upper[i] = std::nextafter(box.upper[i], -inf);
+  }
+  return box;
+}
+
 struct Outcome {
   std::string status;
   long f_evals = 0, j_evals = 0;
@@ -438,12 +454,11 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
             o.stop.max_evaluations = static_cast<int>(std::min<long>(budget, 1L << 30));
             auto engine = registry.create(s, o);
             // The problem's box reaches the engines that take bounds (its strict sides those
-            // that take them; Ceres and NLopt the closed box); the others run unbounded and are
-            // judged alike (outside_bounds). levenberg-marquardt:geodesic=1 and a user's engine
-            // may refuse it: invalid_input.
+            // that take them; Ceres and NLopt the closed box inside it); the others run
+            // unbounded and are judged alike (outside_bounds). levenberg-marquardt:geodesic=1
+            // and a user's engine may refuse it: invalid_input.
             if ((p.lower.size() > 0 || p.upper.size() > 0) && engine->accepts_bounds()) {
-              engine->set_bounds(engine->accepts_strict_bounds() ? p.bounds()
-                                                                 : BoxBounds{p.lower, p.upper});
+              engine->set_bounds(engine->accepts_strict_bounds() ? p.bounds() : closed_inside(p));
             }
             // The problem's scaling likewise (the Newton-type engines; docs/solvers.md).
             if ((p.u_scale.size() > 0 || p.f_scale.size() > 0) && engine->accepts_scaling()) {
