@@ -50,43 +50,35 @@ Summary DynamicSizeEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<
     return engine_->solve(problem, x);
   } else {
     detail::check_initial_guess(name(), problem, x);
-    const auto g = [&problem](const Vector<Dynamic>& at, Vector<Dynamic>& out) {
-      const Vector<N> point = at;
-      Vector<N> value = Vector<N>::Zero();
-      problem.evaluate(point, value);
-      out.resize(N);
-      std::copy(value.data(), value.data() + N, out.data());
+    // A map of the fixed-size problem (`member`: evaluate or residual), and a Jacobian
+    // (jacobian or residual_jacobian), called on dynamic vectors. Copied element-wise: GCC 12
+    // warns (-Warray-bounds) on Eigen's packet copy at N = 1.
+    const auto values = [&problem](auto member) {
+      return [&problem, member](const Vector<Dynamic>& at, Vector<Dynamic>& out) {
+        const Vector<N> point = at;
+        Vector<N> value = Vector<N>::Zero();
+        (problem.*member)(point, value);
+        out.resize(N);
+        std::copy(value.data(), value.data() + N, out.data());
+      };
     };
+    const auto jacobians = [&problem](auto member) {
+      return [&problem, member](const Vector<Dynamic>& at, Matrix<Dynamic, Dynamic>& jac) {
+        const Vector<N> point = at;
+        Matrix<N, N> j = Matrix<N, N>::Zero();
+        (problem.*member)(point, j);
+        jac.resize(N, N);
+        std::copy(j.data(), j.data() + N * N, jac.data());
+      };
+    };
+    const auto g = values(&FixedPointProblem<N>::evaluate);
     // The residual form F (FixedPointProblem::residual) goes along when the problem has one.
-    const auto f = [&problem](const Vector<Dynamic>& at, Vector<Dynamic>& out) {
-      const Vector<N> point = at;
-      Vector<N> value = Vector<N>::Zero();
-      problem.residual(point, value);
-      out.resize(N);
-      std::copy(value.data(), value.data() + N, out.data());
-    };
-    const auto copy_jacobian = [](const Matrix<N, N>& j, Matrix<Dynamic, Dynamic>& jac) {
-      // Element-wise: GCC 12 warns (-Warray-bounds) on Eigen's packet copy at N = 1.
-      jac.resize(N, N);
-      std::copy(j.data(), j.data() + N * N, jac.data());
-    };
+    const auto f = values(&FixedPointProblem<N>::residual);
     Vector<Dynamic> xd = x;
     Summary s;
     if (problem.has_jacobian()) {
-      const auto dg = [&problem, copy_jacobian](const Vector<Dynamic>& at,
-                                                Matrix<Dynamic, Dynamic>& jac) {
-        const Vector<N> point = at;
-        Matrix<N, N> j = Matrix<N, N>::Zero();
-        problem.jacobian(point, j);
-        copy_jacobian(j, jac);
-      };
-      const auto df = [&problem, copy_jacobian](const Vector<Dynamic>& at,
-                                                Matrix<Dynamic, Dynamic>& jac) {
-        const Vector<N> point = at;
-        Matrix<N, N> j = Matrix<N, N>::Zero();
-        problem.residual_jacobian(point, j);
-        copy_jacobian(j, jac);
-      };
+      const auto dg = jacobians(&FixedPointProblem<N>::jacobian);
+      const auto df = jacobians(&FixedPointProblem<N>::residual_jacobian);
       auto dynamic = FixedPointProblem<Dynamic>::with_jacobian(g, dg, N, problem.jacobian_source());
       s = engine_->solve(problem.has_residual() ? dynamic.with_residual(f, df) : dynamic, xd);
     } else {

@@ -159,29 +159,26 @@ class PolyalgorithmEngine : public Engine<N> {
   }
 
  private:
-  // Every stage takes the box, or none does: a stage that refuses it (levenberg-marquardt with
-  // geodesic acceleration) puts the stages before it back to their own.
-  void on_set_bounds() override {
-    std::vector<BoxBounds> previous;
-    for (const auto& s : stages_) previous.push_back(s->bounds());
+  // Every stage takes the box (the scaling), or none does: a stage that refuses it
+  // (levenberg-marquardt with geodesic acceleration refuses a box) puts the stages before it
+  // back to their own, read through `get`.
+  template <typename T, typename Get, typename Set>
+  void set_on_every_stage(const T& value, Get get, Set set) {
+    std::vector<T> previous;
+    for (const auto& s : stages_) previous.push_back(((*s).*get)());
     std::size_t k = 0;
     try {
-      for (; k < stages_.size(); ++k) stages_[k]->set_bounds(this->bounds_);
+      for (; k < stages_.size(); ++k) ((*stages_[k]).*set)(value);
     } catch (...) {
-      for (std::size_t j = 0; j < k; ++j) stages_[j]->set_bounds(previous[j]);
+      for (std::size_t j = 0; j < k; ++j) ((*stages_[j]).*set)(previous[j]);
       throw;
     }
   }
+  void on_set_bounds() override {
+    set_on_every_stage(this->bounds_, &Engine<N>::bounds, &Engine<N>::set_bounds);
+  }
   void on_set_scaling() override {
-    std::vector<Scaling> previous;
-    for (const auto& s : stages_) previous.push_back(s->scaling());
-    std::size_t k = 0;
-    try {
-      for (; k < stages_.size(); ++k) stages_[k]->set_scaling(this->scaling_);
-    } catch (...) {
-      for (std::size_t j = 0; j < k; ++j) stages_[j]->set_scaling(previous[j]);
-      throw;
-    }
+    set_on_every_stage(this->scaling_, &Engine<N>::scaling, &Engine<N>::set_scaling);
   }
   std::vector<std::unique_ptr<Engine<N>>> stages_;
   std::vector<int> caps_;
