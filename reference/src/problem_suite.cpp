@@ -20,18 +20,31 @@
 namespace nlobs::reference {
 namespace {
 
-// The largest closed box inside the problem's: each strict bound one ulp inward. For the engines
-// whose boxes are closed (Ceres, NLopt): they never evaluate F on a strict bound either.
+// A closed box inside the problem's: each strict bound √ε · max(1, |bound|) inward. For the
+// engines whose boxes are closed (Ceres, NLopt): they never evaluate F on a strict bound either.
+// One ulp inward is not enough: where F is ln c, its derivative 1/c at c = 5e-324 is infinite,
+// and a method that jumps to the bound (NLopt's SLSQP does) stops on a non-finite Jacobian.
 BoxBounds closed_inside(const TestProblem& p) {
   BoxBounds box{p.lower, p.upper};
+  const double margin = std::sqrt(std::numeric_limits<double>::epsilon());
+  auto inward = [margin](double bound, double towards) {
+    return bound + std::copysign(margin * std::max(1.0, std::abs(bound)), towards);
+  };
+  // Never past the other side (or its own inward point): the box stays valid, if thin.
+  const Index n = std::max(p.lower.size(), p.upper.size());
+  auto other = [&](const Eigen::VectorXd& side, Index i, double none) {
+    return side.size() == n ? side[i] : none;
+  };
   const double inf = std::numeric_limits<double>::infinity();
   for (Index i = 0; i < p.strict_lower.size(); ++i) {
-    if (p.strict_lower[i] && std::isfinite(box.lower[i]))
-      box.lower[i] = std::nextafter(box.lower[i], inf);
+    if (p.strict_lower[i] && std::isfinite(box.lower[i])) {
+      box.lower[i] = std::min(inward(box.lower[i], 1.0), other(p.upper, i, inf));
+    }
   }
   for (Index i = 0; i < p.strict_upper.size(); ++i) {
-    if (p.strict_upper[i] && std::isfinite(box.upper[i]))
-      box.upper[i] = std::nextafter(box.upper[i], -inf);
+    if (p.strict_upper[i] && std::isfinite(box.upper[i])) {
+      box.upper[i] = std::max(inward(box.upper[i], -1.0), other(box.lower, i, -inf));
+    }
   }
   return box;
 }

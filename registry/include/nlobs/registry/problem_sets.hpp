@@ -42,7 +42,7 @@ struct TestProblem {
   Eigen::VectorXd lower{}, upper{};
   // Strict bounds (lower_i < x_i, x_i < upper_i; BoxBounds): one flag per bound, each empty for
   // a closed side. A point on a strict bound is outside; the engines that take strict bounds
-  // never evaluate F there; in the suite Ceres and NLopt get the closed box one ulp inside.
+  // never evaluate F there; in the suite Ceres and NLopt get a closed box √ε inside.
   StrictBounds strict_lower{}, strict_upper{};
   // Known solutions: the suite reports the ∞-norm distance of the answer to the nearest one.
   std::vector<Eigen::VectorXd> solutions{};

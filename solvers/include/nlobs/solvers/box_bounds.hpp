@@ -11,6 +11,7 @@
 // An empty vector means "no bound on that side"; ±inf entries mean no bound on that component.
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -154,6 +155,9 @@ void require_inside_box(std::string_view owner, const BoxBounds& b, const Vector
 // The bounds of one solve as vectors of the problem's size (±inf where a side is absent), for
 // engines that keep every iterate — and every finite-difference point — inside the box. Sized
 // in start(): at a fixed N nothing allocates.
+// What an engine asks the box to block: a step in x, or only a direction (a gradient).
+enum class BoxMove { kStep, kDirection };
+
 template <int N>
 class Box {
  public:
@@ -239,24 +243,38 @@ class Box {
     return (strict_lower_[j] && v <= lower_[j]) || (strict_upper_[j] && v >= upper_[j]);
   }
 
-  // Whether a bound holds x_i against a move d_i: on a closed bound it points out of; within
-  // kNegligible · d_max of a strict one it points to.
-  bool held(Index i, double x, double d, double d_max) const {
-    if (d < 0.0) return strict_lower_[i] ? x - lower_[i] <= kNegligible * d_max : x <= lower_[i];
-    if (d > 0.0) return strict_upper_[i] ? upper_[i] - x <= kNegligible * d_max : x >= upper_[i];
+  // Whether x_i sits on a closed bound that d_i points out of: the active set of a projected
+  // method (a strict bound is never reached, so it holds nothing here).
+  bool on_closed_bound_against(Index i, double x, double d) const {
+    if (d < 0.0) return !strict_lower_[i] && x <= lower_[i];
+    if (d > 0.0) return !strict_upper_[i] && x >= upper_[i];
     return false;
   }
 
-  // Whether the box stops x from moving along d: some component is held (above) and what the
-  // box lets through, P(x + d) − x, is at most kNegligible of ‖d‖∞. Then the first held
-  // component; else none.
-  std::optional<Index> blocking(const Vector<N>& x, const Vector<N>& d) const {
+  // Whether a bound holds x_i against a move d_i: a closed bound as above; a strict one it points
+  // to when the room left is negligible, at most kNegligible · max(1, |bound|, |s_i|) with s_i the
+  // step's own length (0 when d is only a direction, such as a gradient, whose entries are not
+  // lengths of x). Asked only once an engine is stuck, so a tiny-scale x near a strict bound at
+  // worst ends blocked_by_bound instead of stagnated, both failures.
+  bool held(Index i, double x, double d, double step_length) const {
+    if (on_closed_bound_against(i, x, d)) return true;
+    const bool to_strict = d < 0.0 ? strict_lower_[i] : d > 0.0 && strict_upper_[i];
+    if (!to_strict) return false;
+    const double bound = d < 0.0 ? lower_[i] : upper_[i];
+    const double room = std::abs(x - bound);
+    return room <= kNegligible * std::max({1.0, std::abs(bound), step_length});
+  }
+
+  // Whether the box stops x from moving along d (a step in x, or only a direction): some
+  // component is held (above) and what the box lets through, P(x + d) − x, is at most
+  // kNegligible of ‖d‖∞. Then the first held component; else none.
+  std::optional<Index> blocking(const Vector<N>& x, const Vector<N>& d, BoxMove move) const {
     if (!active_) return std::nullopt;
     const double d_max = d.template lpNorm<Eigen::Infinity>();
     std::optional<Index> first_held;
     double through = 0.0;
     for (Index i = 0; i < x.size(); ++i) {
-      if (held(i, x[i], d[i], d_max)) {
+      if (held(i, x[i], d[i], move == BoxMove::kStep ? std::abs(d[i]) : 0.0)) {
         if (!first_held) first_held = i;
       } else {
         through = std::max(through, std::abs(projected(i, x[i] + d[i], x[i]) - x[i]));
@@ -270,12 +288,18 @@ class Box {
   std::string blocked_message(Index i, const Vector<N>& x, double residual_norm,
                               std::string_view direction) const {
     const bool lower = x[i] - lower_[i] <= upper_[i] - x[i];
-    const bool strict = lower ? strict_lower_[i] : strict_upper_[i];
+    const double bound = lower ? lower_[i] : upper_[i];
     std::ostringstream os;
-    os << "x[" << i << "] = " << x[i] << " is held " << (strict ? "next to its strict " : "at its ")
-       << (lower ? "lower" : "upper") << " bound" << (strict ? " " : "");
-    if (strict) os << (lower ? lower_[i] : upper_[i]);
-    os << ": " << direction << " points out of the box there (|F| = " << residual_norm << ")";
+    os << "x[" << i << "] = " << std::setprecision(std::numeric_limits<double>::max_digits10)
+       << x[i] << std::setprecision(6);
+    if (lower ? strict_lower_[i] : strict_upper_[i]) {
+      os << " is held next to its strict " << (lower ? "lower" : "upper") << " bound " << bound
+         << " (" << std::abs(x[i] - bound) << " from it): " << direction << " points past it";
+    } else {
+      os << " is held at its " << (lower ? "lower" : "upper") << " bound: " << direction
+         << " points out of the box there";
+    }
+    os << " (|F| = " << residual_norm << ")";
     return os.str();
   }
 

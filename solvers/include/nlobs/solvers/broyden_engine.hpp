@@ -72,6 +72,7 @@ class BroydenEngine : public Engine<N> {
   std::string_view name() const override { return "broyden"; }
   const BroydenOptions& broyden_options() const { return broyden_; }
   bool accepts_bounds() const override { return true; }
+  bool accepts_strict_bounds() const override { return true; }
   bool accepts_scaling() const override { return true; }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
@@ -192,7 +193,8 @@ Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& 
         if (fresh) continue;
       } else {
         gradient_.noalias() = -(jac_.transpose() * f_);
-        if (const std::optional<Index> i = box.blocking(x_, gradient_)) {
+        if (const std::optional<Index> i =
+                box.blocking(x_, gradient_, detail::BoxMove::kDirection)) {
           summary.message = box.blocked_message(*i, x_, fnorm, "the descent direction");
           status = Status::kBlockedByBound;
         } else {

@@ -75,6 +75,7 @@ class DoglegEngine : public Engine<N> {
   std::string_view name() const override { return "dogleg"; }
   const DoglegOptions& dogleg_options() const { return dogleg_; }
   bool accepts_bounds() const override { return true; }
+  bool accepts_strict_bounds() const override { return true; }
   bool accepts_scaling() const override { return true; }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
@@ -214,7 +215,7 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
   auto stop_stuck = [&](const char* why) {
     gradient_.noalias() = r_.template triangularView<Eigen::Upper>().transpose() * qtf_;
     gradient_ = -gradient_;
-    if (const std::optional<Index> i = box.blocking(x_, gradient_)) {
+    if (const std::optional<Index> i = box.blocking(x_, gradient_, detail::BoxMove::kDirection)) {
       summary.message = box.blocked_message(*i, x_, f_.template lpNorm<Eigen::Infinity>(),
                                             "the descent direction");
       status = Status::kBlockedByBound;

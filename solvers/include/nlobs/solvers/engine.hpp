@@ -67,8 +67,9 @@ class Engine {
   virtual bool accepts_bounds() const { return false; }
   // Strict sides (BoxBounds::strict_lower/strict_upper: lower < x): the Newton-type engines stop
   // a step that would reach one at a fraction of the way (nlobs/solvers/box_bounds.hpp) and never
-  // evaluate G on it; Ceres and NLopt, whose boxes are closed, refuse them at set_bounds.
-  virtual bool accepts_strict_bounds() const { return accepts_bounds(); }
+  // evaluate G on it. An engine must say so: the others (Ceres and NLopt, whose boxes are closed,
+  // and any plugin that does not override this) refuse them at set_bounds.
+  virtual bool accepts_strict_bounds() const { return false; }
   void set_bounds(BoxBounds bounds) {
     if (!bounds.empty() && !accepts_bounds()) {
       throw InvalidInput(std::string(name()) +
@@ -82,7 +83,8 @@ class Engine {
     if (bounds.any_strict() && !accepts_strict_bounds()) {
       throw InvalidInput(std::string(name()) +
                          " keeps x in a closed box only; engines that take strict bounds: "
-                         "newton, dogleg, levenberg-marquardt, broyden, pseudo-transient, auto");
+                         "newton, dogleg, levenberg-marquardt, broyden, pseudo-transient, and "
+                         "auto when every stage is one of them");
     }
     BoxBounds previous = std::move(bounds_);
     bounds_ = std::move(bounds);

@@ -6,7 +6,8 @@
 // one is half the distance to it): a forward step that would cross a bound is
 // taken backwards; a central pair that would is replaced by the one-sided second-order formula
 // (−3 f(x) + 4 f(x + h) − f(x + 2h)) / 2h towards the side with room, h shrunk to fit if needed
-// (same cost, same order); a component with lower = upper gets a zero column.
+// (same cost, same order); a component that cannot move (lower = upper, or within a few ulps of
+// a bound on the only side with room, where x_j ± h rounds to x_j) gets a zero column.
 #include <algorithm>
 #include <cmath>
 #include <limits>

@@ -73,6 +73,7 @@ class LevenbergMarquardtEngine : public Engine<N> {
   const LevenbergMarquardtOptions& lm_options() const { return lm_; }
   bool least_squares() const override { return true; }
   bool accepts_bounds() const override { return true; }
+  bool accepts_strict_bounds() const override { return true; }
   bool accepts_scaling() const override { return true; }
 
   // Square: F = G − x, J = ∂G − I.
@@ -305,7 +306,7 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
   bool accepted_any = false;  // until the first accepted step Δ ≤ ‖Dp‖ (MINPACK's iter = 1)
   // A square system stuck where a bound holds x against −∇(½‖F‖²) = −Jᵀ F is blocked.
   auto stagnate = [&](const char* why) {
-    if (const std::optional<Index> i = box_.blocking(x_, gradient_)) {
+    if (const std::optional<Index> i = box_.blocking(x_, gradient_, detail::BoxMove::kDirection)) {
       summary.message = box_.blocked_message(*i, x_, f_.template lpNorm<Eigen::Infinity>(),
                                              "the descent direction");
       status = Status::kBlockedByBound;
@@ -331,14 +332,14 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
       status = Status::kNonFinite;
       break;
     }
-    // −∇(½‖F‖²) = −Jᵀ F; in a box, the active set: the variables a bound holds against it are
-    // frozen for this Jacobian (their columns zeroed, so the step leaves them where they are).
+    // −∇(½‖F‖²) = −Jᵀ F; in a box, the active set: the variables on a closed bound it points out
+    // of are frozen for this Jacobian (their columns zeroed, so the step leaves them where they
+    // are). A strict bound is never reached: its steps are cut short by the projection instead.
     gradient_.noalias() = -(jac_.transpose() * f_);
     bool bound_held = false;
     if (box_.active()) {
-      const double g_max = gradient_.template lpNorm<Eigen::Infinity>();
       for (Index k = 0; k < n; ++k) {
-        if (box_.held(k, x_[k], gradient_[k], g_max)) {
+        if (box_.on_closed_bound_against(k, x_[k], gradient_[k])) {
           jac_.col(k).setZero();
           bound_held = true;
         }
@@ -425,6 +426,9 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
           break;
         }
       }
+      // The radius follows the model's own step, as dogleg's: one the box cut short says
+      // nothing against the model (near a strict bound each cut is 99 % of the room left).
+      const double model_pnorm = diag_.cwiseProduct(p_).norm();
       xt_ = x_ + p_;
       const bool projected = box_.project(xt_, x_);
       if (projected) p_ = xt_ - x_;
@@ -461,10 +465,10 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
       if (!(ratio > 0.25)) {  // (a NaN ratio shrinks too)
         double shrink = actual >= 0.0 ? 0.5 : 0.5 * directional / (directional + 0.5 * actual);
         if (0.1 * fnorm_trial >= fnorm || shrink < 0.1) shrink = 0.1;
-        delta = shrink * std::min(delta, pnorm / 0.1);
+        delta = shrink * std::min(delta, model_pnorm / 0.1);
         lambda /= shrink;
       } else if (lambda == 0.0 || ratio >= 0.75) {
-        delta = pnorm / 0.5;
+        delta = model_pnorm / 0.5;
         lambda *= 0.5;
       }
       const bool accepted = ratio >= 1e-4;

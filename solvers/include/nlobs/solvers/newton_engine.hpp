@@ -74,6 +74,7 @@ class NewtonEngine : public Engine<N> {
   std::string_view name() const override { return "newton"; }
   const NewtonOptions& newton_options() const { return newton_; }
   bool accepts_bounds() const override { return true; }
+  bool accepts_strict_bounds() const override { return true; }
   bool accepts_scaling() const override { return true; }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
@@ -205,7 +206,8 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
       std::optional<Index> held;
       if (box.active() && (newton_.line_search || held_in_place)) {
         if (newton_.line_search) dx_ = -gradient_;
-        held = box.blocking(x_, dx_);
+        held = box.blocking(
+            x_, dx_, newton_.line_search ? detail::BoxMove::kDirection : detail::BoxMove::kStep);
       }
       if (system_.budget_spent()) {
         status = Status::kMaxEvaluations;

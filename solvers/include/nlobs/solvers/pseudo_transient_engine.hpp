@@ -86,6 +86,7 @@ class PseudoTransientEngine : public Engine<N> {
   std::string_view name() const override { return "pseudo-transient"; }
   const PseudoTransientOptions& pseudo_transient_options() const { return ptc_; }
   bool accepts_bounds() const override { return true; }
+  bool accepts_strict_bounds() const override { return true; }
   bool accepts_scaling() const override { return true; }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
@@ -179,7 +180,7 @@ Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vec
       xt_ = x_ + p_;
       projected = box.project(xt_, x_);
       if (projected && xt_ == x_) {
-        if (const std::optional<Index> i = box.blocking(x_, p_)) {
+        if (const std::optional<Index> i = box.blocking(x_, p_, detail::BoxMove::kStep)) {
           summary.message = box.blocked_message(*i, x_, f_.template lpNorm<Eigen::Infinity>(),
                                                 "the pseudo-transient flow");
           status = Status::kBlockedByBound;
