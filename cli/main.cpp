@@ -20,6 +20,7 @@
 #include "nlobs/common/version.hpp"
 #include "nlobs/reference/problem_suite.hpp"
 #include "nlobs/registry/plugin.hpp"
+#include "nlobs/registry/problem_sets.hpp"
 #include "output_directory.hpp"
 #include "run_command.hpp"
 #include "scenario.hpp"
@@ -153,10 +154,12 @@ int run_command_line(int argc, char** argv) {
       "suite", "Run every listed solver on every (problem, start) of a problem set");
   std::string suite_set;
   nlobs::cli::SuiteArguments suite_args;
+  // The built-in sets by name, read from the registry (a list written here went stale as sets
+  // were added); a plugin's sets are loaded later and listed by `nlobs list problems`.
   suite
       ->add_option("set", suite_set,
-                   "Problem set: mgh, chua-window or a registered one (nlobs "
-                   "list problems)")
+                   "Problem set: " + nlobs::problem_set_registry().valid_list() +
+                       ", or a plugin's (nlobs list problems)")
       ->required();
   add_suite_options(suite, suite_args);
 

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -256,6 +257,19 @@ TEST(Cli, ExitStatusSaysWhetherTheCommandLineOrTheRunFailed) {
   }
   EXPECT_NE(run("run /tmp").out.find("scenario file '/tmp' is a directory"), std::string::npos);
   EXPECT_EQ(run("--help").status, 0);
+  // suite --help names every set `list problems` lists (the lines "  NAME — ...").
+  const CliRun suite_help = run("suite --help"), sets = run("list problems");
+  EXPECT_EQ(suite_help.status, 0);
+  std::istringstream lines(sets.out);
+  int listed = 0;
+  for (std::string line; std::getline(lines, line);) {
+    const std::size_t dash = line.find(" \u2014 ");
+    if (line.rfind("  ", 0) != 0 || line[2] == ' ' || dash == std::string::npos) continue;
+    const std::string set = line.substr(2, dash - 2);
+    ++listed;
+    EXPECT_NE(suite_help.out.find(set + ","), std::string::npos) << set << "\n" << suite_help.out;
+  }
+  EXPECT_GE(listed, 4) << sets.out;
   // An engine spec echoed in an error is an excerpt.
   const CliRun spec =
       run("solve chua-window --no-reference --engines anderson:" + std::string(5000, 'm') + "=1");
