@@ -270,6 +270,11 @@ TEST(Cli, ExitStatusSaysWhetherTheCommandLineOrTheRunFailed) {
     EXPECT_NE(suite_help.out.find(set + ","), std::string::npos) << set << "\n" << suite_help.out;
   }
   EXPECT_GE(listed, 4) << sets.out;
+  // The threshold is on the scaled residual, and the scaled problems say so (combustion).
+  EXPECT_NE(sets.out.find("solved at |D_f F|2 <= 1e-08 (D_f = diag(f_scale)"), std::string::npos)
+      << sets.out;
+  EXPECT_NE(sets.out.find("combustion:n=10; starts"), std::string::npos) << sets.out;
+  EXPECT_NE(sets.out.find("scaled (u_scale, f_scale)"), std::string::npos) << sets.out;
   // An engine spec echoed in an error is an excerpt.
   const CliRun spec =
       run("solve chua-window --no-reference --engines anderson:" + std::string(5000, 'm') + "=1");
