@@ -135,6 +135,23 @@ TEST(Cli, OutOfRangeIntegersAreErrors) {
                 r.out.find("--steps") != std::string::npos)
         << args << ": " << r.out;
   }
+  // Each says which flag, what was given and what is required.
+  for (const char* value : {"0", "-3", "1000001"}) {
+    const CliRun b = run(std::string("suite bounded --budget ") + value);
+    EXPECT_EQ(b.status, 1) << value;
+    EXPECT_NE(b.out.find(std::string("--budget: '") + value +
+                         "' is out of range: an integer in [1, 1000000] is required"),
+              std::string::npos)
+        << b.out;
+  }
+  for (const char* value : {"abc", "1e9", "2.5", "99999999999999999999"}) {
+    const CliRun b = run(std::string("suite bounded --budget ") + value);
+    EXPECT_EQ(b.status, 1) << value;
+    EXPECT_NE(b.out.find(std::string("--budget: '") + value +
+                         "' is not an integer (one in [1, 1000000] is required)"),
+              std::string::npos)
+        << b.out;
+  }
   const CliRun m = run("solve chua-window --engines anderson:m=1000000000 --no-reference");
   EXPECT_NE(m.status, 0);
   EXPECT_NE(m.out.find("'m=1000000000' is out of range: must be in 0.."), std::string::npos)
