@@ -62,7 +62,8 @@ void print_list(const std::string& what, std::ostream& out) {
     const auto& sets = problem_set_registry();
     for (const ProblemSetEntry* set : sets.entries()) {
       out << "  " << set->name << " — " << set->description
-          << "; solved at |F|2 <= " << set->solved_threshold;
+          << "; solved at |D_f F|2 <= " << set->solved_threshold
+          << " (D_f = diag(f_scale) of a scaled problem, else the identity)";
       const std::string source = sets.source(set->name);
       if (source != "built-in") out << "; from " << source;
       out << '\n';
@@ -72,6 +73,11 @@ void print_list(const std::string& what, std::ostream& out) {
               << "; starts";
           for (const ProblemStart& st : p.starts) out << ' ' << st.label;
           if (p.lower.size() || p.upper.size()) out << "; bounded";
+          if (p.u_scale.size() || p.f_scale.size()) {
+            out << "; scaled (" << (p.u_scale.size() ? "u_scale" : "")
+                << (p.u_scale.size() && p.f_scale.size() ? ", " : "")
+                << (p.f_scale.size() ? "f_scale" : "") << ")";
+          }
           if (!p.solutions.empty()) out << "; " << p.solutions.size() << " known solution(s)";
           if (!p.description.empty()) out << "; " << p.description;
           out << '\n';

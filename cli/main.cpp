@@ -20,6 +20,7 @@
 #include "nlobs/common/version.hpp"
 #include "nlobs/reference/problem_suite.hpp"
 #include "nlobs/registry/plugin.hpp"
+#include "nlobs/registry/problem_sets.hpp"
 #include "output_directory.hpp"
 #include "run_command.hpp"
 #include "scenario.hpp"
@@ -64,6 +65,25 @@ CLI::Validator finite_in(double min, double max, const std::string& description,
       description);
 }
 
+// A decimal integer in [min, max]: CLI::Range said "Value abc not in range 1 to 1000000" of a
+// word that is no number at all, and of 1e9.
+CLI::Validator integer_in(long min, long max) {
+  return CLI::Validator(
+      [min, max](std::string& text) {
+        errno = 0;
+        char* end = nullptr;
+        const long v = std::strtol(text.c_str(), &end, 10);
+        const bool integer = end != text.c_str() && *end == '\0' && errno != ERANGE;
+        if (integer && v >= min && v <= max) return std::string();
+        std::ostringstream os;
+        os << "'" << nlobs::printable(text, 40) << "' is "
+           << (integer ? "out of range: an integer in [" : "not an integer (one in [") << min
+           << ", " << max << (integer ? "] is required" : "] is required)");
+        return os.str();
+      },
+      "INT in " + std::to_string(min) + ".." + std::to_string(max));
+}
+
 // --seed: decimal digits only, within the generator's 64-bit range (no sign, no wrap-around,
 // no saturation).
 std::uint64_t parse_seed(const std::string& text) {
@@ -97,7 +117,7 @@ void add_suite_options(CLI::App* app, nlobs::cli::SuiteArguments& a) {
       ->check(finite_in(0.0, std::numeric_limits<double>::max(), "X > 0", true));
   app->add_option("--budget", a.evaluations_per_dimension,
                   "F evaluations per unknown and one (budget = this * (n + 1)); default 1000")
-      ->check(CLI::Range(1L, 1000000L));
+      ->check(integer_in(1L, 1000000L));
   app->add_flag("--json", a.json, "Print a JSON array instead of the tables");
   app->add_option("--csv", a.csv, "Also write the rows as CSV to FILE ('-': stdout, no table)");
   app->add_flag("--show-x", a.show_x, "Print each row's answer x below it in the table");
@@ -153,10 +173,12 @@ int run_command_line(int argc, char** argv) {
       "suite", "Run every listed solver on every (problem, start) of a problem set");
   std::string suite_set;
   nlobs::cli::SuiteArguments suite_args;
+  // The built-in sets by name, read from the registry (a list written here went stale as sets
+  // were added); a plugin's sets are loaded later and listed by `nlobs list problems`.
   suite
       ->add_option("set", suite_set,
-                   "Problem set: mgh, chua-window or a registered one (nlobs "
-                   "list problems)")
+                   "Problem set: " + nlobs::problem_set_registry().valid_list() +
+                       ", or a plugin's (nlobs list problems)")
       ->required();
   add_suite_options(suite, suite_args);
 
@@ -169,7 +191,7 @@ int run_command_line(int argc, char** argv) {
   nlobs::cli::RunOptions run_options;
   run->add_option("scenario", scenario, "Built-in scenario name or JSON scenario file")->required();
   CLI::Option* steps_opt = run->add_option("--steps", steps, "Number of samples")
-                               ->check(CLI::Range(1L, nlobs::cli::kMaxSteps));
+                               ->check(integer_in(1L, nlobs::cli::kMaxSteps));
   CLI::Option* noise_opt =
       run->add_option("--noise", noise, "Std. deviation of Gaussian measurement noise")
           ->check(finite_in(0.0, std::numeric_limits<double>::max(), "SIGMA >= 0"));

@@ -1,13 +1,16 @@
 #include "suite_command.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <ostream>
 #include <stdexcept>
 
 #include "nlobs/common/printable.hpp"
 #include "nlobs/reference/problem_suite.hpp"
 #include "nlobs/registry/problem_sets.hpp"
+#include "output_file.hpp"
 #include "suite_report.hpp"
 
 namespace nlobs::cli {
@@ -28,9 +31,18 @@ void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArg
   options.time_limit_s = args.time_limit_s;
   options.starts =
       args.starts.empty() ? std::vector<std::string>() : reference::split_spec_list(args.starts);
-  const std::vector<std::string> solvers = args.solvers.empty()
-                                               ? reference::default_suite_solvers()
-                                               : reference::split_spec_list(args.solvers);
+  std::vector<std::string> solvers;
+  // A solver or problem named twice runs once (a second row would only repeat the first), said
+  // on `err`.
+  for (std::string& spec : args.solvers.empty() ? reference::default_suite_solvers()
+                                                : reference::split_spec_list(args.solvers)) {
+    if (std::find(solvers.begin(), solvers.end(), spec) != solvers.end()) {
+      err << "nlobs " << command << ": solver '" << nlobs::printable(spec, 60)
+          << "' is listed more than once; it runs once\n";
+    } else {
+      solvers.push_back(std::move(spec));
+    }
+  }
   // Every selection is built and checked before the first solve.
   std::vector<ProblemSelection> selections;
   double threshold = std::numeric_limits<double>::quiet_NaN();
@@ -40,11 +52,31 @@ void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArg
           "nlobs suite takes a problem set ('" + nlobs::printable(selector, 60) +
           "' names a problem: nlobs solve " + nlobs::printable(selector, 60) + ")");
     }
-    selections.push_back(select_problems(selector, problem_set_registry()));
+    ProblemSelection selection = select_problems(selector, problem_set_registry());
+    std::erase_if(selection.problems, [&](const TestProblem& p) {
+      const bool seen = std::any_of(selections.begin(), selections.end(), [&](const auto& s) {
+        return s.set == selection.set &&
+               std::any_of(s.problems.begin(), s.problems.end(), [&](const TestProblem& q) {
+                 return q.name == p.name && q.size() == p.size();
+               });
+      });
+      if (seen) {
+        err << "nlobs " << command << ": " << nlobs::printable(selection.set->name, 60) << '/'
+            << nlobs::printable(p.name, 60) << ":n=" << p.size()
+            << " is selected more than once; it runs once\n";
+      }
+      return seen;
+    });
+    selections.push_back(std::move(selection));
     const double t = reference::suite_threshold(*selections.back().set, options);
     threshold =
         selections.size() == 1 || t == threshold ? t : std::numeric_limits<double>::quiet_NaN();
   }
+  // The CSV's file is opened (its temporary made, or the FIFO or device opened) before the first
+  // solve: a target that cannot be written is refused at once, not after a long run, and the
+  // file there now is replaced only when the rows are complete.
+  std::optional<OutputFile> csv_file;
+  if (!args.csv.empty() && args.csv != "-") csv_file.emplace(args.csv);
   int total = 0, before = 0;
   for (const ProblemSelection& s : selections) {
     total += reference::count_suite_pairs(s.problems, options);
@@ -77,7 +109,12 @@ void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArg
     rows.insert(rows.end(), part.begin(), part.end());
   }
   if (args.progress == SuiteArguments::Progress::kTerminal) err << '\n';
-  if (!args.csv.empty()) write_text_file(args.csv, suite_to_csv(rows), out);
+  if (csv_file) {
+    csv_file->stream() << suite_to_csv(rows);
+    csv_file->commit();
+  } else if (args.csv == "-") {
+    out << suite_to_csv(rows);
+  }
   if (args.json) {
     out << suite_to_json(rows).dump(2) << '\n';
   } else if (args.csv != "-") {

@@ -14,7 +14,6 @@
 #include <string>
 
 #include "nlobs/common/printable.hpp"
-#include "output_file.hpp"
 #include "run_support.hpp"
 
 namespace nlobs::cli {
@@ -230,14 +229,6 @@ std::string suite_to_csv(const std::vector<reference::SuiteRow>& rows) {
            ',' + std::to_string(r.evals_past_progress) + '\n';
   }
   return out;
-}
-
-void write_text_file(const std::string& path, const std::string& text, std::ostream& stdout_) {
-  if (path == "-") {
-    stdout_ << text;
-    return;
-  }
-  write_output_file(path, text);  // never replaces a link, a FIFO or a device (output_file.hpp)
 }
 
 }  // namespace nlobs::cli

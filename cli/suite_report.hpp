@@ -29,8 +29,5 @@ std::string answer_field(const Eigen::VectorXd& x);
 // `text` with every byte that is not part of a valid UTF-8 sequence replaced by U+FFFD (what
 // nlohmann::json's error_handler_t::replace writes): what the JSON holds of a user's text.
 std::string valid_utf8(std::string_view text);
-// `text` to `path` through a temporary file renamed over it, so a failed write leaves an
-// earlier file as it was; "-" is stdout. Throws std::runtime_error naming the path.
-void write_text_file(const std::string& path, const std::string& text, std::ostream& stdout_);
 
 }  // namespace nlobs::cli

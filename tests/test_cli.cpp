@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -134,6 +135,23 @@ TEST(Cli, OutOfRangeIntegersAreErrors) {
                 r.out.find("--steps") != std::string::npos)
         << args << ": " << r.out;
   }
+  // Each says which flag, what was given and what is required.
+  for (const char* value : {"0", "-3", "1000001"}) {
+    const CliRun b = run(std::string("suite bounded --budget ") + value);
+    EXPECT_EQ(b.status, 1) << value;
+    EXPECT_NE(b.out.find(std::string("--budget: '") + value +
+                         "' is out of range: an integer in [1, 1000000] is required"),
+              std::string::npos)
+        << b.out;
+  }
+  for (const char* value : {"abc", "1e9", "2.5", "99999999999999999999"}) {
+    const CliRun b = run(std::string("suite bounded --budget ") + value);
+    EXPECT_EQ(b.status, 1) << value;
+    EXPECT_NE(b.out.find(std::string("--budget: '") + value +
+                         "' is not an integer (one in [1, 1000000] is required)"),
+              std::string::npos)
+        << b.out;
+  }
   const CliRun m = run("solve chua-window --engines anderson:m=1000000000 --no-reference");
   EXPECT_NE(m.status, 0);
   EXPECT_NE(m.out.find("'m=1000000000' is out of range: must be in 0.."), std::string::npos)
@@ -256,6 +274,24 @@ TEST(Cli, ExitStatusSaysWhetherTheCommandLineOrTheRunFailed) {
   }
   EXPECT_NE(run("run /tmp").out.find("scenario file '/tmp' is a directory"), std::string::npos);
   EXPECT_EQ(run("--help").status, 0);
+  // suite --help names every set `list problems` lists (the lines "  NAME — ...").
+  const CliRun suite_help = run("suite --help"), sets = run("list problems");
+  EXPECT_EQ(suite_help.status, 0);
+  std::istringstream lines(sets.out);
+  int listed = 0;
+  for (std::string line; std::getline(lines, line);) {
+    const std::size_t dash = line.find(" \u2014 ");
+    if (line.rfind("  ", 0) != 0 || line[2] == ' ' || dash == std::string::npos) continue;
+    const std::string set = line.substr(2, dash - 2);
+    ++listed;
+    EXPECT_NE(suite_help.out.find(set + ","), std::string::npos) << set << "\n" << suite_help.out;
+  }
+  EXPECT_GE(listed, 4) << sets.out;
+  // The threshold is on the scaled residual, and the scaled problems say so (combustion).
+  EXPECT_NE(sets.out.find("solved at |D_f F|2 <= 1e-08 (D_f = diag(f_scale)"), std::string::npos)
+      << sets.out;
+  EXPECT_NE(sets.out.find("combustion:n=10; starts"), std::string::npos) << sets.out;
+  EXPECT_NE(sets.out.find("scaled (u_scale, f_scale)"), std::string::npos) << sets.out;
   // An engine spec echoed in an error is an excerpt.
   const CliRun spec =
       run("solve chua-window --no-reference --engines anderson:" + std::string(5000, 'm') + "=1");

@@ -101,6 +101,21 @@ class GreedyEngine final : public Engine<Dynamic> {
   }
 };
 
+// An engine a user registered that counts its solves and returns at once.
+class CountingEngine final : public Engine<Dynamic> {
+ public:
+  static inline int solves = 0;
+  explicit CountingEngine(SolverOptions o) : Engine<Dynamic>(std::move(o)) {}
+  std::string_view name() const override { return "test-counts"; }
+  Summary solve(const FixedPointProblem<Dynamic>&, Vector<Dynamic>&) override {
+    ++solves;
+    Summary s;
+    s.engine = "test-counts";
+    s.status = Status::kMaxIterations;
+    return s;
+  }
+};
+
 void register_once() {
   static const bool done = [] {
     problem_set_registry().add(
@@ -138,6 +153,13 @@ void register_once() {
                  {"test-greedy"},
                  [](EngineSpecReader&, SolverOptions o) -> std::unique_ptr<Engine<Dynamic>> {
                    return std::make_unique<GreedyEngine>(o);
+                 }});
+    engines.add({"test-counts",
+                 "counts its solves",
+                 {},
+                 {"test-counts"},
+                 [](EngineSpecReader&, SolverOptions o) -> std::unique_ptr<Engine<Dynamic>> {
+                   return std::make_unique<CountingEngine>(o);
                  }});
     engines.add({"test-throws",
                  "throws",
@@ -738,10 +760,40 @@ TEST(ProblemSets, TheCliPrintsTheTableJsonAndCsvOfAUsersSet) {
   args = {};
   args.threshold = -1.0;
   EXPECT_THROW(cli::run_problem_suite({"test-set"}, args, "suite", out, err), InvalidInput);
+  // A CSV target that cannot be written is refused before the first solve, not after the run.
   args = {};
-  args.csv = std::filesystem::temp_directory_path().string();  // a directory
-  EXPECT_THROW(cli::run_problem_suite({"test-set/cosine"}, args, "solve", out, err),
-               std::runtime_error);
+  args.solvers = "test-counts";
+  CountingEngine::solves = 0;
+  for (const std::string& target : {std::filesystem::temp_directory_path().string(),  // a directory
+                                    std::string("/nonexistent-nlobs-dir/rows.csv")}) {
+    args.csv = target;
+    EXPECT_THROW(cli::run_problem_suite({"test-set/cosine"}, args, "solve", out, err),
+                 std::runtime_error)
+        << target;
+    EXPECT_EQ(CountingEngine::solves, 0) << target;
+  }
+}
+
+TEST(ProblemSets, ASolverOrProblemNamedTwiceRunsOnce) {
+  register_once();
+  cli::SuiteArguments args;
+  args.solvers = "test-counts,newton,test-counts";
+  args.json = true;
+  std::ostringstream out, err;
+  cli::run_problem_suite({"test-set/cosine", "test-set", "test-set/cosine:n=3"}, args, "solve", out,
+                         err);
+  // test-set holds circle-line (starts near, far) and cosine (start zero): three pairs, each
+  // once, with each solver once.
+  const auto rows = nlohmann::json::parse(out.str());
+  ASSERT_EQ(rows.size(), 3u * 2u) << out.str();
+  EXPECT_EQ(rows[0]["solver"], "test-counts");
+  EXPECT_EQ(rows[1]["solver"], "newton");
+  EXPECT_NE(err.str().find("solver 'test-counts' is listed more than once; it runs once"),
+            std::string::npos)
+      << err.str();
+  EXPECT_NE(err.str().find("test-set/cosine:n=3 is selected more than once; it runs once"),
+            std::string::npos)
+      << err.str();
 }
 
 }  // namespace

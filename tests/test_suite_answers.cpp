@@ -442,6 +442,8 @@ TEST(SuiteAnswers, ATimeLimitEndsADeliberatelySlowEngine) {
     EXPECT_LE(r.f_evals, 26);
     EXPECT_GE(r.f_evals, 1);
     EXPECT_NE(r.message.find("after the time limit of 0.05 s"), std::string::npos) << r.message;
+    // The time it took, also when an exception ended it (it said 0).
+    EXPECT_GE(r.ns, 0.05e9);
   }
   // The well-behaved one keeps its answer (moving towards 2); the stubborn one has none.
   ASSERT_EQ(row(rows, "test-slow").x.size(), 1);

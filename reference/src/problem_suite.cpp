@@ -453,6 +453,14 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
         // on: invalid_input (options or set-up refused, the problem's box refused),
         // out_of_memory (std::bad_alloc), engine_threw (anything else, `throw 42` included).
         bool setting_up = true;
+        // A solve ended by an exception (the time limit's, an engine's) has no mean over repeated
+        // calls: its row gives the wall time of that one attempt, not 0.
+        const auto attempt_started = std::chrono::steady_clock::now();
+        auto attempt_ns = [&attempt_started] {
+          return std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() -
+                                                          attempt_started)
+              .count();
+        };
         try {
           if (is_reference(s)) {
             row.ns = mean_ns_per_call(
@@ -490,12 +498,15 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
                 kTimingNs, 1, kMaxTimedCalls);
           }
         } catch (const TimeLimitStop&) {
+          row.ns = attempt_ns();
           outcome = {"time_limit", meter.count, 0, ""};
           x.resize(0);  // unwound: no answer
         } catch (const std::bad_alloc&) {
+          row.ns = attempt_ns();
           outcome = {"out_of_memory", meter.count, 0, "std::bad_alloc: not enough memory"};
           x.resize(0);
         } catch (...) {
+          row.ns = attempt_ns();
           const bool refused_input = (setting_up || is_reference(s)) && [] {
             try {
               throw;
