@@ -66,15 +66,16 @@ CLI::Validator finite_in(double min, double max, const std::string& description,
 }
 
 // A decimal integer in [min, max]: CLI::Range said "Value abc not in range 1 to 1000000" of a
-// word that is no number at all, and of 1e9.
+// word that is no number at all, and of 1e9. An integer beyond long's range is out of range
+// too, not "not an integer".
 CLI::Validator integer_in(long min, long max) {
   return CLI::Validator(
       [min, max](std::string& text) {
         errno = 0;
         char* end = nullptr;
         const long v = std::strtol(text.c_str(), &end, 10);
-        const bool integer = end != text.c_str() && *end == '\0' && errno != ERANGE;
-        if (integer && v >= min && v <= max) return std::string();
+        const bool integer = end != text.c_str() && *end == '\0';
+        if (integer && errno != ERANGE && v >= min && v <= max) return std::string();
         std::ostringstream os;
         os << "'" << nlobs::printable(text, 40) << "' is "
            << (integer ? "out of range: an integer in [" : "not an integer (one in [") << min

@@ -14,6 +14,36 @@
 #include "suite_report.hpp"
 
 namespace nlobs::cli {
+namespace {
+
+// "nlobs solve --starts: no selected problem (mgh/rosenbrock) has a start 'x5'; their starts:
+// x1, x10, x100": the flag, the label and the labels there are, in the order the problems list
+// them.
+std::string unknown_start_message(const std::string& command,
+                                  const std::vector<std::string>& selectors,
+                                  const std::vector<ProblemSelection>& selections,
+                                  const std::string& wanted) {
+  std::string selected, valid;
+  for (const std::string& selector : selectors) {
+    selected += (selected.empty() ? "" : ", ") + selector;
+  }
+  std::vector<std::string> labels;
+  for (const ProblemSelection& s : selections) {
+    for (const TestProblem& p : s.problems) {
+      for (const ProblemStart& st : p.starts) {
+        if (std::find(labels.begin(), labels.end(), st.label) == labels.end()) {
+          labels.push_back(st.label);
+        }
+      }
+    }
+  }
+  for (const std::string& label : labels) valid += (valid.empty() ? "" : ", ") + label;
+  return "nlobs " + command + " --starts: no selected problem (" + nlobs::printable(selected, 200) +
+         ") has a start '" + nlobs::printable(wanted, 60) +
+         "'; their starts: " + (valid.empty() ? "none" : nlobs::printable(valid, 400));
+}
+
+}  // namespace
 
 void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArguments& args,
                        const std::string& command, std::ostream& out, std::ostream& err) {
@@ -72,6 +102,27 @@ void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArg
     threshold =
         selections.size() == 1 || t == threshold ? t : std::numeric_limits<double>::quiet_NaN();
   }
+  // --starts is checked against every selected problem before the first solve (run_suite checks
+  // one set at a time, so a label only a later selector's problems have was refused after the
+  // earlier ones had run, and a label another problem of the set has was said to be in none).
+  std::vector<std::vector<std::string>> starts_of_selection(selections.size());
+  for (const std::string& wanted : options.starts) {
+    bool found = false;
+    for (std::size_t i = 0; i < selections.size(); ++i) {
+      const bool has = std::any_of(
+          selections[i].problems.begin(), selections[i].problems.end(), [&](const TestProblem& p) {
+            return std::any_of(p.starts.begin(), p.starts.end(),
+                               [&](const ProblemStart& st) { return st.label == wanted; });
+          });
+      auto& labels = starts_of_selection[i];
+      if (has && std::find(labels.begin(), labels.end(), wanted) == labels.end()) {
+        labels.push_back(wanted);
+      }
+      found = found || has;
+    }
+    if (!found)
+      throw std::invalid_argument(unknown_start_message(command, selectors, selections, wanted));
+  }
   // The CSV's file is opened (its temporary made, or the FIFO or device opened) before the first
   // solve: a target that cannot be written is refused at once, not after a long run, and the
   // file there now is replaced only when the rows are complete.
@@ -86,8 +137,15 @@ void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArg
   const Clock::time_point started = Clock::now();
   Clock::time_point last_line = started;
   const auto interval = std::chrono::duration<double>(args.progress_interval_s);
-  for (const ProblemSelection& s : selections) {
+  for (std::size_t i = 0; i < selections.size(); ++i) {
+    const ProblemSelection& s = selections[i];
     reference::SuiteOptions o = options;
+    // Only the labels this selection's problems have (run_suite refuses the others); none of
+    // them: nothing of it runs (an empty list would mean every start).
+    if (!options.starts.empty()) {
+      if (starts_of_selection[i].empty()) continue;
+      o.starts = starts_of_selection[i];
+    }
     if (args.progress == SuiteArguments::Progress::kTerminal) {
       o.progress = [&, before](int done, int) {
         err << "\rnlobs " << command << ": " << before + done << "/" << total

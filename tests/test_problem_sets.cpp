@@ -796,5 +796,44 @@ TEST(ProblemSets, ASolverOrProblemNamedTwiceRunsOnce) {
       << err.str();
 }
 
+// --starts is judged against every selected problem together, before the first solve.
+TEST(ProblemSets, StartLabelsAreCheckedAgainstEverySelectedProblem) {
+  register_once();
+  cli::SuiteArguments args;
+  args.solvers = "test-counts";
+  args.json = true;
+  // A label one selector's problems have and another's lack runs where it is (it was refused
+  // for the second selector after the first had run).
+  args.starts = "zero,x1";
+  std::ostringstream out, err;
+  cli::run_problem_suite({"test-set/cosine", "mgh/rosenbrock"}, args, "solve", out, err);
+  auto rows = nlohmann::json::parse(out.str());
+  ASSERT_EQ(rows.size(), 2u) << out.str();
+  EXPECT_EQ(rows[0]["start"], "zero");
+  EXPECT_EQ(rows[1]["start"], "x1");
+  // A problem named twice and a label: once (the second, emptied selection had no start left
+  // and was refused).
+  args.starts = "zero";
+  out.str("");
+  cli::run_problem_suite({"test-set/cosine", "test-set/cosine"}, args, "solve", out, err);
+  rows = nlohmann::json::parse(out.str());
+  EXPECT_EQ(rows.size(), 1u) << out.str();
+  // A label no selected problem has: the flag, the label and the labels there are, before any
+  // solve. circle-line's "near" is in the set but not in the selection.
+  CountingEngine::solves = 0;
+  args.starts = "zero,near";
+  try {
+    cli::run_problem_suite({"mgh/rosenbrock", "test-set/cosine"}, args, "solve", out, err);
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "nlobs solve --starts: no selected problem (mgh/rosenbrock, test-set/cosine) "
+                  "has a start 'near'; their starts: x1, x10, x100, zero"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(CountingEngine::solves, 0);
+}
+
 }  // namespace
 }  // namespace nlobs

@@ -99,6 +99,27 @@ class InfiniteAnswer final : public Engine<Dynamic> {
   }
 };
 
+// An engine that is quick on its first solve and slow on every later one (sleeping 60 ms before
+// its one evaluation): the suite times a quick solve again and again, so a row may end with a
+// solve the time limit stopped after solves that ended in time.
+class SlowAfterFirstSolve final : public Engine<Dynamic> {
+ public:
+  explicit SlowAfterFirstSolve(SolverOptions o) : Engine<Dynamic>(std::move(o)) {}
+  std::string_view name() const override { return "test-slow-after-first"; }
+  Summary solve(const FixedPointProblem<Dynamic>& g, Vector<Dynamic>& x) override {
+    if (solves_++ > 0) std::this_thread::sleep_for(std::chrono::milliseconds(60));
+    Vector<Dynamic> next(x.size());
+    g.evaluate(x, next);
+    Summary s;
+    s.function_evaluations = 1;
+    s.status = next.allFinite() ? Status::kMaxIterations : Status::kNonFinite;
+    return s;
+  }
+
+ private:
+  int solves_ = 0;
+};
+
 // A user's engine E registered under `name`, as a user registers one.
 template <typename E>
 void add_engine(EngineRegistry<Dynamic>& engines, const std::string& name, std::string what) {
@@ -131,6 +152,8 @@ void register_engines_once() {
     add_engine<IdleEngine>(engines, "test-idle",
                            "finds the root, then evaluates there 30 more times");
     add_engine<InfiniteAnswer>(engines, "test-infinite", "returns inf");
+    add_engine<SlowAfterFirstSolve>(engines, "test-slow-after-first",
+                                    "quick once, then 60 ms before each evaluation");
     return true;
   }();
   (void)done;
@@ -459,6 +482,21 @@ TEST(SuiteAnswers, ATimeLimitEndsADeliberatelySlowEngine) {
   // The limit does not touch a run that ends within it.
   options.time_limit_s = 10.0;
   EXPECT_TRUE(reference::run_suite(set, problems, {"newton"}, options)[0].solved);
+}
+
+// A row the time limit ended gives the time of the solve it ended, never a mean with solves
+// that ended in time. Here: one quick solve (well under the 1 ms the suite times for), then
+// two of 60 ms in the next batch, the last stopped at 50 ms; their mean, 40 ms, was shown.
+TEST(SuiteAnswers, ATimeLimitRowTakesTheTimeOfTheSolveItEnded) {
+  register_engines_once();
+  const ProblemSetEntry set = set_of(halving());
+  SuiteOptions options;
+  options.time_limit_s = 0.05;
+  const auto rows =
+      reference::run_suite(set, build_problem_set(set), {"test-slow-after-first"}, options);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].status, "time_limit");
+  EXPECT_GE(rows[0].ns, 0.05e9);
 }
 
 // A slow F (1 ms per evaluation) with no root: every solver, the C libraries included, would

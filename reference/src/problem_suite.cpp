@@ -454,8 +454,10 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
         // out_of_memory (std::bad_alloc), engine_threw (anything else, `throw 42` included).
         bool setting_up = true;
         // A solve ended by an exception (the time limit's, an engine's) has no mean over repeated
-        // calls: its row gives the wall time of that one attempt, not 0.
-        const auto attempt_started = std::chrono::steady_clock::now();
+        // calls: its row gives the wall time of that one attempt, not 0. So does a row the time
+        // limit ended: the row is the last of the timed calls, and a mean with earlier calls that
+        // ended in time could show less than the limit it was stopped at.
+        auto attempt_started = std::chrono::steady_clock::now();
         auto attempt_ns = [&attempt_started] {
           return std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() -
                                                           attempt_started)
@@ -465,6 +467,7 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
           if (is_reference(s)) {
             row.ns = mean_ns_per_call(
                 [&] {
+                  attempt_started = std::chrono::steady_clock::now();
                   x = start.x;
                   meter.reset(budget, options.time_limit_s);
                   outcome = run_reference(s, p, safe_f, safe_g, x, budget);
@@ -488,6 +491,7 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
             setting_up = false;
             row.ns = mean_ns_per_call(
                 [&] {
+                  attempt_started = std::chrono::steady_clock::now();
                   x = start.x;
                   meter.reset(budget, options.time_limit_s);
                   const Summary sum = solve_or_report(*engine, engine_g, x);
@@ -497,6 +501,7 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
                 },
                 kTimingNs, 1, kMaxTimedCalls);
           }
+          if (meter.timed_out) row.ns = attempt_ns();
         } catch (const TimeLimitStop&) {
           row.ns = attempt_ns();
           outcome = {"time_limit", meter.count, 0, ""};
