@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -18,6 +19,21 @@
 
 namespace nlobs::cli {
 namespace {
+
+// printf into a string of whatever length it takes. A fixed line buffer cut long lines: a
+// plugin's names, escaped by printable (a byte may become "\\xNN"), overran 400 bytes, and the
+// cut split a UTF-8 sequence and dropped the line's end (found by fuzz_suite_report).
+[[gnu::format(printf, 1, 2)]] std::string formatted(const char* format, ...) {
+  va_list args, again;
+  va_start(args, format);
+  va_copy(again, args);
+  const int size = std::vsnprintf(nullptr, 0, format, args);
+  va_end(args);
+  std::string text(size > 0 ? static_cast<std::size_t>(size) : 0U, '\0');
+  if (size > 0) std::vsnprintf(text.data(), text.size() + 1, format, again);
+  va_end(again);
+  return text;
+}
 
 // 1e-08 as "1e-8": the threshold as a user types it.
 std::string short_number(double v) {
@@ -84,7 +100,6 @@ std::string answer_field(const Eigen::VectorXd& x) {
 
 void print_suite_tables(const std::vector<reference::SuiteRow>& rows, double threshold,
                         std::ostream& out, bool show_x) {
-  char line[400];
   std::string current;
   std::vector<std::string> order;
   std::map<std::string, int> solved, pairs;
@@ -115,24 +130,20 @@ void print_suite_tables(const std::vector<reference::SuiteRow>& rows, double thr
       } else {
         start += shown(r.start, 60);
       }
-      std::snprintf(line, sizeof line, "\n%s n=%d (%s)\n  %-*s %-7s %-28s %10s %8s %8s %12s%s%s\n",
-                    shown(r.problem, 80).c_str(), r.n, start.c_str(), width, "solver", "solved",
-                    "status", "|F|2", "F evals", "J evals", "time [us]",
-                    any_error ? "  |x-x*|inf" : "", any_scaled ? "   |D_f F|2" : "");
-      out << line;
+      out << formatted("\n%s n=%d (%s)\n  %-*s %-7s %-28s %10s %8s %8s %12s%s%s\n",
+                       shown(r.problem, 80).c_str(), r.n, start.c_str(), width, "solver", "solved",
+                       "status", "|F|2", "F evals", "J evals", "time [us]",
+                       any_error ? "  |x-x*|inf" : "", any_scaled ? "   |D_f F|2" : "");
     }
     const std::string solver = shown(r.solver, 48);
-    std::snprintf(line, sizeof line, "  %-*s %-7s %-28s %10.2e %8ld %8ld %12.1f", width,
-                  solver.c_str(), r.solved ? "yes" : "no", shown(r.status, 28).c_str(), r.residual,
-                  r.f_evals, r.j_evals, r.ns / 1e3);
-    out << line;
+    out << formatted("  %-*s %-7s %-28s %10.2e %8ld %8ld %12.1f", width, solver.c_str(),
+                     r.solved ? "yes" : "no", shown(r.status, 28).c_str(), r.residual, r.f_evals,
+                     r.j_evals, r.ns / 1e3);
     if (any_error) {
-      std::snprintf(line, sizeof line, " %11s", fmt(r.error, "%.2e").c_str());
-      out << line;
+      out << formatted(" %11s", fmt(r.error, "%.2e").c_str());
     }
     if (any_scaled) {
-      std::snprintf(line, sizeof line, " %11s", fmt(r.scaled_residual, "%.2e").c_str());
-      out << line;
+      out << formatted(" %11s", fmt(r.scaled_residual, "%.2e").c_str());
     }
     out << '\n';
     // A row without an answer, or stopped by the time limit, says why on the next line.
@@ -154,11 +165,9 @@ void print_suite_tables(const std::vector<reference::SuiteRow>& rows, double thr
       << " at the returned point), per solver:\n";
   for (const auto& s : order) {
     const auto& worst = idle[s];
-    std::snprintf(line, sizeof line, "  %-*s %3d / %-4d idle %6ld%s%s%s\n", width,
-                  shown(s, 48).c_str(), solved[s], pairs[s], worst.first,
-                  worst.first > 0 ? " (" : "", shown(worst.second, 100).c_str(),
-                  worst.first > 0 ? ")" : "");
-    out << line;
+    out << formatted("  %-*s %3d / %-4d idle %6ld%s%s%s\n", width, shown(s, 48).c_str(), solved[s],
+                     pairs[s], worst.first, worst.first > 0 ? " (" : "",
+                     shown(worst.second, 100).c_str(), worst.first > 0 ? ")" : "");
   }
   out << "idle: the most F evaluations one run made after |F| last fell below 0.999 x its lowest "
          "(that run; evals_past_progress in JSON and CSV)\n";

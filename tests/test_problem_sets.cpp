@@ -568,6 +568,20 @@ TEST(ProblemSets, TheWritersTakeAnyLabel) {
   cli::print_suite_tables(rows, 1e-8, table);
   EXPECT_NE(table.str().find("start a,\"b\"\\x0a\\xff\\x1b[31m"), std::string::npos) << table.str();
   EXPECT_NE(table.str().find("    line\\x0d\\x0abreak\n"), std::string::npos) << table.str();
+
+  // Names whose escapes run long (each byte of invalid UTF-8 is "\xNN"): the per-solver line
+  // holds them whole and ends its line (a 400-byte buffer cut it mid-escape, found by
+  // fuzz_suite_report).
+  SuiteRow idle = r;
+  idle.solver = std::string(48, '\xda');
+  idle.problem = std::string(100, '\xdb');
+  idle.evals_past_progress = 7;
+  std::ostringstream long_table;
+  cli::print_suite_tables({idle}, 1e-8, long_table);
+  const std::string text = long_table.str();
+  const std::size_t at = text.find(" idle      7 (");
+  ASSERT_NE(at, std::string::npos) << text;
+  EXPECT_NE(text.find(")\nidle: the most F evaluations", at), std::string::npos) << text;
 }
 
 TEST(ProblemSets, MalformedProblemsAreRefusedNamingTheProblem) {
