@@ -169,8 +169,8 @@ void print_suite_tables(const std::vector<reference::SuiteRow>& rows, double thr
                      pairs[s], worst.first, worst.first > 0 ? " (" : "",
                      shown(worst.second, 100).c_str(), worst.first > 0 ? ")" : "");
   }
-  out << "idle: the most F evaluations one run made after |F| last fell below 0.999 x its lowest "
-         "(that run; evals_past_progress in JSON and CSV)\n";
+  out << "idle: the most F evaluations one run made after |F| last fell by 0.1 % (below 0.999 x "
+         "its value at the fall before; that run; evals_past_progress in JSON and CSV)\n";
 }
 
 std::string valid_utf8(std::string_view text) {

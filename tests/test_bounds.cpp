@@ -109,10 +109,13 @@ TEST(Bounds, EveryBoundedEngineSolvesTheSetWithoutEvaluatingOutsideTheBox) {
       // Measured (docs/solvers.md, "Bounds"): from Bullard-Biegler's start b every engine ends
       // at a minimum of |F| on the box's boundary (x2 at its lower bound), blocked_by_bound or
       // stagnated; Ferraris-Tronconi's b has an interior minimum of |F| that traps all but
-      // plain Newton; the residual flow leaves the box at Shacham's reactor.
+      // plain Newton; the residual flow leaves the box at Shacham's reactor. Pseudo-transient
+      // solved Ferraris-Tronconi from a after 528 evaluations with ‖F‖ rising on the way; its
+      // progress window (50 evaluations without a 0.1 % fall) now ends that run, as
+      // `pseudo-transient:progress_window=0` does not (docs/solvers.md).
       const std::map<std::string, int> measured = {
           {"newton", 6},  {"newton:linesearch=1", 5}, {"newton:trustregion=1", 5}, {"dogleg", 5},
-          {"broyden", 5}, {"levenberg-marquardt", 5}, {"pseudo-transient", 2},     {"auto", 6}};
+          {"broyden", 5}, {"levenberg-marquardt", 5}, {"pseudo-transient", 1},     {"auto", 6}};
       EXPECT_GE(solved, measured.at(spec)) << spec << (with_jacobian ? " (AD)" : " (differences)");
     }
   }

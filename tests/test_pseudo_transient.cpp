@@ -176,7 +176,9 @@ TEST(PseudoTransient, APseudoStepTooSmallToMoveXIsRefusedAndNeverConverged) {
   // x = 1e8, F = x − (1e8 + 10): at δ₀ = 2.3e-16 the step δF ≈ 2e-15 is below the spacing of x
   // (1.5e-8), x + p == x. Such a step is no step, and no convergence: δ doubles until x moves
   // (before: the same x at every iteration until the budget was spent). Switched evolution
-  // relaxation then grows δ only as fast as ‖F‖ falls: slowly from so small a δ₀.
+  // relaxation then grows δ only as fast as ‖F‖ falls: slowly from so small a δ₀ — too slowly
+  // for 0.1 % in 50 evaluations, so the progress window ends it (StopCriteria::progress_window);
+  // without the window, the budget.
   const auto far = scalar_root([](const auto& x) { return x - (1e8 + 10.0); });
   SolverOptions o;
   o.stop.max_evaluations = 200;
@@ -185,8 +187,16 @@ TEST(PseudoTransient, APseudoStepTooSmallToMoveXIsRefusedAndNeverConverged) {
       PseudoTransientEngine<1>({.initial_pseudo_step = 2.3e-16, .min_pseudo_step = 2.3e-16}, o)
           .solve(far, x);
   EXPECT_FALSE(s.converged()) << s.full_report();
-  EXPECT_EQ(s.status, Status::kMaxEvaluations);
+  EXPECT_EQ(s.status, Status::kStagnated);
+  EXPECT_NE(s.message.find("progress_window"), std::string::npos) << s.message;
   EXPECT_GT(x[0], 1e8);  // it moved
+  x[0] = 1e8;
+  o.stop.progress_window = 0;
+  s = PseudoTransientEngine<1>({.initial_pseudo_step = 2.3e-16, .min_pseudo_step = 2.3e-16}, o)
+          .solve(far, x);
+  EXPECT_FALSE(s.converged()) << s.full_report();
+  EXPECT_EQ(s.status, Status::kMaxEvaluations);
+  EXPECT_GT(x[0], 1e8);
   // From δ₀ = 1e-2 (the default) the same problem is solved in a few steps.
   x[0] = 1e8;
   s = PseudoTransientEngine<1>({}, o).solve(far, x);

@@ -379,10 +379,11 @@ TEST(Status, InvalidInputReportedBySolveOrReport) {
 }
 
 TEST(Status, EveryStatusHasAName) {
-  for (Status st : {Status::kConverged, Status::kMaxIterations, Status::kMaxEvaluations,
-                    Status::kStagnated, Status::kRepeatedIterates, Status::kDiverged,
-                    Status::kNonFinite, Status::kSingularJacobian, Status::kInvalidInput,
-                    Status::kSolverFailure, Status::kBlockedByBound, Status::kRoundingFloor}) {
+  for (Status st :
+       {Status::kConverged, Status::kMaxIterations, Status::kMaxEvaluations, Status::kStagnated,
+        Status::kRepeatedIterates, Status::kDiverged, Status::kNonFinite, Status::kSingularJacobian,
+        Status::kInvalidInput, Status::kSolverFailure, Status::kBlockedByBound,
+        Status::kRoundingFloor, Status::kLocalMinimum}) {
     EXPECT_NE(to_string(st), "unknown");
   }
 }

@@ -65,9 +65,9 @@ bool is_reference(const std::string& s) {
   return std::find(refs.begin(), refs.end(), s) != refs.end();
 }
 
-// A fall of ‖F‖ counts when it goes below (1 − this) × the lowest before it, as the engines'
-// own rule has it (StopMonitor): rounding-level jitter near a root sets no record.
-constexpr double kMeaningfulFall = 1e-3;
+// A fall of ‖F‖ counts when it goes below (1 − this) × the value at the fall before it, as the
+// engines' progress window has it (ProgressWindow): rounding-level jitter near a root is none.
+constexpr double kMeaningfulFall = kMeaningfulResidualFall;
 
 // Counts the evaluations of F (or G) one solve makes and refuses those beyond its budget or past
 // its deadline: the refused call returns NaN without calling the problem, and the row becomes
@@ -82,10 +82,11 @@ struct Meter {
   bool timed = false;
   Clock::time_point deadline{};
   double time_limit_s = 0.0;
-  // Progress: the lowest ‖D_f F‖₂ seen at an evaluated point, and the count at the last
-  // evaluation that brought it below (1 − kMeaningfulFall) × the lowest before.
+  // Progress, as the engines' StopCriteria::progress_window counts it: the count at the last
+  // evaluation that brought ‖D_f F‖₂ below (1 − kMeaningfulFall) × its value at the fall before
+  // (the anchor). A slow but steady descent makes progress; jitter at a floor does not.
   const Eigen::VectorXd* f_scale = nullptr;
-  double lowest = std::numeric_limits<double>::infinity();
+  double anchor = std::numeric_limits<double>::infinity();
   long last_fall = 0;
   Eigen::VectorXd scratch, residual;
   void reset(long budget, double limit_s) {
@@ -93,7 +94,7 @@ struct Meter {
     cap = budget;
     refused = timed_out = false;
     late_calls = 0;
-    lowest = std::numeric_limits<double>::infinity();
+    anchor = std::numeric_limits<double>::infinity();
     last_fall = 0;
     timed = std::isfinite(limit_s);
     time_limit_s = limit_s;
@@ -117,8 +118,10 @@ struct Meter {
       scratch = f.cwiseProduct(*f_scale);
       norm = scratch.stableNorm();
     }
-    if (norm < (1.0 - kMeaningfulFall) * lowest) last_fall = count;
-    lowest = std::min(lowest, norm);
+    if (norm < (1.0 - kMeaningfulFall) * anchor) {
+      anchor = norm;
+      last_fall = count;
+    }
   }
   // After an evaluation of G: F = G(x) − x.
   void saw_fixed_point(const Eigen::VectorXd& x, const Eigen::VectorXd& g) {

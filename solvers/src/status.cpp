@@ -32,6 +32,8 @@ std::string_view to_string(Status status) {
       return "blocked_by_bound";
     case Status::kRoundingFloor:
       return "rounding_floor";
+    case Status::kLocalMinimum:
+      return "local_minimum";
   }
   return "unknown";
 }

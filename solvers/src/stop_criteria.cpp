@@ -34,6 +34,9 @@ void validate(const StopCriteria& c) {
   if (c.stagnation_patience < 0) {
     fail("stagnation_patience", c.stagnation_patience, "must be >= 0 (0 disables it)");
   }
+  if (c.progress_window < 0) {
+    fail("progress_window", c.progress_window, "must be >= 0 (0 disables it)");
+  }
   if (c.residual_window < 0) {
     fail("residual_window", c.residual_window, "must be >= 0 (0 disables it)");
   }

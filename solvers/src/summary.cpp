@@ -16,7 +16,8 @@ std::string sci(double v) {
 
 bool cut_short(Status s) {
   return s == Status::kMaxIterations || s == Status::kMaxEvaluations || s == Status::kStagnated ||
-         s == Status::kRepeatedIterates || s == Status::kRoundingFloor;
+         s == Status::kRepeatedIterates || s == Status::kRoundingFloor ||
+         s == Status::kLocalMinimum;
 }
 
 }  // namespace
@@ -56,6 +57,7 @@ std::string Summary::unusable_reason() const {
     case Status::kStagnated:
     case Status::kRepeatedIterates:
     case Status::kRoundingFloor:
+    case Status::kLocalMinimum:
       if (!judged)
         return status_name + " at a point whose residual does not show a solution" + detail;
       if (residual_norm > small) {

@@ -140,8 +140,7 @@ Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& 
     return std::move(*scaled);
   }
   const StopCriteria& stop = this->options_.stop;
-  system_.start(name(), problem, x, this->bounds_, broyden_.finite_difference,
-                stop.max_evaluations);
+  system_.start(name(), problem, x, this->bounds_, broyden_.finite_difference, stop);
   const detail::Box<N>& box = system_.box();
   const Index n = x.size();
   if constexpr (N == Dynamic) {
@@ -169,7 +168,7 @@ Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& 
   }
   while (!status) {
     if (system_.budget_spent()) {
-      status = Status::kMaxEvaluations;
+      status = system_.spent_status(summary.message);
       break;
     }
     d_.noalias() = -(h_ * f_);
@@ -185,7 +184,7 @@ Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& 
     }
     if (!accepted) {
       if (system_.budget_spent()) {
-        status = Status::kMaxEvaluations;
+        status = system_.spent_status(summary.message);
       } else if (!fresh) {  // a stale H: try again along the Newton direction
         status = renew(summary.message);
         fresh = !status;

@@ -188,7 +188,10 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
   add({"auto",
        "polyalgorithm: engines in order within one budget, until one answer is usable",
        {{"order", std::string("engine names separated by '/'; default ") + kAutoOrder},
-        {"from", "start|best: each stage from x0 or from the best point so far; default start"}},
+        {"from", "start|best: each stage from x0 or from the best point so far; default start"},
+        {"shared_minimum",
+         "stop (local_minimum) when this many stages end at the same point without "
+         "progress, 0 = off; default 2"}},
        {"auto", "auto:order=dogleg/levenberg-marquardt,from=best"},
        [](EngineSpecReader& s, SolverOptions o) {
          PolyalgorithmOptions p;
@@ -200,6 +203,7 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
            else
              throw InvalidInput("auto: from=" + *v + " is not best or start");
          }
+         if (auto v = s.integer("shared_minimum", 0, 1000)) p.shared_minimum = *v;
          const std::string order = s.text("order").value_or(kAutoOrder);
          std::vector<std::unique_ptr<Engine<N>>> stages;
          for (std::size_t at = 0; at <= order.size();) {

@@ -181,7 +181,7 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
   }
   StopCriteria stop = this->options_.stop;
   stop.stagnation_patience = 0;  // replaced by the trust region's own progress tests
-  system_.start(name(), problem, x, this->bounds_, dogleg_.finite_difference, stop.max_evaluations);
+  system_.start(name(), problem, x, this->bounds_, dogleg_.finite_difference, stop);
   const detail::Box<N>& box = system_.box();
   const Index n = x.size();
   if constexpr (N == Dynamic) {
@@ -227,7 +227,7 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
   int jacobians = 0;
   while (!status) {
     if (system_.budget_spent()) {
-      status = Status::kMaxEvaluations;
+      status = system_.spent_status(summary.message);
       break;
     }
     // J_F = ∂G − I, factored J = Q R.
@@ -254,7 +254,7 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
       dogleg_step(delta);
       if (!accepted_any) delta = std::min(delta, diag_.cwiseProduct(p_).norm());
       if (system_.budget_spent()) {
-        status = Status::kMaxEvaluations;
+        status = system_.spent_status(summary.message);
         break;
       }
       // In a box the step is P(x + p) − x: the model, the ratio and the update all use it. The

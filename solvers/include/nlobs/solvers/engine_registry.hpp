@@ -2,7 +2,7 @@
 // Engines by name: EngineRegistry<N>::global().create("anderson:m=3,damping=0.5").
 // Every built-in engine is registered; a user registers their own under its own name with
 // add(). Options common to all engines: tol (step tolerance), ftol (residual tolerance),
-// max_iter, max_evals.
+// max_iter, max_evals, progress_window.
 //
 // One registration serves every size: a fixed-size registry EngineRegistry<N> that has no entry
 // of a name uses the entry of EngineRegistry<Dynamic> through DynamicSizeEngine<N>. An entry
@@ -67,7 +67,10 @@ class EngineRegistry {
         {"tol", "step tolerance, max norm; default 1e-8"},
         {"ftol", "residual tolerance ‖F‖∞; default off"},
         {"max_iter", "maximum iterations; default 10000"},
-        {"max_evals", "maximum function evaluations; default 100000"}};
+        {"max_evals", "maximum function evaluations; default 100000"},
+        {"progress_window",
+         "evaluations without a 0.1 % fall of |F|_2 before a Jacobian-based engine stops "
+         "stagnated, 0 = off; default 50"}};
     return common;
   }
 
@@ -199,6 +202,7 @@ std::unique_ptr<Engine<N>> EngineRegistry<N>::create(std::string_view spec_text,
   if (auto v = reader.number("ftol")) base.stop.residual_tolerance = *v;
   if (auto v = reader.integer("max_iter", 1, 1000000000)) base.stop.max_iterations = *v;
   if (auto v = reader.integer("max_evals", 1, 1000000000)) base.stop.max_evaluations = *v;
+  if (auto v = reader.integer("progress_window", 0, 1000000000)) base.stop.progress_window = *v;
   std::unique_ptr<Engine<N>> engine;
   try {
     engine = entry->make(reader, std::move(base));

@@ -119,6 +119,7 @@ class LevenbergMarquardtEngine : public Engine<N> {
   Eigen::Matrix<Index, N, 1> perm_;
   FiniteDifferenceWorkspace<N> fd_;
   detail::Box<N> box_;
+  ProgressWindow progress_;
 };
 
 template <int N>
@@ -289,13 +290,26 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
   StopMonitor monitor(stop, x.template lpNorm<Eigen::Infinity>(), /*estimate_lipschitz=*/false);
   int evaluations = 0, jacobians = 0;
   const double eps = std::numeric_limits<double>::epsilon();
+  progress_.start(stop.progress_window);
   auto evaluate = [&](const Vector<N>& at, ResidualVector& out) {
     ++evaluations;
-    return residual(at, out);
+    const bool finite = residual(at, out);
+    progress_.saw(finite ? out.stableNorm() : std::numeric_limits<double>::infinity());
+    return finite;
   };
 
   x_ = x;
   std::optional<Status> status;
+  // The budget is spent, or the progress window passed without progress: status set.
+  auto spent = [&] {
+    if (evaluations >= stop.max_evaluations) {
+      status = Status::kMaxEvaluations;
+    } else if (progress_.expired()) {
+      summary.message = progress_.message();
+      status = Status::kStagnated;
+    }
+    return status.has_value();
+  };
   if (!evaluate(x_, f_)) {
     status = Status::kNonFinite;
   } else if (detail::solved_at_start<Dynamic>(f_, stop)) {
@@ -317,10 +331,7 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
   };
 
   while (!status) {
-    if (evaluations >= stop.max_evaluations) {
-      status = Status::kMaxEvaluations;
-      break;
-    }
+    if (spent()) break;
     if (evaluations + jacobian_cost > stop.max_evaluations) {
       status = Status::kMaxEvaluations;  // the differences would overrun the budget
       break;
@@ -399,10 +410,7 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
         break;
       }
       if (!accepted_any) delta = std::min(delta, vnorm);
-      if (evaluations >= stop.max_evaluations) {
-        status = Status::kMaxEvaluations;
-        break;
-      }
+      if (spent()) break;
       p_ = v_;
       bool accelerated = false;
       if (lm_.geodesic_acceleration) {
@@ -421,10 +429,7 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
             accelerated = true;
           }
         }
-        if (evaluations >= stop.max_evaluations) {
-          status = Status::kMaxEvaluations;
-          break;
-        }
+        if (spent()) break;
       }
       // The radius follows the model's own step, as dogleg's: one the box cut short says
       // nothing against the model (near a strict bound each cut is 99 % of the room left).

@@ -115,7 +115,7 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
     return std::move(*scaled);
   }
   const StopCriteria& stop = this->options_.stop;
-  system_.start(name(), problem, x, this->bounds_, newton_.finite_difference, stop.max_evaluations);
+  system_.start(name(), problem, x, this->bounds_, newton_.finite_difference, stop);
   const detail::Box<N>& box = system_.box();
   const Index n = x.size();
   if constexpr (N == Dynamic) {
@@ -165,7 +165,7 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
 
   while (!status) {
     if (system_.budget_spent()) {
-      status = Status::kMaxEvaluations;
+      status = system_.spent_status(summary.message);
       break;
     }
     if ((status = system_.jacobian(x_, f_, jac_, summary.message))) break;
@@ -210,7 +210,7 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
             x_, dx_, newton_.line_search ? detail::BoxMove::kDirection : detail::BoxMove::kStep);
       }
       if (system_.budget_spent()) {
-        status = Status::kMaxEvaluations;
+        status = system_.spent_status(summary.message);
       } else if (held) {
         summary.message = box.blocked_message(
             *held, x_, fnorm, newton_.line_search ? "the descent direction" : "the Newton step");

@@ -30,6 +30,14 @@ struct PolyalgorithmOptions {
   // often leaves its best point at a local minimum of ‖F‖ that traps the next one (auto solves
   // 52 of 57 runs from the best point, 53 from the start).
   bool restart_from_best = false;
+  // Stop with Status::kLocalMinimum once this many stages ended, none usable (stagnated, at the
+  // rounding floor or blocked by a bound), at the same point with the same ‖F‖∞: within
+  // kSameMinimum relative, ‖x − x'‖∞ ≤ kSameMinimum · max(1, ‖x'‖∞) and
+  // |‖F‖ − ‖F'‖| ≤ kSameMinimum · max(‖F‖, ‖F'‖). Different methods from x0 that meet at one
+  // point have found a local minimum of ‖F‖ they cannot leave; the stages after them are not run.
+  // 0 = never: every stage runs until one is usable or the budget is spent.
+  int shared_minimum = 2;
+  static constexpr double kSameMinimum = 1e-3;
 };
 
 template <int N = Dynamic>
@@ -41,6 +49,10 @@ class PolyalgorithmEngine : public Engine<N> {
                       PolyalgorithmOptions poly = {}, SolverOptions options = {})
       : Engine<N>(std::move(options)), stages_(std::move(stages)), poly_(poly) {
     if (stages_.empty()) throw InvalidInput("auto: needs at least one engine to try");
+    if (poly_.shared_minimum < 0) {
+      throw InvalidInput("auto: shared_minimum = " + std::to_string(poly_.shared_minimum) +
+                         " is invalid: must be >= 0 (0 = off)");
+    }
     for (const auto& s : stages_) {
       if (!s) throw InvalidInput("auto: a stage engine is null");
       caps_.push_back(s->options().stop.max_evaluations);  // a stage's own cap stays a cap
@@ -75,6 +87,11 @@ class PolyalgorithmEngine : public Engine<N> {
     Summary best_summary, last;
     bool have_best = false, have_last = false;
     std::exception_ptr first_throw;  // null unless a stage threw: nothing allocated otherwise
+    // Where the stages that stopped without progress ended (PolyalgorithmOptions::shared_minimum).
+    std::vector<Vector<N>> ends;
+    std::vector<double> end_residuals;
+    std::vector<std::string> end_labels;
+    bool shared = false;
     int evaluations = 0, jacobians = 0, iterations = 0;
     std::ostringstream history;
     auto note = [&history](const std::string& what) {
@@ -118,6 +135,42 @@ class PolyalgorithmEngine : public Engine<N> {
         have_best = true;
       }
       if (last.function_evaluations > left) break;  // a stage that ignored its limit
+      if (poly_.shared_minimum > 0 && stopped_without_progress(last.status) && trial.allFinite() &&
+          std::isfinite(last.residual_norm)) {
+        int meeting = 1;
+        std::string met;
+        for (std::size_t j = 0; j < ends.size(); ++j) {
+          if (!same_minimum(trial, last.residual_norm, ends[j], end_residuals[j])) continue;
+          ++meeting;
+          met += (met.empty() ? "" : ", ") + end_labels[j];
+        }
+        if (meeting >= poly_.shared_minimum) {
+          std::ostringstream os;
+          os.precision(3);
+          os << stage.label() << " ended";
+          if (!met.empty()) os << " where " << met << " did";
+          os << " (|F| " << std::scientific << last.residual_norm
+             << "): a local minimum of |F| that is not a root";
+          if (k + 1 < stages_.size()) {
+            os << "; not run:";
+            for (std::size_t j = k + 1; j < stages_.size(); ++j) {
+              os << (j == k + 1 ? " " : ", ") << stages_[j]->label();
+            }
+          }
+          note(os.str());
+          // The answer is the best point: the meeting point or better. Stages held by the same
+          // bound keep that status (the history names the component).
+          if (last.status != Status::kBlockedByBound ||
+              best_summary.status != Status::kBlockedByBound) {
+            best_summary.status = Status::kLocalMinimum;
+          }
+          shared = true;
+          break;
+        }
+        ends.push_back(trial);
+        end_residuals.push_back(last.residual_norm);
+        end_labels.push_back(stage.label());
+      }
     }
     Summary s;
     if (have_best) {
@@ -145,7 +198,7 @@ class PolyalgorithmEngine : public Engine<N> {
     }
     const bool usable = s.usable();
     std::string before = history.str();
-    if (!usable && evaluations >= budget) {
+    if (!usable && !shared && evaluations >= budget) {
       before += (before.empty() ? "" : "; ") + std::string("the evaluation budget (") +
                 std::to_string(budget) + ") is spent";
     }
@@ -159,6 +212,16 @@ class PolyalgorithmEngine : public Engine<N> {
   }
 
  private:
+  static bool stopped_without_progress(Status status) {
+    return status == Status::kStagnated || status == Status::kRoundingFloor ||
+           status == Status::kBlockedByBound;
+  }
+  static bool same_minimum(const Vector<N>& x, double residual, const Vector<N>& y, double other) {
+    const double tol = PolyalgorithmOptions::kSameMinimum;
+    const double scale = std::max(1.0, y.template lpNorm<Eigen::Infinity>());
+    return (x - y).template lpNorm<Eigen::Infinity>() <= tol * scale &&
+           std::abs(residual - other) <= tol * std::max(residual, other);
+  }
   // Every stage takes the box (the scaling), or none does: a stage that refuses it
   // (levenberg-marquardt with geodesic acceleration refuses a box) puts the stages before it
   // back to their own, read through `get`.

@@ -112,7 +112,7 @@ Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vec
   }
   StopCriteria stop = this->options_.stop;
   stop.stagnation_patience = 0;  // ‖F‖ and the steps may grow along the flow
-  system_.start(name(), problem, x, this->bounds_, ptc_.finite_difference, stop.max_evaluations);
+  system_.start(name(), problem, x, this->bounds_, ptc_.finite_difference, stop);
   const detail::Box<N>& box = system_.box();
   const Index n = x.size();
   if constexpr (N == Dynamic) {
@@ -138,7 +138,20 @@ Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vec
   bool projected = false;
   while (!status) {
     if (system_.budget_spent()) {
-      status = Status::kMaxEvaluations;
+      status = system_.spent_status(summary.message);
+      // Out of progress where a bound holds a component against the flow σF: blocked there.
+      // The flow may still be settling the free components, but ‖F‖ is then the held
+      // component's, which no longer falls (and switched evolution relaxation, growing δ with
+      // ‖F‖⁻¹, keeps their steps small: ~700 to settle them in tests/test_strict_bounds.cpp).
+      if (*status == Status::kStagnated && box.active()) {
+        for (Index i = 0; i < n; ++i) {
+          if (!box.held(i, x_[i], sigma * f_[i], 0.0)) continue;
+          summary.message = box.blocked_message(i, x_, f_.template lpNorm<Eigen::Infinity>(),
+                                                "the pseudo-transient flow");
+          status = Status::kBlockedByBound;
+          break;
+        }
+      }
       break;
     }
     if ((status = system_.jacobian(x_, f_, jac_, summary.message))) break;  // J_F = ∂G − I
@@ -174,7 +187,7 @@ Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vec
       p_ = lu_.solve(f_);
       if (sigma < 0) p_ = -p_;
       if (system_.budget_spent()) {
-        status = Status::kMaxEvaluations;
+        status = system_.spent_status(summary.message);
         break;
       }
       xt_ = x_ + p_;

@@ -19,13 +19,15 @@ class SquareSystem {
  public:
   // A new solve of `problem` from x0 (checked: size, finite, inside `bounds`). Sizes the
   // workspace (at a fixed N nothing allocates).
+  // stop: its max_evaluations and progress_window.
   void start(std::string_view engine, const FixedPointProblem<N>& problem, const Vector<N>& x0,
-             const BoxBounds& bounds, FiniteDifference scheme, int max_evaluations) {
+             const BoxBounds& bounds, FiniteDifference scheme, const StopCriteria& stop) {
     check_initial_guess(engine, problem, x0);
     box_.start(engine, bounds, x0);
     problem_ = &problem;
     scheme_ = scheme;
-    max_evaluations_ = max_evaluations;
+    max_evaluations_ = stop.max_evaluations;
+    progress_.start(stop.progress_window);
     evaluations_ = jacobians_ = 0;
     if constexpr (N == Dynamic) g_.resize(x0.size()), fd_.resize(x0.size());
   }
@@ -36,12 +38,14 @@ class SquareSystem {
     if (problem_->has_residual()) {
       problem_->residual(x, f);
       check_output_size(*problem_, f);
-      return f.allFinite();
+    } else {
+      problem_->evaluate(x, g_);
+      check_output_size(*problem_, g_);
+      f = g_ - x;
     }
-    problem_->evaluate(x, g_);
-    check_output_size(*problem_, g_);
-    f = g_ - x;
-    return f.allFinite();
+    const bool finite = f.allFinite();
+    progress_.saw(finite ? f.stableNorm() : std::numeric_limits<double>::infinity());
+    return finite;
   }
 
   // jac = J_F(x) where f = F(x): the problem's ∂G (user or AD) or differences, minus I. nullopt,
@@ -72,7 +76,15 @@ class SquareSystem {
     return std::nullopt;
   }
 
-  bool budget_spent() const { return evaluations_ >= max_evaluations_; }
+  // The evaluation budget is spent, or the progress window has passed without progress: the run
+  // ends with spent_status().
+  bool budget_spent() const { return evaluations_ >= max_evaluations_ || progress_.expired(); }
+  // Why budget_spent(): kMaxEvaluations, or kStagnated with `message` set.
+  Status spent_status(std::string& message) const {
+    if (evaluations_ >= max_evaluations_) return Status::kMaxEvaluations;
+    message = progress_.message();
+    return Status::kStagnated;
+  }
   int evaluations() const { return evaluations_; }
   const Box<N>& box() const { return box_; }
   const FixedPointProblem<N>& problem() const { return *problem_; }
@@ -93,6 +105,7 @@ class SquareSystem {
   const FixedPointProblem<N>* problem_ = nullptr;
   FiniteDifference scheme_ = FiniteDifference::kCentral;
   int max_evaluations_ = 0, evaluations_ = 0, jacobians_ = 0;
+  ProgressWindow progress_;
   Vector<N> g_ = zero_vector<N>();
   FiniteDifferenceWorkspace<N> fd_;
   Box<N> box_;

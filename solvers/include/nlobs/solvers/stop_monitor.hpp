@@ -4,8 +4,10 @@
 // by zero: ratios are formed only from non-zero steps.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <optional>
+#include <string>
 
 #include "nlobs/solvers/stop_criteria.hpp"
 #include "nlobs/solvers/summary.hpp"
@@ -159,9 +161,7 @@ class StopMonitor {
 
  private:
   static constexpr int kRatios = 3;
-  // A fall of ‖F‖ counts when it goes below (1 − kMeaningfulFall) × the lowest before it: at the
-  // rounding floor ‖F‖ jitters and sets new records by hair's breadths.
-  static constexpr double kMeaningfulFall = 1e-3;
+  static constexpr double kMeaningfulFall = kMeaningfulResidualFall;
   // A step is at the level of rounding in x when ‖Δx‖∞ ≤ kRoundingSteps · ε · (‖x‖∞ + 1):
   // 2.2e-12 relative. An engine converging linearly with contraction L > 1 − kMeaningfulFall has
   // a residual that no longer "falls" by this rule, so it is named at the floor there, within
@@ -205,6 +205,43 @@ class StopMonitor {
   int zero_steps_ = 0;
   double ratios_[kRatios] = {0.0, 0.0, 0.0};
   int ratio_count_ = 0;
+};
+
+// StopCriteria::progress_window: counts the evaluations of F at iterates and trial points since
+// ‖F‖₂ last fell below (1 − kMeaningfulResidualFall) × its value at the fall before (the
+// anchor), for the engines that see every evaluation (SquareSystem, Levenberg–Marquardt). A
+// crawl of 1e-4 relative per evaluation makes progress every ten; jitter at a floor none. No
+// allocation until message().
+class ProgressWindow {
+ public:
+  void start(int window) {
+    window_ = window;
+    count_ = last_fall_ = 0;
+    anchor_ = std::numeric_limits<double>::infinity();
+  }
+  // After an evaluation: ‖F‖₂ there (NaN or inf when F is not finite: no progress).
+  void saw(double norm) {
+    ++count_;
+    if (norm < (1.0 - kMeaningfulResidualFall) * anchor_) {
+      anchor_ = norm;
+      last_fall_ = count_;
+    }
+  }
+  // The window has passed without progress (never when it is off).
+  bool expired() const { return window_ > 0 && count_ - last_fall_ >= window_; }
+  // Why the run stagnated, for Summary::message.
+  std::string message() const {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "|F|_2 has not fallen below 0.999 x %.6g in the last %d evaluations "
+                  "(StopCriteria::progress_window)",
+                  anchor_, window_);
+    return text;
+  }
+
+ private:
+  int window_ = 0, count_ = 0, last_fall_ = 0;
+  double anchor_ = std::numeric_limits<double>::infinity();
 };
 
 }  // namespace nlobs

@@ -62,10 +62,12 @@ struct Summary {
   // acceptance_tolerance):
   //   converged:  ‖F‖∞ ≤ small when a residual_tolerance was asked for (a step criterion met
   //               first under Combine::kAny does not excuse a residual above it);
-  //   cut short (max_iterations, max_evaluations, stagnated, repeated_iterates): only with
-  //               ‖F‖∞ ≤ small, on a root problem (at a least-squares or minimisation point ‖F‖
-  //               does not show a solution: not usable);
-  //   diverged, non_finite, singular_jacobian, solver_failure, invalid_input: never.
+  //   cut short (max_iterations, max_evaluations, stagnated, repeated_iterates,
+  //               rounding_floor, local_minimum): only with ‖F‖∞ ≤ small, on a root problem
+  //               (at a least-squares or minimisation point ‖F‖ does not show a solution: not
+  //               usable);
+  //   diverged, non_finite, singular_jacobian, solver_failure, invalid_input,
+  //   blocked_by_bound: never.
   bool usable() const;
   // Why usable() is false, in one line ("stagnated with |F| 1.500e+03 > acceptance_tolerance
   // 1.000e-06"); empty if usable.
