@@ -6,6 +6,7 @@
 #include <cmath>
 #include <memory>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "nlobs/solvers/builtin_engines.hpp"
@@ -137,6 +138,52 @@ TEST(Polyalgorithm, RestartsFromTheBestPointOrFromTheStart) {
     EXPECT_EQ(second_start[0], best ? 0.5 : 3.0);
     EXPECT_EQ(x[0], 1.0);
   }
+}
+
+// Stages scripted to end at `ends` (x, status), in order, on F = x² − 1 from 3.
+Summary run_scripted(const std::vector<std::pair<double, Status>>& ends, Eigen::VectorXd& x) {
+  std::vector<std::unique_ptr<Engine<>>> stages;
+  for (const auto& [to, status] : ends) {
+    stages.push_back(std::make_unique<ScriptedEngine>(
+        ScriptedEngine::Script{.to = Eigen::VectorXd::Constant(1, to), .status = status}, nullptr));
+  }
+  PolyalgorithmEngine<> engine(std::move(stages), {}, strict());
+  x = Eigen::VectorXd::Constant(1, 3.0);
+  return engine.solve(parabola(-1.0), x);
+}
+
+TEST(Polyalgorithm, ASharedMinimumNamesOnlyItsOwnPoint) {
+  Eigen::VectorXd x;
+  // Stage 1 ends singular near the root (|F| 5e-7, within acceptance_tolerance); stages 2 and 3
+  // meet at x = 0 (|F| = 1). The answer is stage 1's point with stage 1's status: unusable, not
+  // a local minimum made usable by its small |F|.
+  const double near_root = 1.0 + 2.5e-7;
+  Summary s = run_scripted({{near_root, Status::kSingularJacobian},
+                            {0.0, Status::kStagnated},
+                            {0.0, Status::kStagnated},
+                            {1.0, Status::kConverged}},
+                           x);
+  EXPECT_EQ(x[0], near_root);
+  EXPECT_EQ(s.status, Status::kSingularJacobian) << s.message;
+  EXPECT_FALSE(s.usable());
+  EXPECT_NE(s.message.find("a local minimum of |F| that is not a root"), std::string::npos)
+      << s.message;  // the history still says why the run stopped
+
+  // Where the meeting point is the best, it is a local minimum, whatever held one stage ...
+  s = run_scripted({{0.0, Status::kBlockedByBound}, {0.0, Status::kStagnated}}, x);
+  EXPECT_EQ(x[0], 0.0);
+  EXPECT_EQ(s.status, Status::kLocalMinimum) << s.message;
+  s = run_scripted({{0.0, Status::kStagnated}, {0.0, Status::kBlockedByBound}}, x);
+  EXPECT_EQ(s.status, Status::kLocalMinimum) << s.message;
+  // ... and blocked by a bound when a bound held every stage that met there.
+  s = run_scripted({{2.0, Status::kStagnated},
+                    {0.0, Status::kBlockedByBound},
+                    {0.0, Status::kBlockedByBound},
+                    {1.0, Status::kConverged}},
+                   x);
+  EXPECT_EQ(x[0], 0.0);
+  EXPECT_EQ(s.status, Status::kBlockedByBound) << s.message;
+  EXPECT_NE(s.message.find("not run: scripted"), std::string::npos) << s.message;
 }
 
 TEST(Polyalgorithm, UsersStagesThatThrowSkipRecordingOrOverrunTheirLimit) {

@@ -21,6 +21,7 @@
 #include "nlobs/solvers/newton_engine.hpp"
 #include "nlobs/solvers/root_adapter.hpp"
 #include "nlobs/solvers/stop_monitor.hpp"
+#include "test_support.hpp"
 
 namespace nlobs {
 namespace {
@@ -56,18 +57,9 @@ double scaled_residual(const Eigen::VectorXd& x) {
   return f.cwiseProduct(kFScale).lpNorm<Eigen::Infinity>();
 }
 
-const std::vector<std::string> kNewtonType = {"newton",
-                                              "newton:linesearch=1",
-                                              "newton:trustregion=1",
-                                              "dogleg",
-                                              "levenberg-marquardt",
-                                              "broyden",
-                                              "pseudo-transient",
-                                              "auto"};
-
 TEST(Scaling, EveryNewtonTypeEngineSolvesInTheScaledNormAndNoneWithout) {
   const auto g = heat_problem();
-  for (const std::string& spec : kNewtonType) {
+  for (const std::string& spec : test::kJacobianEngineSpecs) {
     SCOPED_TRACE(spec);
     auto engine = EngineRegistry<Dynamic>::global().create(spec, tight());
     ASSERT_TRUE(engine->accepts_scaling());
@@ -183,7 +175,7 @@ TEST(Scaling, TheBoxHoldsInTheProblemsVariables) {
         out[0] = x[0] * x[0] - 4.0;
       },
       1, 1));
-  for (const std::string& spec : kNewtonType) {
+  for (const std::string& spec : test::kJacobianEngineSpecs) {
     SCOPED_TRACE(spec);
     auto engine = EngineRegistry<Dynamic>::global().create(spec, tight());
     engine->set_bounds({Eigen::VectorXd::Constant(1, 0.0), Eigen::VectorXd::Constant(1, 10.0)});
@@ -229,7 +221,7 @@ TEST(Scaling, ARootOnABoundIsReachedInsideTheBox) {
       1, 1));
   // Not pseudo-transient: its flow ẋ = −D_u⁻¹ F is 49 times slower here (x̃ ≈ 25, far from the
   // order 1 a scaling should give) and spends its budget; the box is the point of this test.
-  for (const std::string& spec : kNewtonType) {
+  for (const std::string& spec : test::kJacobianEngineSpecs) {
     if (spec == "pseudo-transient") continue;
     SCOPED_TRACE(spec);
     auto engine = EngineRegistry<Dynamic>::global().create(spec, tight());
@@ -253,7 +245,7 @@ TEST(Scaling, ASmallResidualBesideALargeUnknownKeepsItsDigits) {
   const auto root = RootProblem<Dynamic>::with_autodiff(f, 1, 1);
   const auto g = to_fixed_point<Dynamic>(root);
   ASSERT_TRUE(g.has_residual());
-  for (const std::string& spec : kNewtonType) {
+  for (const std::string& spec : test::kJacobianEngineSpecs) {
     SCOPED_TRACE(spec);
     auto engine = EngineRegistry<Dynamic>::global().create(spec, tight());
     engine->set_scaling({{}, Eigen::VectorXd::Constant(1, 1e12)});

@@ -20,10 +20,6 @@
 namespace nlobs {
 namespace {
 
-const std::vector<std::string> kStrictEngines = {
-    "newton",  "newton:linesearch=1", "newton:trustregion=1", "dogleg",
-    "broyden", "levenberg-marquardt", "pseudo-transient",     "auto"};
-
 SolverOptions tight() {
   SolverOptions o = test::tolerance(1e-12);
   o.stop.residual_tolerance = 1e-10;
@@ -78,7 +74,7 @@ TEST(StrictBounds, EveryEngineSolvesWithoutEvaluatingOnTheBound) {
   const RootProblem<Dynamic> f = equilibrium();
   for (const bool scaled : {false, true}) {
     for (const bool with_jacobian : {true, false}) {
-      for (const std::string& spec : kStrictEngines) {
+      for (const std::string& spec : test::kJacobianEngineSpecs) {
         // The scaled flow of pseudo-transient is D_u = 100 times slower in c₀ (docs/solvers.md,
         // "Scaling"): 2985 iterations with AD, past the budget with differences.
         if (scaled && spec == "pseudo-transient") continue;
@@ -136,7 +132,7 @@ TEST(StrictBounds, ARootPastAStrictBoundEndsBlockedByBoundNamingIt) {
       return out;
     });
     for (const bool with_jacobian : {true, false}) {
-      for (const std::string& spec : kStrictEngines) {
+      for (const std::string& spec : test::kJacobianEngineSpecs) {
         const std::string run =
             spec + (upper ? " upper" : " lower") + (with_jacobian ? " (AD)" : " (differences)");
         auto engine = EngineRegistry<2>::global().create(spec, tight());
@@ -193,7 +189,7 @@ TEST(StrictBounds, AComponentNearAStrictBoundIsNotHeldByALargeGradient) {
     out << 1e4 * (x[0] - 5e-4);
     return out;
   });
-  for (const std::string& spec : kStrictEngines) {
+  for (const std::string& spec : test::kJacobianEngineSpecs) {
     auto engine = EngineRegistry<1>::global().create(spec, tight());
     BoxBounds box{Vector<1>(0.0), Eigen::VectorXd()};
     box.strict_lower = StrictBounds::Constant(1, true);

@@ -1,5 +1,6 @@
 #pragma once
 // Small problems with known answers, shared by the solver tests.
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -29,6 +30,12 @@ inline FixedPointProblem<3> diagonal_linear_problem(const Eigen::Vector3d& rates
       [rates, b](const Vector<3>& x, Vector<3>& g) { g = rates.cwiseProduct(x) + b; },
       [rates](const Vector<3>& /*x*/, Matrix<3, 3>& j) { j = rates.asDiagonal(); });
 }
+
+// Every engine spec that solves with a Jacobian (each globalisation of newton apart), in the
+// order of the documentation: the tests that every such engine must pass loop over it.
+inline const std::array<std::string, 8> kJacobianEngineSpecs = {
+    "newton",  "newton:linesearch=1", "newton:trustregion=1", "dogleg",
+    "broyden", "levenberg-marquardt", "pseudo-transient",     "auto"};
 
 // The message of the InvalidInput that f throws, or "<no exception>".
 template <typename F>

@@ -166,9 +166,15 @@ Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& 
     status = renew(summary.message);
     fresh = !status;
   }
+  // The budget or the progress window is spent: why (blocked where a bound holds x against
+  // −Jᵀ F, J the last Jacobian computed).
+  auto spent_status = [&] {
+    if (box.active()) gradient_.noalias() = -(jac_.transpose() * f_);
+    return system_.spent_status(summary.message, x_, gradient_, fnorm);
+  };
   while (!status) {
     if (system_.budget_spent()) {
-      status = system_.spent_status(summary.message);
+      status = spent_status();
       break;
     }
     d_.noalias() = -(h_ * f_);
@@ -184,7 +190,7 @@ Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& 
     }
     if (!accepted) {
       if (system_.budget_spent()) {
-        status = system_.spent_status(summary.message);
+        status = spent_status();
       } else if (!fresh) {  // a stale H: try again along the Newton direction
         status = renew(summary.message);
         fresh = !status;

@@ -212,10 +212,13 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
 
   // No further progress: blocked where the box holds x against −∇(½‖F‖²) = −Rᵀ Qᵀ F, else
   // stagnated for `why`.
-  auto stop_stuck = [&](const char* why) {
+  auto descent = [&]() -> const Vector<N>& {
     gradient_.noalias() = r_.template triangularView<Eigen::Upper>().transpose() * qtf_;
     gradient_ = -gradient_;
-    if (const std::optional<Index> i = box.blocking(x_, gradient_, detail::BoxMove::kDirection)) {
+    return gradient_;
+  };
+  auto stop_stuck = [&](const char* why) {
+    if (const std::optional<Index> i = box.blocking(x_, descent(), detail::BoxMove::kDirection)) {
       summary.message = box.blocked_message(*i, x_, f_.template lpNorm<Eigen::Infinity>(),
                                             "the descent direction");
       status = Status::kBlockedByBound;
@@ -224,10 +227,17 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
       status = Status::kStagnated;
     }
   };
+  // The budget or the progress window is spent: why (blocked where a bound holds x).
+  auto spent_status = [&] {
+    const bool factored = system_.jacobians() > 0;  // (the window needs one to expire)
+    return system_.spent_status(summary.message, x_,
+                                box.active() && factored ? descent() : gradient_,
+                                f_.template lpNorm<Eigen::Infinity>());
+  };
   int jacobians = 0;
   while (!status) {
     if (system_.budget_spent()) {
-      status = system_.spent_status(summary.message);
+      status = spent_status();
       break;
     }
     // J_F = ∂G − I, factored J = Q R.
@@ -254,7 +264,7 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
       dogleg_step(delta);
       if (!accepted_any) delta = std::min(delta, diag_.cwiseProduct(p_).norm());
       if (system_.budget_spent()) {
-        status = system_.spent_status(summary.message);
+        status = spent_status();
         break;
       }
       // In a box the step is P(x + p) − x: the model, the ratio and the update all use it. The

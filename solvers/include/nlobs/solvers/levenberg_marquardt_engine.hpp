@@ -290,7 +290,9 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
   StopMonitor monitor(stop, x.template lpNorm<Eigen::Infinity>(), /*estimate_lipschitz=*/false);
   int evaluations = 0, jacobians = 0;
   const double eps = std::numeric_limits<double>::epsilon();
-  progress_.start(stop.progress_window);
+  // A least-squares minimum has ‖F‖ > 0 and a warm start may sit at it: no window there (its
+  // stop is function_tolerance's, a convergence).
+  progress_.start(least_squares ? 0 : stop.progress_window);
   auto evaluate = [&](const Vector<N>& at, ResidualVector& out) {
     ++evaluations;
     const bool finite = residual(at, out);
@@ -300,16 +302,6 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
 
   x_ = x;
   std::optional<Status> status;
-  // The budget is spent, or the progress window passed without progress: status set.
-  auto spent = [&] {
-    if (evaluations >= stop.max_evaluations) {
-      status = Status::kMaxEvaluations;
-    } else if (progress_.expired()) {
-      summary.message = progress_.message();
-      status = Status::kStagnated;
-    }
-    return status.has_value();
-  };
   if (!evaluate(x_, f_)) {
     status = Status::kNonFinite;
   } else if (detail::solved_at_start<Dynamic>(f_, stop)) {
@@ -319,15 +311,25 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
   double delta = 0.0, xnorm = 0.0, lambda = 0.0, last_step = 0.0;
   bool accepted_any = false;  // until the first accepted step Δ ≤ ‖Dp‖ (MINPACK's iter = 1)
   // A square system stuck where a bound holds x against −∇(½‖F‖²) = −Jᵀ F is blocked.
-  auto stagnate = [&](const char* why) {
+  auto stagnate = [&](std::string why) {
     if (const std::optional<Index> i = box_.blocking(x_, gradient_, detail::BoxMove::kDirection)) {
       summary.message = box_.blocked_message(*i, x_, f_.template lpNorm<Eigen::Infinity>(),
                                              "the descent direction");
       status = Status::kBlockedByBound;
       return;
     }
-    summary.message = why;
+    summary.message = std::move(why);
     status = Status::kStagnated;
+  };
+  // The budget is spent, or the progress window passed without progress (stagnated, or blocked
+  // where a bound holds x against the descent direction): status set.
+  auto spent = [&] {
+    if (evaluations >= stop.max_evaluations) {
+      status = Status::kMaxEvaluations;
+    } else if (progress_.expired()) {
+      stagnate(progress_.message());
+    }
+    return status.has_value();
   };
 
   while (!status) {
@@ -417,7 +419,8 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
         // r_vv ≈ (2/h)((F(x + h v) − F(x))/h − J v); a = −(JᵀJ + λD²)⁻¹ Jᵀ r_vv.
         const double h = lm_.second_derivative_step;
         xt_ = x_ + h * v_;
-        if (evaluate(xt_, fh_)) {
+        ++evaluations;  // a probe for F'', not a point of the path: outside the progress window
+        if (residual(xt_, fh_)) {
           work_m_.noalias() = jac_ * v_;
           work_m_ = (2.0 / h) * ((fh_ - f_) / h - work_m_);
           work_m_.applyOnTheLeft(qr_.householderQ().adjoint());

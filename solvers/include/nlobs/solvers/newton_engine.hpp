@@ -165,7 +165,9 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
 
   while (!status) {
     if (system_.budget_spent()) {
-      status = system_.spent_status(summary.message);
+      // −∇φ at the last Jacobian: what a bound may hold (the window needs one to expire).
+      if (box.active() && system_.jacobians() > 0) dx_ = -gradient_;
+      status = system_.spent_status(summary.message, x_, dx_, fnorm);
       break;
     }
     if ((status = system_.jacobian(x_, f_, jac_, summary.message))) break;
@@ -209,12 +211,12 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
         held = box.blocking(
             x_, dx_, newton_.line_search ? detail::BoxMove::kDirection : detail::BoxMove::kStep);
       }
-      if (system_.budget_spent()) {
-        status = system_.spent_status(summary.message);
-      } else if (held) {
+      if (held) {  // even when the budget is spent too: the bound is why
         summary.message = box.blocked_message(
             *held, x_, fnorm, newton_.line_search ? "the descent direction" : "the Newton step");
         status = Status::kBlockedByBound;
+      } else if (system_.budget_spent()) {
+        status = system_.spent_status(summary.message);
       } else if (!newton_.line_search) {
         status = Status::kNonFinite;
       } else {

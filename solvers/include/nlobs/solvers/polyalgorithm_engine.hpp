@@ -91,6 +91,7 @@ class PolyalgorithmEngine : public Engine<N> {
     std::vector<Vector<N>> ends;
     std::vector<double> end_residuals;
     std::vector<std::string> end_labels;
+    std::vector<Status> end_statuses;
     bool shared = false;
     int evaluations = 0, jacobians = 0, iterations = 0;
     std::ostringstream history;
@@ -138,10 +139,12 @@ class PolyalgorithmEngine : public Engine<N> {
       if (poly_.shared_minimum > 0 && stopped_without_progress(last.status) && trial.allFinite() &&
           std::isfinite(last.residual_norm)) {
         int meeting = 1;
+        bool all_blocked = last.status == Status::kBlockedByBound;
         std::string met;
         for (std::size_t j = 0; j < ends.size(); ++j) {
           if (!same_minimum(trial, last.residual_norm, ends[j], end_residuals[j])) continue;
           ++meeting;
+          all_blocked = all_blocked && end_statuses[j] == Status::kBlockedByBound;
           met += (met.empty() ? "" : ", ") + end_labels[j];
         }
         if (meeting >= poly_.shared_minimum) {
@@ -158,11 +161,12 @@ class PolyalgorithmEngine : public Engine<N> {
             }
           }
           note(os.str());
-          // The answer is the best point: the meeting point or better. Stages held by the same
-          // bound keep that status (the history names the component).
-          if (last.status != Status::kBlockedByBound ||
-              best_summary.status != Status::kBlockedByBound) {
-            best_summary.status = Status::kLocalMinimum;
+          // The answer is the best point. When it is the meeting point, its status says why the
+          // run ended there: local_minimum, or blocked_by_bound when every stage that met there
+          // was held by a bound (the history names the component). A better point another stage
+          // left keeps that stage's own status: its failure is not this minimum's.
+          if (same_minimum(best, best_residual, trial, last.residual_norm)) {
+            best_summary.status = all_blocked ? Status::kBlockedByBound : Status::kLocalMinimum;
           }
           shared = true;
           break;
@@ -170,6 +174,7 @@ class PolyalgorithmEngine : public Engine<N> {
         ends.push_back(trial);
         end_residuals.push_back(last.residual_norm);
         end_labels.push_back(stage.label());
+        end_statuses.push_back(last.status);
       }
     }
     Summary s;

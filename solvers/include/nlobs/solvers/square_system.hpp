@@ -85,7 +85,21 @@ class SquareSystem {
     message = progress_.message();
     return Status::kStagnated;
   }
+  // As above, where a window that expired with the box holding x against `descent` (−∇(½‖F‖²)
+  // at the engine's last Jacobian) is kBlockedByBound: out of progress because a bound stops x,
+  // the diagnosis the engine's own stuck tests would have given.
+  Status spent_status(std::string& message, const Vector<N>& x, const Vector<N>& descent,
+                      double residual_norm) const {
+    const Status spent = spent_status(message);
+    if (spent != Status::kStagnated || !box_.active()) return spent;
+    if (const std::optional<Index> i = box_.blocking(x, descent, BoxMove::kDirection)) {
+      message = box_.blocked_message(*i, x, residual_norm, "the descent direction");
+      return Status::kBlockedByBound;
+    }
+    return spent;
+  }
   int evaluations() const { return evaluations_; }
+  int jacobians() const { return jacobians_; }
   const Box<N>& box() const { return box_; }
   const FixedPointProblem<N>& problem() const { return *problem_; }
 

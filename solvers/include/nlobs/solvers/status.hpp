@@ -30,10 +30,11 @@ enum class Status {
   // falling: the engine can get no closer in double precision (StopCriteria). Usable when ‖F‖
   // meets acceptance_tolerance, like the other statuses that cut a run short.
   kRoundingFloor,
-  // `auto`: two of its stages (different methods) ended, neither usable, at the same point
-  // with the same ‖F‖∞ (each within 1e-3, relative): a local minimum of ‖F‖ that is not a root,
-  // which the later stages are not run to find again (PolyalgorithmOptions::shared_minimum).
-  // Usable when ‖F‖ meets acceptance_tolerance, like the statuses that cut a run short.
+  // `auto`: PolyalgorithmOptions::shared_minimum of its stages (default two; different methods)
+  // ended, none usable, at the same point with the same ‖F‖∞ (each within 1e-3, relative), and
+  // that point is the best any stage found: a local minimum of ‖F‖ that is not a root, which the
+  // later stages are not run to find again. Usable when ‖F‖ meets acceptance_tolerance, like the
+  // statuses that cut a run short.
   kLocalMinimum,
 };
 

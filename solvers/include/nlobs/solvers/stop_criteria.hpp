@@ -77,8 +77,9 @@ struct StopCriteria {
 // L ∉ [0, 1), negative patience, growth ≤ 1, limits ≤ 0, ...).
 void validate(const StopCriteria& criteria);
 
-// A fall of ‖F‖ counts as progress when it goes below (1 − kMeaningfulResidualFall) × the lowest
-// before it: at the rounding floor ‖F‖ jitters and sets new records by hair's breadths.
+// A fall of ‖F‖ counts as progress when it goes below (1 − kMeaningfulResidualFall) × its value at
+// the last such fall (not the lowest seen since): at the rounding floor ‖F‖ jitters and sets new
+// records by hair's breadths, and a crawl of 1e-4 per evaluation still counts once per eleven.
 inline constexpr double kMeaningfulResidualFall = 1e-3;
 
 }  // namespace nlobs

@@ -41,6 +41,7 @@ class StopMonitor {
                                bool step_may_converge = true) {
     ++iterations_;
     last_step_ = step;
+    reason_ = nullptr;  // a reason only for the status of the last update
     // Did ‖F‖ fall by a meaningful fraction below every earlier residual? (NaN: unknown.)
     const double best_before = lowest_residual_;
     const bool residual_known = std::isfinite(residual);
@@ -50,7 +51,9 @@ class StopMonitor {
       ratios_[ratio_count_ % kRatios] = step / prev_step_;
       ++ratio_count_;
     }
-    if (iterate_norm > limit_) return Status::kDiverged;
+    if (iterate_norm > limit_) {
+      return stop(Status::kDiverged, "|x|inf exceeded divergence_limit x max(1, |x0|inf)");
+    }
     constexpr double kNoStep = std::numeric_limits<double>::infinity();
     const double relative = step / (iterate_norm + 1.0);
     if (converged(step_may_converge ? (c_.relative_step ? relative : step) : kNoStep,
@@ -60,7 +63,7 @@ class StopMonitor {
 
     zero_steps_ = (step == 0.0) ? zero_steps_ + 1 : 0;
     if (c_.stop_on_repeated_iterates && zero_steps_ >= 2) {
-      return Status::kRepeatedIterates;  // x_l = x_{l−1} = x_{l−2}
+      return stop(Status::kRepeatedIterates, "x_l = x_(l-1) = x_(l-2)");
     }
     // The rounding floor: the step is at the level of rounding in x and ‖F‖ no longer falls,
     // kFloorPatience times in a row. Newton's own step there is J⁻¹ times F's rounding noise,
@@ -73,7 +76,10 @@ class StopMonitor {
     floor_count_ = residual_known && step_may_converge && rounding_step && !residual_fell
                        ? floor_count_ + 1
                        : 0;
-    if (floor_count_ >= kFloorPatience) return Status::kRoundingFloor;
+    if (floor_count_ >= kFloorPatience) {
+      return stop(Status::kRoundingFloor,
+                  "the step is at the level of rounding in x and |F| no longer falls");
+    }
     if (progress_ == Progress::kBestResidual) {
       if (residual < best_before) {  // a new record (NaN: none)
         since_best_ = 0;
@@ -83,8 +89,16 @@ class StopMonitor {
         far_above_ = residual > c_.divergence_growth * best_before ? far_above_ + 1 : 0;
       }
       if (c_.residual_window > 0) {
-        if (far_above_ >= c_.residual_window) return Status::kDiverged;
-        if (since_best_ >= c_.residual_window) return Status::kStagnated;
+        if (far_above_ >= c_.residual_window) {
+          return stop(Status::kDiverged,
+                      "every residual of the last residual_window iterations exceeded "
+                      "divergence_growth x the best before them");
+        }
+        if (since_best_ >= c_.residual_window) {
+          return stop(Status::kStagnated,
+                      "no residual of the last residual_window iterations fell below the best "
+                      "before them");
+        }
       }
     } else if (iterations_ > 1 && step >= prev_step_) {
       if (non_shrinking_ == 0) {
@@ -105,13 +119,18 @@ class StopMonitor {
         } else {
           const bool grew =
               run_start_step_ > 0.0 ? step > c_.divergence_growth * run_start_step_ : step > 0.0;
-          return grew ? Status::kDiverged : Status::kStagnated;
+          return grew ? stop(Status::kDiverged,
+                             "the step grew more than divergence_growth x over "
+                             "stagnation_patience iterations while |F| did not fall 0.1 %")
+                      : stop(Status::kStagnated,
+                             "the steps did not shrink over stagnation_patience iterations "
+                             "while |F| did not fall 0.1 %");
         }
       }
     } else {
       non_shrinking_ = 0;
     }
-    if (iterations_ >= c_.max_iterations) return Status::kMaxIterations;
+    if (iterations_ >= c_.max_iterations) return stop(Status::kMaxIterations, nullptr);
     prev_step_ = step;
     return std::nullopt;
   }
@@ -138,8 +157,10 @@ class StopMonitor {
   }
 
   // Copies step, contraction, L, the error bound for `residual` at the returned point and
-  // the a priori iteration count into the summary.
+  // the a priori iteration count into the summary; and, when the run ended with the status this
+  // monitor returned and the engine left no message, the rule that ended it.
   void fill(Summary& s, double residual) const {
+    if (s.message.empty() && reason_ && stopped_ == s.status) s.message = reason_;
     s.iterations = iterations_;
     s.step_norm = last_step_;
     s.residual_norm = residual;
@@ -189,7 +210,16 @@ class StopMonitor {
     return c_.combine == Combine::kAny ? met > 0 : met == enabled;
   }
 
+  // The status update() returns, with the rule's reason for Summary::message (static text).
+  Status stop(Status status, const char* reason) {
+    stopped_ = status;
+    reason_ = reason;
+    return status;
+  }
+
   StopCriteria c_;
+  Status stopped_ = Status::kConverged;
+  const char* reason_ = nullptr;
   double limit_;
   bool estimate_lipschitz_;
   Progress progress_;
@@ -210,8 +240,8 @@ class StopMonitor {
 // StopCriteria::progress_window: counts the evaluations of F at iterates and trial points since
 // ‖F‖₂ last fell below (1 − kMeaningfulResidualFall) × its value at the fall before (the
 // anchor), for the engines that see every evaluation (SquareSystem, Levenberg–Marquardt). A
-// crawl of 1e-4 relative per evaluation makes progress every ten; jitter at a floor none. No
-// allocation until message().
+// crawl of 1e-4 relative per evaluation makes progress every eleven evaluations; jitter at a
+// floor none. No allocation until message().
 class ProgressWindow {
  public:
   void start(int window) {
