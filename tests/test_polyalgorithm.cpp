@@ -175,6 +175,8 @@ TEST(Polyalgorithm, ASharedMinimumNamesOnlyItsOwnPoint) {
   EXPECT_EQ(s.status, Status::kLocalMinimum) << s.message;
   s = run_scripted({{0.0, Status::kStagnated}, {0.0, Status::kBlockedByBound}}, x);
   EXPECT_EQ(s.status, Status::kLocalMinimum) << s.message;
+  s = run_scripted({{0.0, Status::kStagnated}, {1e-4, Status::kBlockedByBound}}, x);
+  EXPECT_EQ(s.status, Status::kLocalMinimum) << s.message;  // the best is the blocked one's
   // ... and blocked by a bound when a bound held every stage that met there.
   s = run_scripted({{2.0, Status::kStagnated},
                     {0.0, Status::kBlockedByBound},

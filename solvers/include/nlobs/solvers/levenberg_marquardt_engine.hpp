@@ -327,7 +327,15 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
     if (evaluations >= stop.max_evaluations) {
       status = Status::kMaxEvaluations;
     } else if (progress_.expired()) {
-      stagnate(progress_.message());
+      // (where ‖F‖∞ is already usable, stagnated: a blocked answer is never usable)
+      const double usable =
+          std::max(stop.residual_tolerance.value_or(0.0), stop.acceptance_tolerance);
+      if (f_.template lpNorm<Eigen::Infinity>() <= usable) {
+        summary.message = progress_.message();
+        status = Status::kStagnated;
+      } else {
+        stagnate(progress_.message());
+      }
     }
     return status.has_value();
   };
@@ -419,7 +427,10 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
         // r_vv ≈ (2/h)((F(x + h v) − F(x))/h − J v); a = −(JᵀJ + λD²)⁻¹ Jᵀ r_vv.
         const double h = lm_.second_derivative_step;
         xt_ = x_ + h * v_;
-        ++evaluations;  // a probe for F'', not a point of the path: outside the progress window
+        // A probe for F'', not a point of the path: it counts towards the progress window but
+        // is never progress.
+        ++evaluations;
+        progress_.saw(std::numeric_limits<double>::infinity());
         if (residual(xt_, fh_)) {
           work_m_.noalias() = jac_ * v_;
           work_m_ = (2.0 / h) * ((fh_ - f_) / h - work_m_);

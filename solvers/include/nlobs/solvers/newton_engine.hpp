@@ -211,12 +211,12 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
         held = box.blocking(
             x_, dx_, newton_.line_search ? detail::BoxMove::kDirection : detail::BoxMove::kStep);
       }
-      if (held) {  // even when the budget is spent too: the bound is why
+      if (system_.budget_spent()) {
+        status = system_.spent_status(summary.message, x_, dx_, fnorm);
+      } else if (held) {
         summary.message = box.blocked_message(
             *held, x_, fnorm, newton_.line_search ? "the descent direction" : "the Newton step");
         status = Status::kBlockedByBound;
-      } else if (system_.budget_spent()) {
-        status = system_.spent_status(summary.message);
       } else if (!newton_.line_search) {
         status = Status::kNonFinite;
       } else {

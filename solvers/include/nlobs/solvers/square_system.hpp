@@ -3,6 +3,7 @@
 // square root problem (Newton, dogleg, Levenberg–Marquardt, Broyden, pseudo-transient): the one
 // place that counts evaluations, checks G's size, keeps a difference Jacobian inside the
 // evaluation budget and the box, and fills the Summary at the end.
+#include <algorithm>
 #include <limits>
 #include <optional>
 #include <string>
@@ -27,6 +28,7 @@ class SquareSystem {
     problem_ = &problem;
     scheme_ = scheme;
     max_evaluations_ = stop.max_evaluations;
+    usable_residual_ = std::max(stop.residual_tolerance.value_or(0.0), stop.acceptance_tolerance);
     progress_.start(stop.progress_window);
     evaluations_ = jacobians_ = 0;
     if constexpr (N == Dynamic) g_.resize(x0.size()), fd_.resize(x0.size());
@@ -87,11 +89,14 @@ class SquareSystem {
   }
   // As above, where a window that expired with the box holding x against `descent` (−∇(½‖F‖²)
   // at the engine's last Jacobian) is kBlockedByBound: out of progress because a bound stops x,
-  // the diagnosis the engine's own stuck tests would have given.
+  // the diagnosis the engine's own stuck tests would have given — unless ‖F‖∞ (residual_norm) is
+  // already small enough to use: a stagnated answer is usable there, a blocked one never.
   Status spent_status(std::string& message, const Vector<N>& x, const Vector<N>& descent,
                       double residual_norm) const {
     const Status spent = spent_status(message);
-    if (spent != Status::kStagnated || !box_.active()) return spent;
+    if (spent != Status::kStagnated || !box_.active() || residual_norm <= usable_residual_) {
+      return spent;
+    }
     if (const std::optional<Index> i = box_.blocking(x, descent, BoxMove::kDirection)) {
       message = box_.blocked_message(*i, x, residual_norm, "the descent direction");
       return Status::kBlockedByBound;
@@ -119,6 +124,7 @@ class SquareSystem {
   const FixedPointProblem<N>* problem_ = nullptr;
   FiniteDifference scheme_ = FiniteDifference::kCentral;
   int max_evaluations_ = 0, evaluations_ = 0, jacobians_ = 0;
+  double usable_residual_ = 0.0;  // max(residual_tolerance, acceptance_tolerance)
   ProgressWindow progress_;
   Vector<N> g_ = zero_vector<N>();
   FiniteDifferenceWorkspace<N> fd_;
