@@ -31,6 +31,7 @@ configure_package_config_file(cmake/nlobsConfig.cmake.in
 write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/nlobsConfigVersion.cmake
                                  COMPATIBILITY SameMinorVersion)
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/nlobsConfig.cmake ${PROJECT_SOURCE_DIR}/cmake/FindADOLC.cmake
+              ${PROJECT_SOURCE_DIR}/cmake/FindKLU.cmake
               ${PROJECT_SOURCE_DIR}/cmake/NlobsPlugin.cmake
               ${CMAKE_CURRENT_BINARY_DIR}/nlobsConfigVersion.cmake
         DESTINATION ${NLOBS_CMAKE_DIR})

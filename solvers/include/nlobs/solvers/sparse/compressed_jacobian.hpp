@@ -22,11 +22,10 @@
 #include "nlobs/solvers/autodiff.hpp"
 #include "nlobs/solvers/callable.hpp"
 #include "nlobs/solvers/sparse/column_colouring.hpp"
+#include "nlobs/solvers/sparse/sparse_jacobian.hpp"
 #include "nlobs/solvers/sparse/sparsity_pattern.hpp"
 
 namespace nlobs {
-
-using SparseJacobian = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
 class CompressedJacobian {
  public:

@@ -1,0 +1,21 @@
+#pragma once
+// A linear solver from a spec string, in the engine spec grammar (engine_spec.hpp):
+//   dense-lu | band-lu[:lower=L,upper=U] | sparse-lu | klu
+//   gmres[:restart=30,max_iterations=300,preconditioner=none|jacobi|ilu0|ilut,
+//          drop_tolerance=1e-4,fill_factor=10]
+//   bicgstab[:max_iterations=300,preconditioner=…,drop_tolerance=…,fill_factor=…]
+// Unknown names and options throw InvalidInput listing the valid ones.
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "nlobs/solvers/linear/linear_solver.hpp"
+
+namespace nlobs {
+
+std::unique_ptr<LinearSolver> make_linear_solver(std::string_view spec);
+// The names make_linear_solver accepts, with a one-line description each.
+std::vector<std::pair<std::string, std::string>> linear_solver_names();
+
+}  // namespace nlobs

@@ -1,0 +1,114 @@
+#include "nlobs/solvers/linear/make_linear_solver.hpp"
+
+#include <limits>
+
+#include "nlobs/solvers/engine_spec.hpp"
+#include "nlobs/solvers/linear/band_lu.hpp"
+#include "nlobs/solvers/linear/bicgstab.hpp"
+#include "nlobs/solvers/linear/dense_lu.hpp"
+#include "nlobs/solvers/linear/gmres.hpp"
+#include "nlobs/solvers/linear/klu.hpp"
+#include "nlobs/solvers/linear/preconditioners.hpp"
+#include "nlobs/solvers/linear/sparse_lu.hpp"
+
+namespace nlobs {
+namespace {
+
+constexpr int kIntMax = std::numeric_limits<int>::max();
+
+const std::vector<EngineOptionInfo>& preconditioner_options() {
+  static const std::vector<EngineOptionInfo> options = {
+      {"preconditioner", "none (default), jacobi, ilu0 or ilut; right preconditioning"},
+      {"drop_tolerance", "ilut: drop entries below this x the row norm, in (0, 1), default 1e-4"},
+      {"fill_factor", "ilut: at most this x J's entries per row, >= 1, default 10"}};
+  return options;
+}
+
+std::unique_ptr<LinearPreconditioner> read_preconditioner(EngineSpecReader& reader) {
+  const std::string kind = reader.text("preconditioner").value_or("none");
+  IlutOptions ilut;
+  const auto drop = reader.number("drop_tolerance");
+  const auto fill = reader.integer("fill_factor", 1, kIntMax);
+  if ((drop || fill) && kind != "ilut") {
+    throw InvalidInput(
+        "linear solver options drop_tolerance and fill_factor belong to "
+        "preconditioner=ilut, not " +
+        kind);
+  }
+  if (drop) ilut.drop_tolerance = *drop;
+  if (fill) ilut.fill_factor = *fill;
+  if (kind == "none") return nullptr;
+  if (kind == "jacobi") return std::make_unique<JacobiPreconditioner>();
+  if (kind == "ilu0") return std::make_unique<Ilu0Preconditioner>();
+  if (kind == "ilut") return std::make_unique<IlutPreconditioner>(ilut);
+  throw InvalidInput("linear solver preconditioner '" + kind +
+                     "' is unknown; valid: none, jacobi, ilu0, ilut");
+}
+
+std::vector<EngineOptionInfo> with_preconditioner(std::vector<EngineOptionInfo> options) {
+  const auto& more = preconditioner_options();
+  options.insert(options.end(), more.begin(), more.end());
+  return options;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> linear_solver_names() {
+  return {
+      {"dense-lu", "LU with partial pivoting of J made dense: O(n^2) memory, O(n^3) work"},
+      {"band-lu", "band LU with partial pivoting (LAPACK dgbtf2): widths from J or lower=,upper="},
+      {"sparse-lu", "Eigen's supernodal SparseLU, COLAMD ordering"},
+      {"klu", "SuiteSparse KLU (BTF + AMD), refactoring with the last pivot order"},
+      {"gmres", "restarted GMRES(m), right-preconditioned"},
+      {"bicgstab", "BiCGSTAB, right-preconditioned"}};
+}
+
+std::unique_ptr<LinearSolver> make_linear_solver(std::string_view text) {
+  const EngineSpec spec = parse_engine_spec(text);
+  if (spec.name == "dense-lu" || spec.name == "sparse-lu" || spec.name == "klu") {
+    EngineSpecReader reader(spec, {});
+    reader.finish();
+    if (spec.name == "dense-lu") return std::make_unique<DenseLuSolver>();
+    if (spec.name == "sparse-lu") return std::make_unique<SparseLuSolver>();
+    return std::make_unique<KluSolver>();
+  }
+  if (spec.name == "band-lu") {
+    EngineSpecReader reader(spec, {{"lower", "lower bandwidth, >= 0 (with upper; default: J's)"},
+                                   {"upper", "upper bandwidth, >= 0 (with lower; default: J's)"}});
+    const auto lower = reader.integer("lower", 0, kIntMax);
+    const auto upper = reader.integer("upper", 0, kIntMax);
+    reader.finish();
+    if (lower.has_value() != upper.has_value()) {
+      throw InvalidInput("linear solver spec '" + spec.text +
+                         "': give both lower and upper, or neither");
+    }
+    if (lower) return std::make_unique<BandLuSolver>(*lower, *upper);
+    return std::make_unique<BandLuSolver>();
+  }
+  if (spec.name == "gmres") {
+    EngineSpecReader reader(
+        spec, with_preconditioner({{"restart", "Krylov vectors per cycle, >= 1, default 30"},
+                                   {"max_iterations", "over all cycles, >= 1, default 300"}}));
+    GmresOptions options;
+    if (const auto v = reader.integer("restart", 1, 100000)) options.restart = *v;
+    if (const auto v = reader.integer("max_iterations", 1, kIntMax)) options.max_iterations = *v;
+    auto preconditioner = read_preconditioner(reader);
+    reader.finish();
+    return std::make_unique<GmresSolver>(options, std::move(preconditioner));
+  }
+  if (spec.name == "bicgstab") {
+    EngineSpecReader reader(spec, with_preconditioner({{"max_iterations", ">= 1, default 300"}}));
+    BicgstabOptions options;
+    if (const auto v = reader.integer("max_iterations", 1, kIntMax)) options.max_iterations = *v;
+    auto preconditioner = read_preconditioner(reader);
+    reader.finish();
+    return std::make_unique<BicgstabSolver>(options, std::move(preconditioner));
+  }
+  std::string valid;
+  for (const auto& [name, description] : linear_solver_names()) {
+    valid += (valid.empty() ? "" : ", ") + name;
+  }
+  throw InvalidInput("linear solver '" + spec.name + "' is unknown; valid: " + valid);
+}
+
+}  // namespace nlobs
