@@ -1,5 +1,6 @@
 #include "nlobs/solvers/linear/make_linear_solver.hpp"
 
+#include <algorithm>
 #include <limits>
 
 #include "nlobs/solvers/engine_spec.hpp"
@@ -10,6 +11,7 @@
 #include "nlobs/solvers/linear/klu.hpp"
 #include "nlobs/solvers/linear/preconditioners.hpp"
 #include "nlobs/solvers/linear/sparse_lu.hpp"
+#include "nlobs/solvers/sparse/sparsity_pattern.hpp"
 
 namespace nlobs {
 namespace {
@@ -109,6 +111,25 @@ std::unique_ptr<LinearSolver> make_linear_solver(std::string_view text) {
     valid += (valid.empty() ? "" : ", ") + name;
   }
   throw InvalidInput("linear solver '" + spec.name + "' is unknown; valid: " + valid);
+}
+
+std::string choose_linear_solver(const std::string& requested, const SparsityPattern& pattern,
+                                 Index n) {
+  if (pattern.rows != n || pattern.cols != n) {
+    throw InvalidInput("the sparse Jacobian's pattern is " + std::to_string(pattern.rows) + "x" +
+                       std::to_string(pattern.cols) + ", the problem has " + std::to_string(n) +
+                       " unknowns");
+  }
+  if (requested != "auto") return requested;
+  Index width = 0;
+  for (Index i = 0; i < pattern.rows; ++i) {
+    const Index first = pattern.row_start[static_cast<std::size_t>(i)];
+    const Index end = pattern.row_start[static_cast<std::size_t>(i) + 1];
+    if (first == end) continue;
+    width = std::max({width, i - pattern.columns[static_cast<std::size_t>(first)],
+                      pattern.columns[static_cast<std::size_t>(end) - 1] - i});
+  }
+  return width <= kAutoBandWidth ? "band-lu" : "klu";
 }
 
 }  // namespace nlobs

@@ -77,6 +77,7 @@ std::string Summary::brief_report() const {
   os << to_string(status) << " after " << iterations << " iterations (" << function_evaluations
      << " evaluations";
   if (jacobian_evaluations > 0) os << ", " << jacobian_evaluations << " Jacobians";
+  if (linear_iterations > 0) os << ", " << linear_iterations << " linear iterations";
   os << "), |step| " << sci(step_norm);
   if (!std::isnan(residual_norm)) os << ", |F| " << sci(residual_norm);
   if (objective) os << ", f " << sci(*objective);
@@ -94,8 +95,13 @@ std::string Summary::full_report() const {
   if (!message.empty()) os << "  message                " << message << '\n';
   os << "  iterations             " << iterations << '\n'
      << "  function evaluations   " << function_evaluations << '\n'
-     << "  jacobian evaluations   " << jacobian_evaluations << '\n'
-     << "  final step norm        " << sci(step_norm) << '\n'
+     << "  jacobian evaluations   " << jacobian_evaluations << '\n';
+  if (!linear_solver.empty()) {
+    os << "  linear solver          " << linear_solver << " (" << linear_setups << " setups";
+    if (linear_iterations > 0) os << ", " << linear_iterations << " Krylov iterations";
+    os << ")\n";
+  }
+  os << "  final step norm        " << sci(step_norm) << '\n'
      << "  final residual norm    " << sci(residual_norm) << '\n';
   if (objective) os << "  objective              " << sci(*objective) << '\n';
   if (contraction_estimate) {

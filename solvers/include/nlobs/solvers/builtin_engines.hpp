@@ -75,14 +75,27 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
        "Newton on F = G - x, any Jacobian source",
        {{"linesearch", "0/1 Armijo backtracking; default 0"},
         {"trustregion", "0/1 dogleg trust region, a Jacobian every iterate; default 0"},
-        {"fd", "forward|central differences when no Jacobian; default central"}},
-       {"newton", "newton:linesearch=1", "newton:trustregion=1"},
+        {"fd", "forward|central differences when no Jacobian; default central"},
+        {"linear",
+         "auto|dense|band-lu|sparse-lu|klu|gmres|bicgstab: the linear solver of a problem with "
+         "a sparse Jacobian; default auto (band-lu or klu)"},
+        {"preconditioner", "none|jacobi|ilu0|ilut, with linear=gmres|bicgstab; default none"}},
+       {"newton", "newton:linesearch=1", "newton:trustregion=1",
+        "newton:linesearch=1,linear=gmres,preconditioner=ilu0"},
        [](EngineSpecReader& s, SolverOptions o) {
          NewtonOptions n;
          if (auto v = s.boolean("linesearch")) n.line_search = *v;
          if (auto v = s.boolean("trustregion")) n.trust_region = *v;
          if (auto v = s.text("fd"))
            n.finite_difference = detail::parse_finite_difference("newton", *v);
+         if (auto v = s.text("linear")) n.linear_solver = *v;
+         if (auto v = s.text("preconditioner")) {
+           if (n.linear_solver != "gmres" && n.linear_solver != "bicgstab") {
+             throw InvalidInput("newton: preconditioner=" + *v +
+                                " needs linear=gmres or linear=bicgstab");
+           }
+           n.linear_solver += ":preconditioner=" + *v;
+         }
          return std::make_unique<NewtonEngine<N>>(n, std::move(o));
        }});
   add({"dogleg",

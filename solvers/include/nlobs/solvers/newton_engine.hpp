@@ -12,12 +12,19 @@
 // projected steepest-descent path of ½‖F‖² is searched from its Cauchy point. A point where a
 // bound holds x against the descent direction and neither path decreases ‖F‖ ends the run
 // blocked_by_bound (without a line search: where the projected Newton step is zero).
+// Sparse path (run-time size, a problem with a sparse Jacobian: sparse/sparse_problem.hpp): J_F is
+// assembled sparse and the step solved by NewtonOptions::linear_solver (nlobs/solvers/linear/);
+// with a Krylov solver the step is inexact, ‖F + J_F Δx‖₂ ≤ η_k ‖F‖₂ with η_k from
+// Eisenstat–Walker [EW96] (Newton–Krylov), and a Krylov solve that ends above η_k but below ‖F‖
+// still gives a descent direction of ‖F‖² and is taken.
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <sstream>
+#include <string>
 #include <string_view>
 #include <utility>
 
@@ -25,6 +32,9 @@
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
+#include "nlobs/solvers/linear/forcing_term.hpp"
+#include "nlobs/solvers/linear/linear_solver.hpp"
+#include "nlobs/solvers/linear/make_linear_solver.hpp"
 #include "nlobs/solvers/square_system.hpp"
 #include "nlobs/solvers/stop_monitor.hpp"
 
@@ -39,6 +49,13 @@ struct NewtonOptions {
   int max_backtracks = 30;            // ≥ 1
   // Used only when the problem carries no Jacobian.
   FiniteDifference finite_difference = FiniteDifference::kCentral;
+  // The sparse path's linear solver, a make_linear_solver spec ("klu", "gmres:preconditioner=
+  // ilu0", …), or "auto" (band-lu when J's bandwidth is at most 16, kAutoBandWidth, else klu), or
+  // "dense" (the dense path even for a problem with a sparse Jacobian). Read only for problems
+  // with a sparse Jacobian; the trust region is dense whatever this says.
+  std::string linear_solver = "auto";
+  // η_k of the Krylov solvers (ignored by the direct ones).
+  ForcingTermOptions forcing{};
 };
 
 template <int N = Dynamic>
@@ -58,6 +75,15 @@ class NewtonEngine : public Engine<N> {
       fail("backtrack_factor", newton_.backtrack_factor, "must lie in (0, 1)");
     }
     if (newton_.max_backtracks < 1) fail("max_backtracks", newton_.max_backtracks, "must be >= 1");
+    if (newton_.linear_solver != "auto" && newton_.linear_solver != "dense") {
+      try {
+        make_linear_solver(newton_.linear_solver);
+      } catch (const InvalidInput& e) {
+        throw InvalidInput(std::string("NewtonOptions::linear_solver: ") + e.what() +
+                           " (or auto, dense)");
+      }
+    }
+    forcing_ = ForcingTerm(newton_.forcing);
     if (newton_.line_search && newton_.trust_region) {
       throw InvalidInput(
           "NewtonOptions: line_search and trust_region are two globalisations; "
@@ -80,6 +106,12 @@ class NewtonEngine : public Engine<N> {
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
 
  private:
+  // dx_ = −J_F⁻¹ f_ at x_ (dense: jac_, LU; sparse: sparse_jac_, linear_); nullopt or the status.
+  std::optional<Status> dense_step(std::string& message, int iteration);
+  std::optional<Status> sparse_step(std::string& message);
+  // ∇φ = J_Fᵀ f_ (φ = ½‖F‖²) into gradient_, and ‖J_F gradient_‖², at the last Jacobian.
+  void merit_gradient(bool sparse);
+  double merit_curvature(bool sparse) const;
   void on_limit_evaluations(int max_evaluations) override {
     if (trust_region_) trust_region_->limit_evaluations(max_evaluations);
   }
@@ -99,10 +131,99 @@ class NewtonEngine : public Engine<N> {
   // of the largest |J_ij| is treated as a zero pivot: the Newton step would be meaningless.
   static constexpr double kSingularPivot = 1e-13;
   Eigen::PartialPivLU<Matrix<N, N>> lu_;
+  // The sparse path (run-time size only); the linear solver is made afresh for each solve.
+  SparseJacobian sparse_jac_;
+  std::shared_ptr<LinearSolver> linear_;
+  ForcingTerm forcing_;
+  Vector<N> linear_residual_ = zero_vector<N>();  // F_k + J_k (x_{k+1} − x_k), for [EW96]
 };
 
 template <int N>
+std::optional<Status> NewtonEngine<N>::dense_step(std::string& message, int iteration) {
+  if (const std::optional<Status> status = system_.jacobian(x_, f_, jac_, message)) return status;
+  lu_.compute(jac_);
+  const double smallest_pivot = lu_.matrixLU().diagonal().cwiseAbs().minCoeff();
+  if (!(smallest_pivot > kSingularPivot * jac_.cwiseAbs().maxCoeff())) {
+    std::ostringstream os;
+    os << "Jacobian of F is singular at iteration " << iteration + 1 << " (smallest LU pivot "
+       << smallest_pivot << ")";
+    message = os.str();
+    return Status::kSingularJacobian;
+  }
+  dx_ = lu_.solve(f_);
+  dx_ = -dx_;
+  if (!dx_.allFinite()) {
+    message = "Newton step is not finite (Jacobian numerically singular)";
+    return Status::kSingularJacobian;
+  }
+  return std::nullopt;
+}
+
+template <int N>
+std::optional<Status> NewtonEngine<N>::sparse_step(std::string& message) {
+  if constexpr (N == Dynamic) {
+    if (const std::optional<Status> status =
+            system_.sparse_jacobian(x_, f_, sparse_jac_, message)) {
+      return status;
+    }
+    LinearStatus linear = linear_->setup(sparse_jac_);
+    if (linear == LinearStatus::kSolved) {
+      linear = linear_->solve(f_, dx_, forcing_.eta());
+      // Above η_k but below ‖F‖: with r = F + J Δx, ∇φᵀΔx = Fᵀ J Δx = Fᵀ r − ‖F‖² < 0 when
+      // ‖r‖ < ‖F‖: still a descent direction.
+      if (linear == LinearStatus::kNotConverged && linear_->stats().last_residual < 1.0) {
+        linear = LinearStatus::kSolved;
+      }
+    }
+    if (linear != LinearStatus::kSolved) {
+      // A direct solver's zero pivot is J's; a Krylov solver's breakdown or singular
+      // preconditioner need not be (BiCGSTAB breaks down on regular systems).
+      message = linear_->message();
+      if (linear == LinearStatus::kNonFinite) return Status::kNonFinite;
+      if (linear == LinearStatus::kSingular && !linear_->iterative()) {
+        return Status::kSingularJacobian;
+      }
+      return Status::kSolverFailure;
+    }
+    dx_ = -dx_;
+    return std::nullopt;
+  } else {
+    static_cast<void>(message);
+    return Status::kInvalidInput;  // unreachable: fixed sizes have no sparse path
+  }
+}
+
+template <int N>
+void NewtonEngine<N>::merit_gradient(bool sparse) {
+  if constexpr (N == Dynamic) {
+    if (sparse) {
+      gradient_.noalias() = sparse_jac_.transpose() * f_;
+      return;
+    }
+  }
+  static_cast<void>(sparse);
+  gradient_.noalias() = jac_.transpose() * f_;
+}
+
+template <int N>
+double NewtonEngine<N>::merit_curvature(bool sparse) const {
+  if constexpr (N == Dynamic) {
+    if (sparse) return (sparse_jac_ * gradient_).squaredNorm();
+  }
+  static_cast<void>(sparse);
+  return (jac_ * gradient_).squaredNorm();
+}
+
+template <int N>
 Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
+  if (problem.sparse_residual_jacobian() != nullptr && newton_.linear_solver != "dense" &&
+      (trust_region_ || !this->scaling_.empty())) {
+    // Both would take the dense n×n path: say so rather than allocate it.
+    throw InvalidInput(std::string("newton: ") +
+                       (trust_region_ ? "the trust region" : "a scaling (set_scaling)") +
+                       " is not on the sparse path yet; use the line search, or "
+                       "NewtonOptions::linear_solver = \"dense\" for a small problem");
+  }
   if (trust_region_) {
     Summary s = trust_region_->solve(problem, x);
     s.engine = name();
@@ -118,10 +239,19 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
   system_.start(name(), problem, x, this->bounds_, newton_.finite_difference, stop);
   const detail::Box<N>& box = system_.box();
   const Index n = x.size();
+  bool sparse = false;
   if constexpr (N == Dynamic) {
     for (Vector<N>* v : {&x_, &f_, &dx_, &xt_, &ft_, &gradient_}) v->resize(n);
-    jac_.resize(n, n);
-    if (lu_.rows() != n) lu_ = Eigen::PartialPivLU<Matrix<N, N>>(n);
+    const SparseJacobianSource* source = problem.sparse_residual_jacobian();
+    sparse = source != nullptr && newton_.linear_solver != "dense";
+    if (sparse) {
+      linear_ =
+          make_linear_solver(choose_linear_solver(newton_.linear_solver, *source->pattern, n));
+      forcing_.restart();
+    } else {
+      jac_.resize(n, n);
+      if (lu_.rows() != n) lu_ = Eigen::PartialPivLU<Matrix<N, N>>(n);
+    }
   }
   Summary summary;
   summary.engine = name();
@@ -134,6 +264,9 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
   // in place (held_in_place).
   bool projected = false, held_in_place = false;
   double t = 1.0;
+  // An inexact (Krylov) step has ∇φᵀΔx = −‖F‖² + Fᵀr, not −‖F‖²: the Armijo test then takes the
+  // slope from ∇φ = J_Fᵀ F as a projected step does.
+  const bool inexact = sparse && linear_->iterative();
   auto search = [&](const Vector<N>& d, double t0, bool armijo) {
     const double phi0 = f_.squaredNorm();
     t = t0;
@@ -144,7 +277,7 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
       if (held_in_place) return false;  // every component that would move is held
       const bool finite = system_.residual(xt_, ft_);
       if (!armijo) return finite;
-      const double decrease = projected || box.active()
+      const double decrease = projected || box.active() || inexact
                                   ? -2.0 * newton_.sufficient_decrease * gradient_.dot(xt_ - x_)
                                   : 2.0 * newton_.sufficient_decrease * t * phi0;
       // (A projected Newton path need not descend: ∇φᵀ(x_t − x) > 0 still allows no increase.)
@@ -170,32 +303,18 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
       status = system_.spent_status(summary.message, x_, dx_, fnorm);
       break;
     }
-    if ((status = system_.jacobian(x_, f_, jac_, summary.message))) break;
-    lu_.compute(jac_);
-    const double smallest_pivot = lu_.matrixLU().diagonal().cwiseAbs().minCoeff();
-    if (!(smallest_pivot > kSingularPivot * jac_.cwiseAbs().maxCoeff())) {
-      std::ostringstream os;
-      os << "Jacobian of F is singular at iteration " << monitor.iterations() + 1
-         << " (smallest LU pivot " << smallest_pivot << ")";
-      summary.message = os.str();
-      status = Status::kSingularJacobian;
+    if ((status = sparse ? sparse_step(summary.message)
+                         : dense_step(summary.message, monitor.iterations()))) {
       break;
     }
-    dx_ = lu_.solve(f_);
-    dx_ = -dx_;
-    if (!dx_.allFinite()) {
-      summary.message = "Newton step is not finite (Jacobian numerically singular)";
-      status = Status::kSingularJacobian;
-      break;
-    }
-    if (box.active()) gradient_.noalias() = jac_.transpose() * f_;
+    if (box.active() || inexact) merit_gradient(sparse);
 
     // The Newton step (backtracked with a line search); in a box, when that finds no decrease,
     // the projected steepest-descent path from the Cauchy point of the linear model.
     bool descent_step = false;
     bool accepted = search(dx_, 1.0, newton_.line_search);
     if (!accepted && newton_.line_search && box.active() && !system_.budget_spent()) {
-      const double curvature = (jac_ * gradient_).squaredNorm();
+      const double curvature = merit_curvature(sparse);
       if (curvature > 0.0) {
         dx_ = -gradient_;
         accepted = search(dx_, gradient_.squaredNorm() / curvature, true);
@@ -227,6 +346,19 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
     }
     const double step = projected ? (xt_ - x_).template lpNorm<Eigen::Infinity>()
                                   : t * dx_.template lpNorm<Eigen::Infinity>();
+    if (inexact) {
+      // η_{k+1} from the step taken (backtracked, projected or not), [EW96] choice 1; a descent
+      // step was no Newton step: start afresh.
+      if constexpr (N == Dynamic) {
+        linear_residual_ = f_;
+        linear_residual_.noalias() += sparse_jac_ * (xt_ - x_);
+        if (descent_step) {
+          forcing_.restart();
+        } else {
+          forcing_.update(ft_.norm(), f_.norm(), linear_residual_.norm());
+        }
+      }
+    }
     x_ = xt_;
     f_ = ft_;
     fnorm = f_.template lpNorm<Eigen::Infinity>();
@@ -240,6 +372,11 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
 
   x = x_;
   system_.finish(summary, *status, monitor, x, f_, stop);
+  if (sparse) {
+    summary.linear_solver = std::string(linear_->name());
+    summary.linear_setups = linear_->stats().setups;
+    summary.linear_iterations = linear_->stats().iterations;
+  }
   return summary;
 }
 

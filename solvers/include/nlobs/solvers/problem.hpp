@@ -8,6 +8,7 @@
 // A problem type-erases the user's callable once, at construction: build it once and solve it
 // many times (a window estimator does); evaluating it never allocates for fixed sizes.
 #include <functional>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -18,7 +19,18 @@
 #include "nlobs/solvers/status.hpp"
 #include "nlobs/solvers/types.hpp"
 
+// Declared only: what the sparse path needs is in nlobs/solvers/sparse/ (the problem carries it
+// without every user of this header compiling Eigen's sparse module).
+namespace Eigen {
+template <typename Scalar, int Options, typename StorageIndex>
+class SparseMatrix;
+}  // namespace Eigen
+
 namespace nlobs {
+
+struct SparsityPattern;
+// = Eigen::SparseMatrix<double, RowMajor> (nlobs/solvers/sparse/sparse_jacobian.hpp).
+using SparseJacobian = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 
 // Where an engine that needs ∂G (Newton, the contraction check) gets it.
 enum class JacobianSource {
@@ -39,7 +51,25 @@ inline std::string_view to_string(JacobianSource source) {
   return "unknown";
 }
 
+// A sparse Jacobian of F at run-time size, for the engines' sparse path (docs/solvers.md, "Sparse
+// Jacobians"): its pattern, and `evaluate(x, f, J)` filling J = ∂F(x) with exactly that structure
+// (f = F(x), which differences need) and returning the evaluations of F it made (0 for AD).
+// Built by sparse_autodiff_problem / sparse_difference_problem (sparse/sparse_problem.hpp).
+struct SparseJacobianSource {
+  std::shared_ptr<const SparsityPattern> pattern;
+  std::function<int(const Vector<Dynamic>& x, const Vector<Dynamic>& f, SparseJacobian& jac)>
+      evaluate;
+  int evaluations_per_jacobian = 0;  // what evaluate returns: for the evaluation budget
+};
+
 namespace detail {
+inline void check_sparse_source(const char* owner, const SparseJacobianSource& sparse) {
+  if (!sparse.pattern || !sparse.evaluate || sparse.evaluations_per_jacobian < 0) {
+    throw InvalidInput(std::string(owner) +
+                       ": a sparse Jacobian needs a pattern, an evaluate function and "
+                       "evaluations_per_jacobian >= 0");
+  }
+}
 inline void check_size(const char* what, Index expected, Index got) {
   if (expected != got) {
     std::ostringstream os;
@@ -108,6 +138,20 @@ class FixedPointProblem {
     FixedPointProblem out = *this;
     out.f_ = std::move(f);
     out.df_ = std::move(df);
+    out.sparse_.reset();  // it was the old residual's
+    return out;
+  }
+  // ∂F of the residual form as a sparse matrix (run-time size only): the engines' sparse path.
+  // nullptr when the problem has none.
+  const SparseJacobianSource* sparse_residual_jacobian() const { return sparse_.get(); }
+  FixedPointProblem with_sparse_residual_jacobian(SparseJacobianSource sparse) const {
+    static_assert(N == Dynamic, "a sparse Jacobian is for run-time sizes");
+    if (!has_residual()) {
+      throw InvalidInput("FixedPointProblem: a sparse residual Jacobian needs the residual form");
+    }
+    detail::check_sparse_source("FixedPointProblem", sparse);
+    FixedPointProblem out = *this;
+    out.sparse_ = std::make_shared<const SparseJacobianSource>(std::move(sparse));
     return out;
   }
 
@@ -135,6 +179,7 @@ class FixedPointProblem {
   JacobianSource source_;
   Map f_;
   JacobianMap df_;
+  std::shared_ptr<const SparseJacobianSource> sparse_;
 };
 
 namespace detail {
@@ -190,6 +235,15 @@ class RootProblem {
   bool has_jacobian() const { return static_cast<bool>(df_); }
   void evaluate(const VectorType& x, ResidualType& f) const { f_(x, f); }
   void jacobian(const VectorType& x, JacobianType& jac) const { df_(x, jac); }
+  // ∂F as a sparse matrix (run-time size only), or nullptr: see sparse/sparse_problem.hpp.
+  const SparseJacobianSource* sparse_jacobian() const { return sparse_.get(); }
+  RootProblem with_sparse_jacobian(SparseJacobianSource sparse) const {
+    static_assert(N == Dynamic && M == Dynamic, "a sparse Jacobian is for run-time sizes");
+    detail::check_sparse_source("RootProblem", sparse);
+    RootProblem out = *this;
+    out.sparse_ = std::make_shared<const SparseJacobianSource>(std::move(sparse));
+    return out;
+  }
 
  private:
   RootProblem(Index n, Index m, Map f, JacobianMap df, JacobianSource source)
@@ -212,6 +266,9 @@ class RootProblem {
   Map f_;
   JacobianMap df_;
   JacobianSource source_;
+  // Shared by the problem's copies, workspace included (evaluate() holds its scratch): solve
+  // copies of a problem with a sparse Jacobian one at a time, not concurrently.
+  std::shared_ptr<const SparseJacobianSource> sparse_;
 };
 
 }  // namespace nlobs

@@ -57,11 +57,26 @@ FixedPointProblem<N> to_fixed_point(const RootProblem<N, N>& root,
   // With Ψ = I the engines that solve G(x) − x = 0 get F itself (FixedPointProblem::residual).
   const bool identity = std::holds_alternative<IdentityScaling>(psi);
   auto f = [root](const Vec& x, Vec& out) { root.evaluate(x, out); };
+  // F's sparse Jacobian is the residual form's (Ψ = I).
+  auto with_sparse = [&root](FixedPointProblem<N> out) {
+    if constexpr (N == Dynamic) {
+      if (const SparseJacobianSource* sparse = root.sparse_jacobian()) {
+        return out.with_sparse_residual_jacobian(*sparse);
+      }
+    }
+    return out;
+  };
   if (!root.has_jacobian()) {
     FixedPointProblem<N> out = FixedPointProblem<N>::from_map(std::move(g), n);
-    return identity ? out.with_residual(std::move(f)) : out;
+    return identity ? with_sparse(out.with_residual(std::move(f))) : out;
   }
-  auto dg = [root, psi, scratch = Jac(n, n)](const Vec& x, Jac& jac) mutable {
+  // A problem with a sparse Jacobian may be too large for a dense one: its scratch is sized only
+  // if a dense Jacobian is ever asked for.
+  const bool lazy = N == Dynamic && root.sparse_jacobian() != nullptr;
+  auto dg = [root, psi, scratch = lazy ? Jac() : Jac(n, n)](const Vec& x, Jac& jac) mutable {
+    if constexpr (N == Dynamic) {
+      if (scratch.rows() != root.size()) scratch.resize(root.size(), root.size());
+    }
     root.jacobian(x, scratch);
     if (const auto* m = std::get_if<Matrix<N, N>>(&psi)) {
       jac.noalias() = *m * scratch;
@@ -74,10 +89,10 @@ FixedPointProblem<N> to_fixed_point(const RootProblem<N, N>& root,
   FixedPointProblem<N> out =
       FixedPointProblem<N>::with_jacobian(std::move(g), std::move(dg), n, root.jacobian_source());
   if (!identity) return out;
-  return out.with_residual(std::move(f), [root](const Vec& x, Jac& jac) {
+  return with_sparse(out.with_residual(std::move(f), [root](const Vec& x, Jac& jac) {
     if constexpr (N == Dynamic) jac.resize(root.size(), root.size());
     root.jacobian(x, jac);
-  });
+  }));
 }
 
 }  // namespace nlobs

@@ -11,6 +11,7 @@
 #include "nlobs/solvers/box_bounds.hpp"
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
+#include "nlobs/solvers/linear/linear_solver.hpp"
 #include "nlobs/solvers/stop_monitor.hpp"
 
 namespace nlobs::detail {
@@ -72,6 +73,23 @@ class SquareSystem {
     }
     ++jacobians_;
     if (!jac.allFinite()) {
+      message = "the Jacobian of F is not finite";
+      return Status::kNonFinite;
+    }
+    return std::nullopt;
+  }
+
+  // jac = J_F(x) from the problem's sparse residual Jacobian (run-time size; the caller checked
+  // problem().sparse_residual_jacobian()), f = F(x). As jacobian(): nullopt or the status.
+  std::optional<Status> sparse_jacobian(const Vector<N>& x, const Vector<N>& f, SparseJacobian& jac,
+                                        std::string& message) {
+    const SparseJacobianSource& sparse = *problem_->sparse_residual_jacobian();
+    if (evaluations_ + sparse.evaluations_per_jacobian > max_evaluations_) {
+      return Status::kMaxEvaluations;
+    }
+    evaluations_ += sparse.evaluate(x, f, jac);
+    ++jacobians_;
+    if (detail::first_non_finite_row(jac) >= 0) {
       message = "the Jacobian of F is not finite";
       return Status::kNonFinite;
     }

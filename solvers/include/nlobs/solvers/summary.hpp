@@ -26,7 +26,12 @@ struct Summary {
   int iterations = 0;            // completed iterations of the engine's sequence
   int function_evaluations = 0;  // evaluations of G (or F), including finite differences
   int jacobian_evaluations = 0;  // Jacobians computed (user-supplied, AD or finite differences)
-  double step_norm = 0.0;        // ‖x_l − x_{l−1}‖∞ of the last step
+  // The sparse path's linear solver (nlobs/solvers/linear/): its name, its setups
+  // (factorisations or preconditioner builds) and Krylov iterations; empty and 0 on dense paths.
+  std::string linear_solver;
+  int linear_setups = 0;
+  int linear_iterations = 0;
+  double step_norm = 0.0;  // ‖x_l − x_{l−1}‖∞ of the last step
   double residual_norm = std::numeric_limits<double>::quiet_NaN();  // ‖G(x) − x‖∞ at the
                                                                     // returned x (NaN: unknown)
   // Ratio of the last consecutive step norms: estimates the linear convergence factor.

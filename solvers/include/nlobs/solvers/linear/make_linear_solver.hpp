@@ -15,6 +15,14 @@
 namespace nlobs {
 
 std::unique_ptr<LinearSolver> make_linear_solver(std::string_view spec);
+
+struct SparsityPattern;
+// The spec NewtonEngine's sparse path uses for an n-unknown problem whose Jacobian has `pattern`:
+// `requested` itself, or for "auto" band-lu when the bandwidth max(lower, upper) is at most
+// kAutoBandWidth, else klu. Throws InvalidInput when the pattern is not n×n.
+inline constexpr Index kAutoBandWidth = 16;
+std::string choose_linear_solver(const std::string& requested, const SparsityPattern& pattern,
+                                 Index n);
 // The names make_linear_solver accepts, with a one-line description each.
 std::vector<std::pair<std::string, std::string>> linear_solver_names();
 

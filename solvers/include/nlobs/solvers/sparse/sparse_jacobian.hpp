@@ -5,6 +5,6 @@
 
 namespace nlobs {
 
-using SparseJacobian = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+using SparseJacobian = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 
 }  // namespace nlobs

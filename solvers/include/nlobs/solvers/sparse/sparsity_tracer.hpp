@@ -24,6 +24,15 @@
 
 namespace nlobs {
 
+namespace detail {
+// Comparisons of values that depend on x since the counter was last reset, in this thread.
+inline thread_local long SparsityTracerBranches = 0;
+}  // namespace detail
+
+// The tracer and its functions live in a namespace of their own: argument-dependent lookup finds
+// them from generic code, and they do not hide ::abs, std::exp … from code in namespace nlobs.
+namespace sparsity_tracing {
+
 class SparsityTracer {
  public:
   SparsityTracer() = default;
@@ -111,28 +120,23 @@ class SparsityTracer {
   std::vector<Index> inputs_;
 };
 
-namespace detail {
-// Comparisons of values that depend on x since the counter was last reset, in this thread.
-inline thread_local long SparsityTracerBranches = 0;
-
 inline bool depends(const SparsityTracer& a) {
   return !a.inputs().empty();
 }
-}  // namespace detail
 
 // Comparisons: by value; one whose operands depend on x is a branch (counted).
-#define NLOBS_TRACER_COMPARISON(op)                                                 \
-  inline bool operator op(const SparsityTracer& a, const SparsityTracer& b) {       \
-    if (detail::depends(a) || detail::depends(b)) ++detail::SparsityTracerBranches; \
-    return a.value() op b.value();                                                  \
-  }                                                                                 \
-  inline bool operator op(const SparsityTracer& a, double b) {                      \
-    if (detail::depends(a)) ++detail::SparsityTracerBranches;                       \
-    return a.value() op b;                                                          \
-  }                                                                                 \
-  inline bool operator op(double a, const SparsityTracer& b) {                      \
-    if (detail::depends(b)) ++detail::SparsityTracerBranches;                       \
-    return a op b.value();                                                          \
+#define NLOBS_TRACER_COMPARISON(op)                                           \
+  inline bool operator op(const SparsityTracer& a, const SparsityTracer& b) { \
+    if (depends(a) || depends(b)) ++detail::SparsityTracerBranches;           \
+    return a.value() op b.value();                                            \
+  }                                                                           \
+  inline bool operator op(const SparsityTracer& a, double b) {                \
+    if (depends(a)) ++detail::SparsityTracerBranches;                         \
+    return a.value() op b;                                                    \
+  }                                                                           \
+  inline bool operator op(double a, const SparsityTracer& b) {                \
+    if (depends(b)) ++detail::SparsityTracerBranches;                         \
+    return a op b.value();                                                    \
   }
 NLOBS_TRACER_COMPARISON(<)
 NLOBS_TRACER_COMPARISON(<=)
@@ -217,6 +221,10 @@ NLOBS_TRACER_BINARY(min, std::min(x, y))
 NLOBS_TRACER_BINARY(max, std::max(x, y))
 NLOBS_TRACER_BINARY(copysign, std::copysign(x, y))
 #undef NLOBS_TRACER_BINARY
+
+}  // namespace sparsity_tracing
+
+using sparsity_tracing::SparsityTracer;
 
 }  // namespace nlobs
 

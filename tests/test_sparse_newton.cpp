@@ -1,0 +1,288 @@
+// Newton's sparse path: problems that carry a sparse Jacobian (sparse/sparse_problem.hpp) solved
+// with every linear solver of nlobs/solvers/linear/, on problems nlobs does not ship: Broyden's
+// tridiagonal function (up to n = 2·10⁵), 2-D Bratu (PETSc's SNES ex5), a singular linear system;
+// the same root as the dense path, the counts in the Summary, bounds, coloured differences, and
+// the named failures.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "nlobs/solvers/builtin_engines.hpp"
+#include "nlobs/solvers/engine_registry.hpp"
+#include "nlobs/solvers/newton_engine.hpp"
+#include "nlobs/solvers/root_adapter.hpp"
+#include "nlobs/solvers/sparse/sparse_problem.hpp"
+#include "test_support.hpp"
+
+namespace nlobs {
+namespace {
+
+// F_i = (3 − 2x_i) x_i − x_{i−1} − 2x_{i+1} + 1 (x_0 = x_{n+1} = 0).
+auto broyden_tridiagonal() {
+  return [](const auto& x, auto& f) {
+    const Index n = x.size();
+    f.resize(n);
+    for (Index i = 0; i < n; ++i) {
+      f[i] = (3.0 - 2.0 * x[i]) * x[i] + 1.0;
+      if (i > 0) f[i] -= x[i - 1];
+      if (i + 1 < n) f[i] -= 2.0 * x[i + 1];
+    }
+  };
+}
+
+// 2-D Bratu on an s×s grid, λ = 6.
+auto bratu(Index s) {
+  return [s](const auto& u, auto& f) {
+    using T = typename std::decay_t<decltype(u)>::Scalar;
+    using std::exp;
+    const double h2 = 1.0 / static_cast<double>((s + 1) * (s + 1));
+    f.resize(s * s);
+    for (Index r = 0; r < s; ++r) {
+      for (Index c = 0; c < s; ++c) {
+        const Index p = r * s + c;
+        T sum = 4.0 * u[p];
+        if (r > 0) sum -= u[p - s];
+        if (r + 1 < s) sum -= u[p + s];
+        if (c > 0) sum -= u[p - 1];
+        if (c + 1 < s) sum -= u[p + 1];
+        f[p] = sum / h2 - 6.0 * exp(u[p]);
+      }
+    }
+  };
+}
+
+SolverOptions tight() {
+  SolverOptions o;
+  o.stop.residual_tolerance = 1e-10;
+  o.stop.max_iterations = 100;
+  return o;
+}
+
+Summary solve_with(const std::string& linear, const RootProblem<>& problem, Vector<Dynamic>& x,
+                   bool line_search = true) {
+  NewtonEngine<> newton(NewtonOptions{.line_search = line_search, .linear_solver = linear},
+                        tight());
+  return newton.solve(to_fixed_point(problem), x);
+}
+
+struct Expected {
+  std::string spec, name;
+  bool krylov;
+};
+const std::vector<Expected> kLinearSolvers = {{"auto", "band-lu", false},
+                                              {"band-lu", "band-lu", false},
+                                              {"sparse-lu", "sparse-lu", false},
+                                              {"klu", "klu", false},
+                                              {"gmres", "gmres", true},
+                                              {"gmres:preconditioner=ilu0", "gmres", true},
+                                              {"bicgstab:preconditioner=ilu0", "bicgstab", true}};
+
+TEST(SparseNewton, SolvesBroydenTridiagonalWithEveryLinearSolverAtTheDenseRoot) {
+  const Index n = 200;
+  const Vector<Dynamic> x0 = Vector<Dynamic>::Constant(n, -1.0);
+  Vector<Dynamic> dense_root = x0;
+  const Summary dense =
+      solve_with("auto", RootProblem<>::with_autodiff(broyden_tridiagonal(), n, n), dense_root);
+  ASSERT_EQ(dense.status, Status::kConverged) << dense.message;
+  EXPECT_TRUE(dense.linear_solver.empty()) << "no sparse Jacobian: the dense path";
+
+  const RootProblem<> problem = sparse_autodiff_problem(broyden_tridiagonal(), x0);
+  for (const Expected& e : kLinearSolvers) {
+    Vector<Dynamic> x = x0;
+    const Summary s = solve_with(e.spec, problem, x);
+    ASSERT_EQ(s.status, Status::kConverged) << e.spec << ": " << s.message;
+    EXPECT_LE(s.residual_norm, 1e-10) << e.spec;
+    EXPECT_LE((x - dense_root).lpNorm<Eigen::Infinity>(), 1e-9) << e.spec;
+    EXPECT_EQ(s.linear_solver, e.name) << e.spec;
+    EXPECT_EQ(s.linear_setups, s.jacobian_evaluations) << e.spec;
+    EXPECT_EQ(s.linear_iterations > 0, e.krylov) << e.spec;
+    EXPECT_NE(s.full_report().find("linear solver          " + e.name), std::string::npos);
+  }
+  // Without a line search (what `newton` runs by name): full steps, same root.
+  for (const std::string linear : {"klu", "gmres:preconditioner=ilu0"}) {
+    Vector<Dynamic> x = x0;
+    const Summary s = solve_with(linear, problem, x, /*line_search=*/false);
+    ASSERT_EQ(s.status, Status::kConverged) << linear << ": " << s.message;
+    EXPECT_LE((x - dense_root).lpNorm<Eigen::Infinity>(), 1e-9) << linear;
+  }
+  // "dense" keeps the dense path for a problem that has a sparse Jacobian.
+  Vector<Dynamic> x = x0;
+  const Summary s = solve_with("dense", problem, x);
+  ASSERT_EQ(s.status, Status::kConverged);
+  EXPECT_TRUE(s.linear_solver.empty());
+  EXPECT_LE((x - dense_root).lpNorm<Eigen::Infinity>(), 1e-12);
+}
+
+TEST(SparseNewton, SolvesTwoDimensionalBratuByKluAndByNewtonKrylov) {
+  const Index s = 30;  // n = 900, bandwidth 30 > kAutoBandWidth: auto is klu
+  const Vector<Dynamic> x0 = Vector<Dynamic>::Zero(s * s);
+  const RootProblem<> problem = sparse_autodiff_problem(bratu(s), x0);
+  Vector<Dynamic> direct = x0, krylov = x0;
+  const Summary a = solve_with("auto", problem, direct);
+  ASSERT_EQ(a.status, Status::kConverged) << a.message;
+  EXPECT_EQ(a.linear_solver, "klu");
+  const Summary k = solve_with("gmres:preconditioner=ilu0", problem, krylov);
+  ASSERT_EQ(k.status, Status::kConverged) << k.message;
+  EXPECT_GT(k.linear_iterations, 0);
+  EXPECT_LE((direct - krylov).lpNorm<Eigen::Infinity>(), 1e-8);
+  // A Krylov budget of 3 per step: the steps are inexact but reduce |F|, and are taken.
+  Vector<Dynamic> short_budget = x0;
+  const Summary b = solve_with("gmres:preconditioner=ilu0,max_iterations=3", problem, short_budget);
+  ASSERT_EQ(b.status, Status::kConverged) << b.message;
+  EXPECT_LE(b.linear_iterations, 3 * b.linear_setups);
+  EXPECT_TRUE(b.usable()) << b.unusable_reason();
+  // Stopped by the step test (1e-8) after inexact steps: as close as that test asks.
+  EXPECT_LE((short_budget - direct).lpNorm<Eigen::Infinity>(), 1e-6);
+  // The lower-branch solution is positive and symmetric under swapping the grid's axes.
+  EXPECT_GT(direct.minCoeff(), 0.0);
+  for (Index r = 0; r < s; ++r) {
+    for (Index c = 0; c < r; ++c) EXPECT_NEAR(direct[r * s + c], direct[c * s + r], 1e-9);
+  }
+}
+
+TEST(SparseNewton, ReachesTwoHundredThousandUnknownsWithoutADenseMatrix) {
+  // A dense J would be 320 GB: to_fixed_point must not size one, Newton must not touch one.
+  const Index n = 200000;
+  const Vector<Dynamic> x0 = Vector<Dynamic>::Constant(n, -1.0);
+  const RootProblem<> problem = sparse_autodiff_problem(broyden_tridiagonal(), x0);
+  Vector<Dynamic> x = x0;
+  const Summary s = solve_with("auto", problem, x);
+  ASSERT_EQ(s.status, Status::kConverged) << s.message;
+  EXPECT_EQ(s.linear_solver, "band-lu");
+  Vector<Dynamic> f;
+  broyden_tridiagonal()(x, f);
+  EXPECT_LE(f.lpNorm<Eigen::Infinity>(), 1e-10);
+}
+
+TEST(SparseNewton, KeepsABindingBoxAsTheDensePathDoes) {
+  const Index n = 100;
+  const Vector<Dynamic> x0 = Vector<Dynamic>::Constant(n, -1.0);
+  const RootProblem<> problem = sparse_autodiff_problem(broyden_tridiagonal(), x0);
+  Vector<Dynamic> root = x0;
+  ASSERT_EQ(solve_with("klu", problem, root).status, Status::kConverged);
+  const double upper = 0.5 * (root.minCoeff() + root.maxCoeff());  // cuts through the root
+  for (const bool line_search : {true, false}) {
+    std::vector<Summary> summaries;
+    std::vector<Vector<Dynamic>> answers;
+    for (const std::string linear : {"dense", "klu", "gmres:preconditioner=ilu0"}) {
+      NewtonEngine<> newton(NewtonOptions{.line_search = line_search, .linear_solver = linear},
+                            tight());
+      newton.set_bounds({Vector<Dynamic>::Constant(n, -2.0), Vector<Dynamic>::Constant(n, upper)});
+      Vector<Dynamic> x = x0;
+      summaries.push_back(newton.solve(to_fixed_point(problem), x));
+      answers.push_back(x);
+      EXPECT_LE(x.maxCoeff(), upper) << linear;
+    }
+    for (std::size_t k = 1; k < summaries.size(); ++k) {
+      EXPECT_EQ(summaries[k].status, summaries[0].status)
+          << k << ": " << summaries[k].message << " / " << summaries[0].message;
+      EXPECT_LE((answers[k] - answers[0]).lpNorm<Eigen::Infinity>(), 1e-6) << k;
+    }
+    EXPECT_DOUBLE_EQ(answers[0].maxCoeff(), upper) << "the box binds";
+  }
+}
+
+TEST(SparseNewton, RefusesWhatWouldTakeTheDensePathAtLargeSize) {
+  const Vector<Dynamic> x0 = Vector<Dynamic>::Constant(50, -1.0);
+  const FixedPointProblem<> problem =
+      to_fixed_point(sparse_autodiff_problem(broyden_tridiagonal(), x0));
+  Vector<Dynamic> x = x0;
+  NewtonEngine<> trust(NewtonOptions{.trust_region = true});
+  EXPECT_THROW(trust.solve(problem, x), InvalidInput);
+  NewtonEngine<> scaled(NewtonOptions{.line_search = true});
+  scaled.set_scaling({.u_scale = Vector<Dynamic>::Constant(50, 2.0)});
+  EXPECT_THROW(scaled.solve(problem, x), InvalidInput);
+  NewtonEngine<> dense(NewtonOptions{.trust_region = true, .linear_solver = "dense"}, tight());
+  EXPECT_EQ(dense.solve(problem, x).status, Status::kConverged);
+}
+
+TEST(SparseNewton, UsesColouredDifferences) {
+  const Index n = 100;
+  const Vector<Dynamic> x0 = Vector<Dynamic>::Constant(n, -1.0);
+  // F on doubles only, with a declared tridiagonal pattern: coloured forward differences.
+  auto on_doubles = [](const Vector<Dynamic>& x, Vector<Dynamic>& f) {
+    broyden_tridiagonal()(x, f);
+  };
+  const RootProblem<> problem =
+      sparse_difference_problem(on_doubles, SparsityPattern::band(n, 1, 1));
+  NewtonEngine<> newton(NewtonOptions{.line_search = true, .linear_solver = "klu"}, tight());
+  Vector<Dynamic> x = x0;
+  const Summary s = newton.solve(to_fixed_point(problem), x);
+  ASSERT_EQ(s.status, Status::kConverged) << s.message;
+  Vector<Dynamic> f;
+  broyden_tridiagonal()(x, f);
+  EXPECT_LE(f.lpNorm<Eigen::Infinity>(), 1e-10);
+  // Three colours per Jacobian, one evaluation each, beside the residual evaluations.
+  EXPECT_GE(s.function_evaluations, 3 * s.jacobian_evaluations + s.iterations);
+}
+
+TEST(SparseNewton, NamesASingularSparseJacobian) {
+  // F = (x₀ − x₁, x₁ − x₀ + 1): J = [[1, −1], [−1, 1]] is singular everywhere, no root.
+  auto singular = [](const auto& x, auto& f) {
+    f.resize(2);
+    f[0] = x[0] - x[1];
+    f[1] = x[1] - x[0] + 1.0;
+  };
+  const RootProblem<> problem = sparse_autodiff_problem(singular, Vector<Dynamic>::Zero(2));
+  for (const std::string linear : {"band-lu", "sparse-lu", "klu", "gmres"}) {
+    Vector<Dynamic> x = Vector<Dynamic>::Zero(2);
+    const Summary s = solve_with(linear, problem, x);
+    // A Krylov breakdown is the solver's failure (BiCGSTAB breaks down on regular J too).
+    EXPECT_EQ(s.status, linear == "gmres" ? Status::kSolverFailure : Status::kSingularJacobian)
+        << linear << ": " << s.message;
+    EXPECT_NE(s.message.find(linear), std::string::npos) << s.message;
+    EXPECT_TRUE(x.allFinite());
+  }
+}
+
+TEST(SparseNewton, IsReachableByEngineSpecAndRefusesBadSpecs) {
+  const Vector<Dynamic> x0 = Vector<Dynamic>::Constant(50, -1.0);
+  const RootProblem<> problem = sparse_autodiff_problem(broyden_tridiagonal(), x0);
+  auto engine = EngineRegistry<Dynamic>::global().create(
+      "newton:linesearch=1,linear=bicgstab,preconditioner=jacobi", tight());
+  Vector<Dynamic> x = x0;
+  const Summary s = engine->solve(to_fixed_point(problem), x);
+  ASSERT_EQ(s.status, Status::kConverged) << s.message;
+  EXPECT_EQ(s.linear_solver, "bicgstab");
+  EXPECT_THROW(EngineRegistry<Dynamic>::global().create("newton:linear=cholesky"), InvalidInput);
+  EXPECT_NE(test::message_of([] {
+              EngineRegistry<Dynamic>::global().create("newton:linear=cholesky");
+            }).find("(or auto, dense)"),
+            std::string::npos);
+  EXPECT_THROW(EngineRegistry<Dynamic>::global().create("newton:preconditioner=ilu0"),
+               InvalidInput);
+  EXPECT_THROW(EngineRegistry<Dynamic>::global().create("newton:linear=klu,preconditioner=ilu0"),
+               InvalidInput);
+  EXPECT_THROW(NewtonEngine<>(NewtonOptions{.forcing = {.maximum = 2.0}}), InvalidInput);
+}
+
+TEST(SparseProblem, AddsTheDiagonalAndRefusesABranchingF) {
+  // F_i = x_{i+1} (no diagonal): the pattern gets it, so ILU(0) and the pivots have one.
+  auto shift = [](const auto& x, auto& f) {
+    f.resize(x.size());
+    for (Index i = 0; i < x.size(); ++i) f[i] = x[(i + 1) % x.size()] - 1.0;
+  };
+  const RootProblem<> problem = sparse_autodiff_problem(shift, Vector<Dynamic>::Zero(5));
+  const SparsityPattern& pattern = *problem.sparse_jacobian()->pattern;
+  for (Index i = 0; i < 5; ++i) EXPECT_TRUE(pattern.contains(i, i)) << i;
+  EXPECT_EQ(pattern.nonzeros(), 10);
+  Vector<Dynamic> root = Vector<Dynamic>::Zero(5);
+  EXPECT_EQ(solve_with("klu", problem, root).status, Status::kConverged);
+  EXPECT_LE((root - Vector<Dynamic>::Ones(5)).norm(), 1e-12);
+  // ILU(0) meets the zero diagonal: a named solver failure, not a singular J.
+  root.setZero();
+  const Summary s = solve_with("gmres:preconditioner=ilu0", problem, root);
+  EXPECT_EQ(s.status, Status::kSolverFailure);
+  EXPECT_NE(s.message.find("ilu0: row 0: zero pivot"), std::string::npos) << s.message;
+
+  auto branching = [](const auto& x, auto& f) {
+    f.resize(x.size());
+    for (Index i = 0; i < x.size(); ++i) f[i] = x[i] > 0.0 ? x[i] : -x[i];
+  };
+  EXPECT_THROW(sparse_autodiff_problem(branching, Vector<Dynamic>::Ones(3)), InvalidInput);
+}
+
+}  // namespace
+}  // namespace nlobs
