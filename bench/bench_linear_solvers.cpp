@@ -10,6 +10,7 @@
 #include <memory>
 #include <string>
 
+#include "large_test_problems.hpp"
 #include "nlobs/solvers/linear/linear_solver.hpp"
 #include "nlobs/solvers/linear/make_linear_solver.hpp"
 #include "nlobs/solvers/sparse/compressed_jacobian.hpp"
@@ -28,48 +29,22 @@ constexpr std::array<const char*, 9> kSolvers = {"dense-lu",
                                                  "gmres:preconditioner=ilut",
                                                  "bicgstab:preconditioner=ilu0"};
 
-nlobs::SparseJacobian bratu_jacobian(Index s) {
-  auto f = [s](const auto& u, auto& out) {
-    using T = typename std::decay_t<decltype(u)>::Scalar;
-    using std::exp;
-    const double h2 = 1.0 / static_cast<double>((s + 1) * (s + 1));
-    out.resize(s * s);
-    for (Index r = 0; r < s; ++r) {
-      for (Index c = 0; c < s; ++c) {
-        const Index p = r * s + c;
-        T sum = 4.0 * u[p];
-        if (r > 0) sum -= u[p - s];
-        if (r + 1 < s) sum -= u[p + s];
-        if (c > 0) sum -= u[p - 1];
-        if (c + 1 < s) sum -= u[p + 1];
-        out[p] = sum / h2 - 6.0 * exp(u[p]);
-      }
-    }
-  };
-  const Eigen::VectorXd u = Eigen::VectorXd::Constant(s * s, 0.1);
-  nlobs::CompressedJacobian cj(nlobs::detect_sparsity(f, u, s * s));
-  nlobs::SparseJacobian jac;
-  cj.autodiff(f, u, jac);
-  return jac;
-}
-
-nlobs::SparseJacobian broyden_tridiagonal_jacobian(Index n) {
-  auto f = [](const auto& x) {
-    using T = typename std::decay_t<decltype(x)>::Scalar;
-    const Index m = x.size();
-    nlobs::Vector<nlobs::Dynamic, T> out(m);
-    for (Index i = 0; i < m; ++i) {
-      out[i] = (3.0 - 2.0 * x[i]) * x[i] + 1.0;
-      if (i > 0) out[i] -= x[i - 1];
-      if (i + 1 < m) out[i] -= 2.0 * x[i + 1];
-    }
-    return out;
-  };
-  const Eigen::VectorXd x = Eigen::VectorXd::Constant(n, -1.0);
-  nlobs::CompressedJacobian cj(nlobs::detect_sparsity(f, x, n));
+// J = ∂f(x) by the compressed AD path, the pattern detected at x.
+template <typename F>
+nlobs::SparseJacobian compressed_jacobian_at(F f, const Eigen::VectorXd& x) {
+  nlobs::CompressedJacobian cj(nlobs::detect_sparsity(f, x, x.size()));
   nlobs::SparseJacobian jac;
   cj.autodiff(f, x, jac);
   return jac;
+}
+
+nlobs::SparseJacobian bratu_jacobian(Index s) {
+  return compressed_jacobian_at(nlobs::test::bratu(s), Eigen::VectorXd::Constant(s * s, 0.1));
+}
+
+nlobs::SparseJacobian broyden_tridiagonal_jacobian(Index n) {
+  return compressed_jacobian_at(nlobs::test::broyden_tridiagonal(),
+                                Eigen::VectorXd::Constant(n, -1.0));
 }
 
 void run(benchmark::State& state, const nlobs::SparseJacobian& jac) {

@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "large_test_problems.hpp"
 #include "nlobs/solvers/autodiff.hpp"
 #include "nlobs/solvers/sparse/compressed_jacobian.hpp"
 
@@ -13,25 +14,7 @@ namespace {
 
 using nlobs::Index;
 
-auto bratu(Index s) {
-  return [s](const auto& u, auto& f) {
-    using T = typename std::decay_t<decltype(u)>::Scalar;
-    using std::exp;
-    const double h2 = 1.0 / static_cast<double>((s + 1) * (s + 1));
-    f.resize(s * s);
-    for (Index r = 0; r < s; ++r) {
-      for (Index c = 0; c < s; ++c) {
-        const Index p = r * s + c;
-        T sum = 4.0 * u[p];
-        if (r > 0) sum -= u[p - s];
-        if (r + 1 < s) sum -= u[p + s];
-        if (c > 0) sum -= u[p - 1];
-        if (c + 1 < s) sum -= u[p + 1];
-        f[p] = sum / h2 - 6.0 * exp(u[p]);
-      }
-    }
-  };
-}
+using nlobs::test::bratu;
 
 Eigen::VectorXd start(Index s) {
   return Eigen::VectorXd::Constant(s * s, 0.1);

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "large_test_problems.hpp"
 #include "nlobs/solvers/linear/band_lu.hpp"
 #include "nlobs/solvers/linear/bicgstab.hpp"
 #include "nlobs/solvers/linear/dense_lu.hpp"
@@ -458,30 +459,9 @@ TEST(KrylovSolvers, SolveJacobianFreeWithAnApproximationForThePreconditioner) {
   EXPECT_EQ(bad.setup(KrylovSolver::Operator{}, 4), LinearStatus::kInvalidInput);
 }
 
-// 2-D Bratu's residual, generic in its scalar type: what a user writes for with_autodiff.
-auto bratu_residual(Index s, double lambda = 6.0) {
-  return [s, lambda](const auto& u, auto& f) {
-    using T = typename std::decay_t<decltype(u)>::Scalar;
-    using std::exp;
-    const double h2 = 1.0 / static_cast<double>((s + 1) * (s + 1));
-    f.resize(s * s);
-    for (Index r = 0; r < s; ++r) {
-      for (Index c = 0; c < s; ++c) {
-        const Index p = r * s + c;
-        T sum = 4.0 * u[p];
-        if (r > 0) sum -= u[p - s];
-        if (r + 1 < s) sum -= u[p + s];
-        if (c > 0) sum -= u[p - 1];
-        if (c + 1 < s) sum -= u[p + 1];
-        f[p] = sum / h2 - lambda * exp(u[p]);
-      }
-    }
-  };
-}
-
 TEST(JacobianProducts, MatchTheAssembledJacobianAndDriveAJacobianFreeGmres) {
   const Index s = 15;
-  auto f = bratu_residual(s);
+  auto f = test::bratu(s);
   Vector<Dynamic> u(s * s);
   for (Index i = 0; i < u.size(); ++i) u[i] = 0.3 * std::sin(0.1 * static_cast<double>(i));
   CompressedJacobian compressed(detect_sparsity(f, u, s * s));

@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "large_test_problems.hpp"
 #include "nlobs/solvers/autodiff.hpp"
 #include "nlobs/solvers/sparse/compressed_jacobian.hpp"
 #include "test_support.hpp"
@@ -20,42 +21,8 @@
 namespace nlobs {
 namespace {
 
-// Broyden tridiagonal: F_i = (3 − 2x_i) x_i − x_{i−1} − 2x_{i+1} + 1 (x_0 = x_{n+1} = 0).
-auto broyden_tridiagonal() {
-  return [](const auto& x) {
-    using T = typename std::decay_t<decltype(x)>::Scalar;
-    const Index n = x.size();
-    Vector<Dynamic, T> f(n);
-    for (Index i = 0; i < n; ++i) {
-      f[i] = (3.0 - 2.0 * x[i]) * x[i] + 1.0;
-      if (i > 0) f[i] -= x[i - 1];
-      if (i + 1 < n) f[i] -= 2.0 * x[i + 1];
-    }
-    return f;
-  };
-}
-
-// 2-D Bratu on an s×s interior grid, h = 1/(s+1): (4u − Σ neighbours)/h² − λ e^u, u = 0 on the
-// boundary (written with a user's out-parameter shape).
-auto bratu(Index s, double lambda = 6.0) {
-  return [s, lambda](const auto& u, auto& f) {
-    using T = typename std::decay_t<decltype(u)>::Scalar;
-    using std::exp;
-    const double h2 = 1.0 / static_cast<double>((s + 1) * (s + 1));
-    f.resize(s * s);
-    for (Index r = 0; r < s; ++r) {
-      for (Index c = 0; c < s; ++c) {
-        const Index p = r * s + c;
-        T sum = 4.0 * u[p];
-        if (r > 0) sum -= u[p - s];
-        if (r + 1 < s) sum -= u[p + s];
-        if (c > 0) sum -= u[p - 1];
-        if (c + 1 < s) sum -= u[p + 1];
-        f[p] = sum / h2 - lambda * exp(u[p]);
-      }
-    }
-  };
-}
+using test::bratu;
+using test::broyden_tridiagonal;
 
 std::vector<std::pair<Index, Index>> five_point_entries(Index s) {
   std::vector<std::pair<Index, Index>> e;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "large_test_problems.hpp"
 #include "nlobs/solvers/builtin_engines.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 #include "nlobs/solvers/newton_engine.hpp"
@@ -19,39 +20,8 @@
 namespace nlobs {
 namespace {
 
-// F_i = (3 − 2x_i) x_i − x_{i−1} − 2x_{i+1} + 1 (x_0 = x_{n+1} = 0).
-auto broyden_tridiagonal() {
-  return [](const auto& x, auto& f) {
-    const Index n = x.size();
-    f.resize(n);
-    for (Index i = 0; i < n; ++i) {
-      f[i] = (3.0 - 2.0 * x[i]) * x[i] + 1.0;
-      if (i > 0) f[i] -= x[i - 1];
-      if (i + 1 < n) f[i] -= 2.0 * x[i + 1];
-    }
-  };
-}
-
-// 2-D Bratu on an s×s grid, λ = 6.
-auto bratu(Index s) {
-  return [s](const auto& u, auto& f) {
-    using T = typename std::decay_t<decltype(u)>::Scalar;
-    using std::exp;
-    const double h2 = 1.0 / static_cast<double>((s + 1) * (s + 1));
-    f.resize(s * s);
-    for (Index r = 0; r < s; ++r) {
-      for (Index c = 0; c < s; ++c) {
-        const Index p = r * s + c;
-        T sum = 4.0 * u[p];
-        if (r > 0) sum -= u[p - s];
-        if (r + 1 < s) sum -= u[p + s];
-        if (c > 0) sum -= u[p - 1];
-        if (c + 1 < s) sum -= u[p + 1];
-        f[p] = sum / h2 - 6.0 * exp(u[p]);
-      }
-    }
-  };
-}
+using test::bratu;
+using test::broyden_tridiagonal;
 
 SolverOptions tight() {
   SolverOptions o;
@@ -151,8 +121,7 @@ TEST(SparseNewton, ReachesTwoHundredThousandUnknownsWithoutADenseMatrix) {
   const Summary s = solve_with("auto", problem, x);
   ASSERT_EQ(s.status, Status::kConverged) << s.message;
   EXPECT_EQ(s.linear_solver, "band-lu");
-  Vector<Dynamic> f;
-  broyden_tridiagonal()(x, f);
+  const Vector<Dynamic> f = broyden_tridiagonal()(x);
   EXPECT_LE(f.lpNorm<Eigen::Infinity>(), 1e-10);
 }
 
@@ -203,7 +172,7 @@ TEST(SparseNewton, UsesColouredDifferences) {
   const Vector<Dynamic> x0 = Vector<Dynamic>::Constant(n, -1.0);
   // F on doubles only, with a declared tridiagonal pattern: coloured forward differences.
   auto on_doubles = [](const Vector<Dynamic>& x, Vector<Dynamic>& f) {
-    broyden_tridiagonal()(x, f);
+    f = broyden_tridiagonal()(x);
   };
   const RootProblem<> problem =
       sparse_difference_problem(on_doubles, SparsityPattern::band(n, 1, 1));
@@ -211,8 +180,7 @@ TEST(SparseNewton, UsesColouredDifferences) {
   Vector<Dynamic> x = x0;
   const Summary s = newton.solve(to_fixed_point(problem), x);
   ASSERT_EQ(s.status, Status::kConverged) << s.message;
-  Vector<Dynamic> f;
-  broyden_tridiagonal()(x, f);
+  const Vector<Dynamic> f = broyden_tridiagonal()(x);
   EXPECT_LE(f.lpNorm<Eigen::Infinity>(), 1e-10);
   // Three colours per Jacobian, one evaluation each, beside the residual evaluations.
   EXPECT_GE(s.function_evaluations, 3 * s.jacobian_evaluations + s.iterations);
