@@ -9,6 +9,7 @@
 #include "large_test_problems.hpp"
 #include "nlobs/solvers/autodiff.hpp"
 #include "nlobs/solvers/sparse/compressed_jacobian.hpp"
+#include "nlobs/solvers/sparse/sparse_jacobian.hpp"
 
 namespace {
 

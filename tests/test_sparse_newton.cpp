@@ -53,8 +53,9 @@ TEST(SparseNewton, SolvesBroydenTridiagonalWithEveryLinearSolverAtTheDenseRoot) 
   const Index n = 200;
   const Vector<Dynamic> x0 = Vector<Dynamic>::Constant(n, -1.0);
   Vector<Dynamic> dense_root = x0;
-  const Summary dense =
-      solve_with("auto", RootProblem<>::with_autodiff(broyden_tridiagonal(), n, n), dense_root);
+  const Summary dense = solve_with(
+      "auto", RootProblem<>::with_autodiff(broyden_tridiagonal(), n, n).with_dense_jacobian(),
+      dense_root);
   ASSERT_EQ(dense.status, Status::kConverged) << dense.message;
   EXPECT_TRUE(dense.linear_solver.empty()) << "no sparse Jacobian: the dense path";
 

@@ -12,11 +12,12 @@
 // projected steepest-descent path of ½‖F‖² is searched from its Cauchy point. A point where a
 // bound holds x against the descent direction and neither path decreases ‖F‖ ends the run
 // blocked_by_bound (without a line search: where the projected Newton step is zero).
-// Sparse path (run-time size, a problem with a sparse Jacobian: sparse/sparse_problem.hpp): J_F is
-// assembled sparse and the step solved by NewtonOptions::linear_solver (nlobs/solvers/linear/);
-// with a Krylov solver the step is inexact, ‖F + J_F Δx‖₂ ≤ η_k ‖F‖₂ with η_k from
-// Eisenstat–Walker [EW96] (Newton–Krylov), and a Krylov solve that ends above η_k but below ‖F‖
-// still gives a descent direction of ‖F‖² and is taken.
+// Sparse path (run-time size, a problem with a sparse Jacobian, declared by
+// sparse/sparse_problem.hpp or detected at x₀ for RootProblem::with_autodiff by
+// sparse/sparsity_detection.hpp's rule): J_F is assembled sparse and the step solved by
+// NewtonOptions::linear_solver (nlobs/solvers/linear/); with a Krylov solver the step is inexact,
+// ‖F + J_F Δx‖₂ ≤ η_k ‖F‖₂ with η_k from Eisenstat–Walker [EW96] (Newton–Krylov), and a Krylov
+// solve that ends above η_k but below ‖F‖ still gives a descent direction of ‖F‖² and is taken.
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
@@ -51,8 +52,8 @@ struct NewtonOptions {
   FiniteDifference finite_difference = FiniteDifference::kCentral;
   // The sparse path's linear solver, a make_linear_solver spec ("klu", "gmres:preconditioner=
   // ilu0", …), or "auto" (band-lu when J's bandwidth is at most 16, kAutoBandWidth, else klu), or
-  // "dense" (the dense path even for a problem with a sparse Jacobian). Read only for problems
-  // with a sparse Jacobian; the trust region is dense whatever this says.
+  // "dense" (the dense path even for a problem with a sparse Jacobian; no detection is run).
+  // Read only for problems with a sparse Jacobian; the trust region is dense whatever this says.
   std::string linear_solver = "auto";
   // η_k of the Krylov solvers (ignored by the direct ones).
   ForcingTermOptions forcing{};
@@ -216,7 +217,10 @@ double NewtonEngine<N>::merit_curvature(bool sparse) const {
 
 template <int N>
 Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
-  if (problem.sparse_residual_jacobian() != nullptr && newton_.linear_solver != "dense" &&
+  // A declared sparse Jacobian says the dense one may be out of reach; one still to be detected
+  // does not (the trust region and a scaling then take the dense path, as before detection).
+  const detail::SparseJacobianState* sparse_state = problem.sparse_jacobian_state().get();
+  if (sparse_state != nullptr && sparse_state->declared() && newton_.linear_solver != "dense" &&
       (trust_region_ || !this->scaling_.empty())) {
     // Both would take the dense n×n path: say so rather than allocate it.
     throw InvalidInput(std::string("newton: ") +
@@ -242,8 +246,9 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
   bool sparse = false;
   if constexpr (N == Dynamic) {
     for (Vector<N>* v : {&x_, &f_, &dx_, &xt_, &ft_, &gradient_}) v->resize(n);
-    const SparseJacobianSource* source = problem.sparse_residual_jacobian();
-    sparse = source != nullptr && newton_.linear_solver != "dense";
+    const SparseJacobianSource* source =
+        newton_.linear_solver == "dense" ? nullptr : problem.sparse_residual_jacobian(x);
+    sparse = source != nullptr;
     if (sparse) {
       linear_ =
           make_linear_solver(choose_linear_solver(newton_.linear_solver, *source->pattern, n));

@@ -16,21 +16,11 @@
 
 #include "nlobs/solvers/autodiff.hpp"
 #include "nlobs/solvers/callable.hpp"
+#include "nlobs/solvers/sparse/sparsity_detection.hpp"
 #include "nlobs/solvers/status.hpp"
 #include "nlobs/solvers/types.hpp"
 
-// Declared only: what the sparse path needs is in nlobs/solvers/sparse/ (the problem carries it
-// without every user of this header compiling Eigen's sparse module).
-namespace Eigen {
-template <typename Scalar, int Options, typename StorageIndex>
-class SparseMatrix;
-}  // namespace Eigen
-
 namespace nlobs {
-
-struct SparsityPattern;
-// = Eigen::SparseMatrix<double, RowMajor> (nlobs/solvers/sparse/sparse_jacobian.hpp).
-using SparseJacobian = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
 
 // Where an engine that needs ∂G (Newton, the contraction check) gets it.
 enum class JacobianSource {
@@ -51,25 +41,7 @@ inline std::string_view to_string(JacobianSource source) {
   return "unknown";
 }
 
-// A sparse Jacobian of F at run-time size, for the engines' sparse path (docs/solvers.md, "Sparse
-// Jacobians"): its pattern, and `evaluate(x, f, J)` filling J = ∂F(x) with exactly that structure
-// (f = F(x), which differences need) and returning the evaluations of F it made (0 for AD).
-// Built by sparse_autodiff_problem / sparse_difference_problem (sparse/sparse_problem.hpp).
-struct SparseJacobianSource {
-  std::shared_ptr<const SparsityPattern> pattern;
-  std::function<int(const Vector<Dynamic>& x, const Vector<Dynamic>& f, SparseJacobian& jac)>
-      evaluate;
-  int evaluations_per_jacobian = 0;  // what evaluate returns: for the evaluation budget
-};
-
 namespace detail {
-inline void check_sparse_source(const char* owner, const SparseJacobianSource& sparse) {
-  if (!sparse.pattern || !sparse.evaluate || sparse.evaluations_per_jacobian < 0) {
-    throw InvalidInput(std::string(owner) +
-                       ": a sparse Jacobian needs a pattern, an evaluate function and "
-                       "evaluations_per_jacobian >= 0");
-  }
-}
 inline void check_size(const char* what, Index expected, Index got) {
   if (expected != got) {
     std::ostringstream os;
@@ -142,16 +114,34 @@ class FixedPointProblem {
     return out;
   }
   // ∂F of the residual form as a sparse matrix (run-time size only): the engines' sparse path.
-  // nullptr when the problem has none.
-  const SparseJacobianSource* sparse_residual_jacobian() const { return sparse_.get(); }
+  // nullptr when the problem has none, or has not detected it yet; sparse_residual_jacobian(x)
+  // detects it at x first when the problem came from RootProblem::with_autodiff.
+  const SparseJacobianSource* sparse_residual_jacobian() const {
+    return sparse_ ? sparse_->get() : nullptr;
+  }
+  const SparseJacobianSource* sparse_residual_jacobian(const VectorType& x) const {
+    if constexpr (N == Dynamic) {
+      if (sparse_) return sparse_->resolve(x);
+    }
+    return nullptr;
+  }
   FixedPointProblem with_sparse_residual_jacobian(SparseJacobianSource sparse) const {
+    detail::check_sparse_source("FixedPointProblem", sparse);
+    return with_sparse_jacobian_state(detail::SparseJacobianState::declared(std::move(sparse)));
+  }
+  // For adapters (to_fixed_point) and engines: the sparse Jacobian declared or to be detected,
+  // shared with the root problem it came from; null for none.
+  const std::shared_ptr<detail::SparseJacobianState>& sparse_jacobian_state() const {
+    return sparse_;
+  }
+  FixedPointProblem with_sparse_jacobian_state(
+      std::shared_ptr<detail::SparseJacobianState> state) const {
     static_assert(N == Dynamic, "a sparse Jacobian is for run-time sizes");
     if (!has_residual()) {
       throw InvalidInput("FixedPointProblem: a sparse residual Jacobian needs the residual form");
     }
-    detail::check_sparse_source("FixedPointProblem", sparse);
     FixedPointProblem out = *this;
-    out.sparse_ = std::make_shared<const SparseJacobianSource>(std::move(sparse));
+    out.sparse_ = std::move(state);
     return out;
   }
 
@@ -179,7 +169,7 @@ class FixedPointProblem {
   JacobianSource source_;
   Map f_;
   JacobianMap df_;
-  std::shared_ptr<const SparseJacobianSource> sparse_;
+  std::shared_ptr<detail::SparseJacobianState> sparse_;
 };
 
 namespace detail {
@@ -210,8 +200,27 @@ class RootProblem {
   static RootProblem from_map(F f, Index n = N, Index m = M) {
     return RootProblem(n, m, wrap(std::move(f)), {}, JacobianSource::kFiniteDifference);
   }
+  // F generic in its scalar type: ∂F by forward-mode AD. At run-time size (N = M = Dynamic) the
+  // problem also finds J's sparsity pattern itself, once, at the first point an engine with a
+  // sparse path (newton) asks with, and gives that engine a compressed sparse Jacobian when the
+  // pattern is sparse enough — the rule in sparse/sparsity_detection.hpp; with_dense_jacobian()
+  // switches it off. F must then also accept SparsityTracer scalars, as it accepts ceres::Jet (an
+  // F that cannot — one that takes only double and Jet — is built with_dense_autodiff).
   template <typename F>
   static RootProblem with_autodiff(F f, Index n = N, Index m = M) {
+    RootProblem out = with_dense_autodiff(f, n, m);
+    if constexpr (N == Dynamic && M == Dynamic) {
+      out.sparse_ = detail::SparseJacobianState::detected_later(
+          [f = std::move(f), m](const Vector<Dynamic>& x, std::string& note) mutable {
+            return detail::detect_sparse_jacobian(f, x, m, note);
+          });
+    }
+    return out;
+  }
+  // ∂F by forward-mode AD, dense at every size: no sparsity detection (F is never evaluated on
+  // SparsityTracer scalars).
+  template <typename F>
+  static RootProblem with_dense_autodiff(F f, Index n = N, Index m = M) {
     JacobianMap df = [f, n, m](const VectorType& x, JacobianType& jac) mutable {
       if constexpr (N == Dynamic || M == Dynamic) jac.resize(m, n);
       autodiff_jacobian<N, M>(f, x, jac);
@@ -235,14 +244,35 @@ class RootProblem {
   bool has_jacobian() const { return static_cast<bool>(df_); }
   void evaluate(const VectorType& x, ResidualType& f) const { f_(x, f); }
   void jacobian(const VectorType& x, JacobianType& jac) const { df_(x, jac); }
-  // ∂F as a sparse matrix (run-time size only), or nullptr: see sparse/sparse_problem.hpp.
-  const SparseJacobianSource* sparse_jacobian() const { return sparse_.get(); }
+  // ∂F as a sparse matrix (run-time size only), or nullptr: declared (sparse/sparse_problem.hpp)
+  // or detected (with_autodiff). sparse_jacobian(x) detects it at x first if that is still to do.
+  const SparseJacobianSource* sparse_jacobian() const { return sparse_ ? sparse_->get() : nullptr; }
+  const SparseJacobianSource* sparse_jacobian(const VectorType& x) const {
+    if constexpr (N == Dynamic && M == Dynamic) {
+      if (sparse_) return sparse_->resolve(x);
+    }
+    return nullptr;
+  }
   RootProblem with_sparse_jacobian(SparseJacobianSource sparse) const {
     static_assert(N == Dynamic && M == Dynamic, "a sparse Jacobian is for run-time sizes");
     detail::check_sparse_source("RootProblem", sparse);
     RootProblem out = *this;
-    out.sparse_ = std::make_shared<const SparseJacobianSource>(std::move(sparse));
+    out.sparse_ = detail::SparseJacobianState::declared(std::move(sparse));
     return out;
+  }
+  // This problem without a sparse Jacobian, declared or to be detected: every engine uses the
+  // dense one.
+  RootProblem with_dense_jacobian() const {
+    RootProblem out = *this;
+    out.sparse_.reset();
+    return out;
+  }
+  // What became of the sparse Jacobian: "declared", what detection found or why it declined
+  // (n too small, F branches on x, a row too dense), or "" when the problem has none.
+  std::string sparse_jacobian_note() const { return sparse_ ? sparse_->note() : std::string(); }
+  // For adapters (to_fixed_point): the sparse Jacobian's state, shared by the problem's copies.
+  const std::shared_ptr<detail::SparseJacobianState>& sparse_jacobian_state() const {
+    return sparse_;
   }
 
  private:
@@ -268,7 +298,7 @@ class RootProblem {
   JacobianSource source_;
   // Shared by the problem's copies, workspace included (evaluate() holds its scratch): solve
   // copies of a problem with a sparse Jacobian one at a time, not concurrently.
-  std::shared_ptr<const SparseJacobianSource> sparse_;
+  std::shared_ptr<detail::SparseJacobianState> sparse_;
 };
 
 }  // namespace nlobs

@@ -60,8 +60,8 @@ FixedPointProblem<N> to_fixed_point(const RootProblem<N, N>& root,
   // F's sparse Jacobian is the residual form's (Ψ = I).
   auto with_sparse = [&root](FixedPointProblem<N> out) {
     if constexpr (N == Dynamic) {
-      if (const SparseJacobianSource* sparse = root.sparse_jacobian()) {
-        return out.with_sparse_residual_jacobian(*sparse);
+      if (root.sparse_jacobian_state()) {
+        return out.with_sparse_jacobian_state(root.sparse_jacobian_state());
       }
     }
     return out;
@@ -70,9 +70,9 @@ FixedPointProblem<N> to_fixed_point(const RootProblem<N, N>& root,
     FixedPointProblem<N> out = FixedPointProblem<N>::from_map(std::move(g), n);
     return identity ? with_sparse(out.with_residual(std::move(f))) : out;
   }
-  // A problem with a sparse Jacobian may be too large for a dense one: its scratch is sized only
-  // if a dense Jacobian is ever asked for.
-  const bool lazy = N == Dynamic && root.sparse_jacobian() != nullptr;
+  // A problem with a sparse Jacobian (declared, or to be detected) may be too large for a dense
+  // one: its scratch is sized only if a dense Jacobian is ever asked for.
+  const bool lazy = N == Dynamic && root.sparse_jacobian_state() != nullptr;
   auto dg = [root, psi, scratch = lazy ? Jac() : Jac(n, n)](const Vec& x, Jac& jac) mutable {
     if constexpr (N == Dynamic) {
       if (scratch.rows() != root.size()) scratch.resize(root.size(), root.size());

@@ -54,7 +54,9 @@ RootProblem<Model::kStates, Model::kStates> square_window_residual(
   constexpr int N = Model::kStates;
   detail::require_square_window("square_window_residual", window);
   const OutputWindow<Model>* win = &window;
-  return RootProblem<N, N>::with_autodiff(
+  // Dense AD: a window's state is small, and a type-erased model (AnyModel) evaluates only double
+  // and ceres::Jet, not the SparsityTracer that detection would pass.
+  return RootProblem<N, N>::with_dense_autodiff(
       [win](const auto& w) {
         using T = typename std::decay_t<decltype(w)>::Scalar;
         Vector<N, T> h(w.size());
@@ -68,7 +70,7 @@ template <DiscreteModel Model>
 RootProblem<Model::kStates, Dynamic> window_residual_problem(const OutputWindow<Model>& window) {
   constexpr int N = Model::kStates;
   const OutputWindow<Model>* win = &window;
-  return RootProblem<N, Dynamic>::with_autodiff(
+  return RootProblem<N, Dynamic>::with_dense_autodiff(  // (as square_window_residual)
       [win](const auto& w) {
         using T = typename std::decay_t<decltype(w)>::Scalar;
         return Vector<Dynamic, T>(win->residual(Vector<N, T>(w)));

@@ -7,10 +7,11 @@
 // (one evaluation of F per colour instead of n).
 //
 // J is an Eigen::SparseMatrix<double, RowMajor> with exactly the pattern's structure (shape()
-// sets it once); evaluations write its values in place and allocate nothing. The pattern must
+// sets it once); evaluations write its values in place and allocate nothing. (Eigen's sparse
+// module is only declared here, so that problem.hpp can carry a compressed Jacobian cheaply: a
+// caller that reads J includes nlobs/solvers/sparse/sparse_jacobian.hpp.) The pattern must
 // hold every entry F has: an entry it misses is added, unseen, into an entry of the same row and
 // colour. missing_entry() finds such an entry.
-#include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -22,20 +23,16 @@
 #include "nlobs/solvers/autodiff.hpp"
 #include "nlobs/solvers/callable.hpp"
 #include "nlobs/solvers/sparse/column_colouring.hpp"
-#include "nlobs/solvers/sparse/sparse_jacobian.hpp"
+#include "nlobs/solvers/sparse/sparse_jacobian_source.hpp"
 #include "nlobs/solvers/sparse/sparsity_pattern.hpp"
 
 namespace nlobs {
 
 class CompressedJacobian {
  public:
-  explicit CompressedJacobian(SparsityPattern pattern)
-      : pattern_(std::move(pattern)), columns_(pattern_), colouring_(colour_columns(pattern_)) {
-    if (pattern_.nonzeros() > std::numeric_limits<SparseJacobian::StorageIndex>::max()) {
-      throw InvalidInput("CompressedJacobian: " + std::to_string(pattern_.nonzeros()) +
-                         " entries exceed the sparse matrix's index type");
-    }
-  }
+  // Colours the pattern (column_colouring.hpp); throws InvalidInput for a pattern with more
+  // entries than J's int indices hold (src/compressed_jacobian.cpp).
+  explicit CompressedJacobian(SparsityPattern pattern);
 
   const SparsityPattern& pattern() const { return pattern_; }
   const ColumnColouring& colouring() const { return colouring_; }
@@ -43,18 +40,9 @@ class CompressedJacobian {
   int autodiff_passes() const { return (colouring_.colours + kJetStride - 1) / kJetStride; }
   int difference_evaluations() const { return colouring_.colours; }
 
-  // J sized and structured as the pattern (values zero); once, or when J was used elsewhere.
-  void shape(SparseJacobian& jac) const {
-    if (jac.rows() == pattern_.rows && jac.cols() == pattern_.cols &&
-        jac.nonZeros() == pattern_.nonzeros() && jac.isCompressed()) {
-      return;
-    }
-    jac.resize(pattern_.rows, pattern_.cols);
-    jac.resizeNonZeros(pattern_.nonzeros());
-    std::copy(pattern_.row_start.begin(), pattern_.row_start.end(), jac.outerIndexPtr());
-    std::copy(pattern_.columns.begin(), pattern_.columns.end(), jac.innerIndexPtr());
-    std::fill_n(jac.valuePtr(), pattern_.nonzeros(), 0.0);
-  }
+  // J sized and structured as the pattern (values zero) once, or when J was used elsewhere;
+  // returns J's value array (src/compressed_jacobian.cpp).
+  double* shape(SparseJacobian& jac) const;
 
   // J = ∂f/∂x at x by forward-mode AD, f generic in its scalar type (either shape of
   // callable.hpp) with pattern().rows outputs.
@@ -62,10 +50,9 @@ class CompressedJacobian {
   void autodiff(F& f, const Vector<Dynamic>& x, SparseJacobian& jac) {
     using Jet = ceres::Jet<double, kJetStride>;
     check_size(x);
-    shape(jac);
+    double* values = shape(jac);
     xj_.resize(x.size());
     fj_.resize(pattern_.rows);
-    double* values = jac.valuePtr();
     for (int first = 0; first < colouring_.colours; first += kJetStride) {
       for (Index j = 0; j < x.size(); ++j) {
         xj_[j] = Jet(x[j]);
@@ -90,10 +77,9 @@ class CompressedJacobian {
   int differences(F& f, const Vector<Dynamic>& x, const Vector<Dynamic>& f0, SparseJacobian& jac) {
     check_size(x);
     check_output(f0.size());
-    shape(jac);
+    double* values = shape(jac);
     xt_ = x;
     ft_.resize(pattern_.rows);
-    double* values = jac.valuePtr();
     const double root_eps = std::sqrt(std::numeric_limits<double>::epsilon());
     for (int c = 0; c < colouring_.colours; ++c) {
       for (Index j = 0; j < x.size(); ++j) {
@@ -134,6 +120,38 @@ class CompressedJacobian {
   Vector<Dynamic, ceres::Jet<double, kJetStride>> xj_, fj_;
   Vector<Dynamic> xt_, ft_;
 };
+
+namespace detail {
+// The sparse Jacobian of f by compressed AD (f generic in its scalar type) or coloured forward
+// differences (f on doubles), on `pattern` with its whole diagonal: a structural entry, zero
+// where F_i does not depend on x_i (ILU(0) and Jacobi then still fail on the zero, named).
+template <typename F>
+SparseJacobianSource autodiff_jacobian_source(F f, const SparsityPattern& pattern) {
+  CompressedJacobian compressed(with_diagonal(pattern));
+  auto structure = std::make_shared<const SparsityPattern>(compressed.pattern());
+  return SparseJacobianSource{
+      std::move(structure),
+      [compressed = std::move(compressed), f = std::move(f)](
+          const Vector<Dynamic>& x, const Vector<Dynamic>&, SparseJacobian& jac) mutable {
+        compressed.autodiff(f, x, jac);
+        return 0;
+      },
+      0};
+}
+template <typename F>
+SparseJacobianSource difference_jacobian_source(F f, const SparsityPattern& pattern) {
+  CompressedJacobian compressed(with_diagonal(pattern));
+  auto structure = std::make_shared<const SparsityPattern>(compressed.pattern());
+  const int evaluations = compressed.difference_evaluations();
+  return SparseJacobianSource{
+      std::move(structure),
+      [compressed = std::move(compressed), f = std::move(f)](
+          const Vector<Dynamic>& x, const Vector<Dynamic>& fx, SparseJacobian& jac) mutable {
+        return compressed.differences(f, x, fx, jac);
+      },
+      evaluations};
+}
+}  // namespace detail
 
 // The first entry (row, column) that f — generic — has and `declared` lacks, found by
 // detecting f's pattern at x (detect_sparsity: throws where f branches on x); nullopt when

@@ -12,7 +12,6 @@
 // problem keeps the dense Jacobian of the AD path too, for the engines that have no sparse path
 // yet. Coloured differences step forward (+h) whatever a box says: near a bound where F is not
 // defined outside, use the AD form.
-#include <memory>
 #include <utility>
 
 #include "nlobs/solvers/problem.hpp"
@@ -20,49 +19,11 @@
 
 namespace nlobs {
 
-namespace detail {
-// `pattern` with every diagonal entry of its square part.
-inline SparsityPattern with_diagonal(const SparsityPattern& pattern) {
-  SparsityPattern out;
-  out.rows = pattern.rows;
-  out.cols = pattern.cols;
-  out.row_start.assign(static_cast<std::size_t>(pattern.rows) + 1, 0);
-  out.columns.reserve(pattern.columns.size() + static_cast<std::size_t>(pattern.rows));
-  for (Index i = 0; i < pattern.rows; ++i) {
-    bool placed = i >= pattern.cols;  // no diagonal entry in a row below the square part
-    for (Index k = pattern.row_start[i]; k < pattern.row_start[i + 1]; ++k) {
-      const Index j = pattern.columns[k];
-      if (!placed && j >= i) {
-        if (j != i) out.columns.push_back(i);
-        placed = true;
-      }
-      out.columns.push_back(j);
-    }
-    if (!placed) out.columns.push_back(i);
-    out.row_start[static_cast<std::size_t>(i) + 1] = static_cast<Index>(out.columns.size());
-  }
-  return out;
-}
-
-template <typename Evaluate>
-SparseJacobianSource sparse_source(const CompressedJacobian& compressed, Evaluate evaluate,
-                                   int evaluations) {
-  return SparseJacobianSource{std::make_shared<const SparsityPattern>(compressed.pattern()),
-                              std::move(evaluate), evaluations};
-}
-}  // namespace detail
-
 template <typename F>
-RootProblem<> sparse_autodiff_problem(F f, SparsityPattern pattern) {
-  CompressedJacobian compressed(detail::with_diagonal(pattern));
-  const Index n = pattern.cols, m = pattern.rows;
-  auto evaluate = [compressed, f](const Vector<Dynamic>& x, const Vector<Dynamic>&,
-                                  SparseJacobian& jac) mutable {
-    compressed.autodiff(f, x, jac);
-    return 0;
-  };
-  SparseJacobianSource source = detail::sparse_source(compressed, std::move(evaluate), 0);
-  return RootProblem<>::with_autodiff(std::move(f), n, m).with_sparse_jacobian(std::move(source));
+RootProblem<> sparse_autodiff_problem(F f, const SparsityPattern& pattern) {
+  SparseJacobianSource source = detail::autodiff_jacobian_source(f, pattern);
+  return RootProblem<>::with_autodiff(std::move(f), pattern.cols, pattern.rows)
+      .with_sparse_jacobian(std::move(source));
 }
 
 // The pattern found at x (m outputs; default: square).
@@ -73,16 +34,10 @@ RootProblem<> sparse_autodiff_problem(F f, const Vector<Dynamic>& x, Index m = -
 }
 
 template <typename F>
-RootProblem<> sparse_difference_problem(F f, SparsityPattern pattern) {
-  CompressedJacobian compressed(detail::with_diagonal(pattern));
-  const Index n = pattern.cols, m = pattern.rows;
-  const int evaluations = compressed.difference_evaluations();
-  auto evaluate = [compressed, f](const Vector<Dynamic>& x, const Vector<Dynamic>& fx,
-                                  SparseJacobian& jac) mutable {
-    return compressed.differences(f, x, fx, jac);
-  };
-  SparseJacobianSource source = detail::sparse_source(compressed, std::move(evaluate), evaluations);
-  return RootProblem<>::from_map(std::move(f), n, m).with_sparse_jacobian(std::move(source));
+RootProblem<> sparse_difference_problem(F f, const SparsityPattern& pattern) {
+  SparseJacobianSource source = detail::difference_jacobian_source(f, pattern);
+  return RootProblem<>::from_map(std::move(f), pattern.cols, pattern.rows)
+      .with_sparse_jacobian(std::move(source));
 }
 
 }  // namespace nlobs

@@ -85,27 +85,41 @@ struct SparsityPattern {
   }
 };
 
-// The pattern of f: Rⁿ → Rᵐ, f generic in its scalar type (either shape of callable.hpp),
-// from one evaluation at x on SparsityTracer inputs. m: f's output size (Dynamic: whatever f
-// returns; for a writing f, n). Throws InvalidInput when f compared a value that depends on x (its
-// pattern may change with x: declare it, or use a dense Jacobian) — naming how many comparisons.
+namespace detail {
+// `pattern` with every diagonal entry of its square part (src/sparsity_pattern.cpp).
+SparsityPattern with_diagonal(const SparsityPattern& pattern);
+
+// What one evaluation of f on SparsityTracer inputs found: the pattern, the comparisons of values
+// that depend on x (branches), and whether the trace went past its limits (then the pattern is
+// empty and meaningless).
+struct SparsityTrace {
+  SparsityPattern pattern;
+  long branches = 0;
+  bool exceeded = false;
+};
+
+// Evaluates f once at x on SparsityTracer inputs within `limits`; m as detect_sparsity's. The
+// tracer's thread-local counters are reset on the way out, also when f throws.
 template <typename F>
-SparsityPattern detect_sparsity(F& f, const Vector<Dynamic>& x, Index m = Dynamic) {
+SparsityTrace trace_sparsity(F& f, const Vector<Dynamic>& x, Index m, SparsityTraceLimits limits) {
+  struct Reset {
+    ~Reset() {
+      SparsityTracerBranches = 0;
+      SparsityTracerLimits = SparsityTraceLimits{};
+    }
+  } reset;
+  SparsityTracerBranches = 0;
+  SparsityTracerLimits = limits;
   const Index n = x.size();
   Vector<Dynamic, SparsityTracer> traced(n);
   for (Index j = 0; j < n; ++j) traced[j] = SparsityTracer(x[j], j);
   Vector<Dynamic, SparsityTracer> out(m == Dynamic ? n : m);
-  detail::SparsityTracerBranches = 0;
-  detail::invoke_map(f, traced, out);
-  if (const long branches = detail::SparsityTracerBranches; branches > 0) {
-    detail::SparsityTracerBranches = 0;
-    throw InvalidInput("detect_sparsity: F compared a value that depends on x (" +
-                       std::to_string(branches) +
-                       " comparisons): its pattern may depend on x, and one evaluation sees "
-                       "only the branch taken at this x; declare the pattern or use a dense "
-                       "Jacobian");
-  }
-  SparsityPattern p;
+  invoke_map(f, traced, out);
+  SparsityTrace trace;
+  trace.branches = SparsityTracerBranches;
+  trace.exceeded = SparsityTracerLimits.exceeded;
+  if (trace.exceeded) return trace;
+  SparsityPattern& p = trace.pattern;
   p.rows = out.size();
   p.cols = n;
   p.row_start.assign(static_cast<std::size_t>(p.rows) + 1, 0);
@@ -114,7 +128,25 @@ SparsityPattern detect_sparsity(F& f, const Vector<Dynamic>& x, Index m = Dynami
     p.columns.insert(p.columns.end(), row.begin(), row.end());
     p.row_start[i + 1] = static_cast<Index>(p.columns.size());
   }
-  return p;
+  return trace;
+}
+}  // namespace detail
+
+// The pattern of f: Rⁿ → Rᵐ, f generic in its scalar type (either shape of callable.hpp),
+// from one evaluation at x on SparsityTracer inputs. m: f's output size (Dynamic: whatever f
+// returns; for a writing f, n). Throws InvalidInput when f compared a value that depends on x (its
+// pattern may change with x: declare it, or use a dense Jacobian) — naming how many comparisons.
+template <typename F>
+SparsityPattern detect_sparsity(F& f, const Vector<Dynamic>& x, Index m = Dynamic) {
+  detail::SparsityTrace trace = detail::trace_sparsity(f, x, m, {});
+  if (trace.branches > 0) {
+    throw InvalidInput("detect_sparsity: F compared a value that depends on x (" +
+                       std::to_string(trace.branches) +
+                       " comparisons): its pattern may depend on x, and one evaluation sees "
+                       "only the branch taken at this x; declare the pattern or use a dense "
+                       "Jacobian");
+  }
+  return std::move(trace.pattern);
 }
 
 }  // namespace nlobs

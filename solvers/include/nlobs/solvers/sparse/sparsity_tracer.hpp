@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <iterator>
 #include <limits>
 #include <utility>
@@ -27,6 +28,17 @@ namespace nlobs {
 namespace detail {
 // Comparisons of values that depend on x since the counter was last reset, in this thread.
 inline thread_local long SparsityTracerBranches = 0;
+
+// Bounds on the work of one trace, for automatic detection (RootProblem::with_autodiff): a
+// value that depends on more than `largest_set` inputs, or more than `budget` indices copied in
+// all, marks the trace `exceeded`, and from then on values carry no inputs (the trace is cheap
+// and its pattern discarded). Unbounded by default (detect_sparsity).
+struct SparsityTraceLimits {
+  std::size_t largest_set = std::numeric_limits<std::size_t>::max();
+  long long budget = std::numeric_limits<long long>::max();
+  bool exceeded = false;
+};
+inline thread_local SparsityTraceLimits SparsityTracerLimits;
 }  // namespace detail
 
 // The tracer and its functions live in a namespace of their own: argument-dependent lookup finds
@@ -49,6 +61,7 @@ class SparsityTracer {
   // The result of an operation on a and b: value v, the union of their inputs.
   static SparsityTracer combine(double v, const SparsityTracer& a, const SparsityTracer& b) {
     SparsityTracer r(v);
+    if (detail::SparsityTracerLimits.exceeded) return r;
     if (b.inputs_.empty()) {
       r.inputs_ = a.inputs_;
     } else if (a.inputs_.empty()) {
@@ -58,12 +71,15 @@ class SparsityTracer {
       std::set_union(a.inputs_.begin(), a.inputs_.end(), b.inputs_.begin(), b.inputs_.end(),
                      std::back_inserter(r.inputs_));
     }
+    r.count();
     return r;
   }
   // The result of a function of a alone: value v, a's inputs.
   static SparsityTracer follow(double v, const SparsityTracer& a) {
     SparsityTracer r(v);
+    if (detail::SparsityTracerLimits.exceeded) return r;
     r.inputs_ = a.inputs_;
+    r.count();
     return r;
   }
 
@@ -116,6 +132,16 @@ class SparsityTracer {
   }
 
  private:
+  // Charges this value's set to the trace's limits.
+  void count() {
+    detail::SparsityTraceLimits& limits = detail::SparsityTracerLimits;
+    limits.budget -= static_cast<long long>(inputs_.size());
+    if (limits.budget < 0 || inputs_.size() > limits.largest_set) {
+      limits.exceeded = true;
+      inputs_.clear();
+    }
+  }
+
   double value_ = 0.0;
   std::vector<Index> inputs_;
 };

@@ -1,0 +1,27 @@
+#include "nlobs/solvers/sparse/sparsity_pattern.hpp"
+
+namespace nlobs::detail {
+
+SparsityPattern with_diagonal(const SparsityPattern& pattern) {
+  SparsityPattern out;
+  out.rows = pattern.rows;
+  out.cols = pattern.cols;
+  out.row_start.assign(static_cast<std::size_t>(pattern.rows) + 1, 0);
+  out.columns.reserve(pattern.columns.size() + static_cast<std::size_t>(pattern.rows));
+  for (Index i = 0; i < pattern.rows; ++i) {
+    bool placed = i >= pattern.cols;  // no diagonal entry in a row below the square part
+    for (Index k = pattern.row_start[i]; k < pattern.row_start[i + 1]; ++k) {
+      const Index j = pattern.columns[k];
+      if (!placed && j >= i) {
+        if (j != i) out.columns.push_back(i);
+        placed = true;
+      }
+      out.columns.push_back(j);
+    }
+    if (!placed) out.columns.push_back(i);
+    out.row_start[static_cast<std::size_t>(i) + 1] = static_cast<Index>(out.columns.size());
+  }
+  return out;
+}
+
+}  // namespace nlobs::detail
