@@ -1,11 +1,13 @@
 // Newton's sparse path end to end (problem built, solved from the start): a pattern declared
 // against the same problem written as an unchanged RootProblem::with_autodiff, whose pattern is
 // detected at x₀ (sparse/sparsity_detection.hpp) — issue 40's target: within 1.5× at n = 10⁵.
-// Broyden's tridiagonal function from −1 (band-lu) and 2-D Bratu, λ = 6, from 0 (klu).
+// Broyden's tridiagonal function from −1 (band-lu) and 2-D Bratu, λ = 6, from 0 (klu). Then
+// pseudo-transient continuation on Bratu, detected, with klu and with BiCGSTAB + ILU(0).
 #include <benchmark/benchmark.h>
 
 #include "large_test_problems.hpp"
 #include "nlobs/solvers/newton_engine.hpp"
+#include "nlobs/solvers/pseudo_transient_engine.hpp"
 #include "nlobs/solvers/root_adapter.hpp"
 #include "nlobs/solvers/sparse/sparse_problem.hpp"
 
@@ -60,6 +62,34 @@ void BM_NewtonBratu(benchmark::State& state) {
 }
 BENCHMARK(BM_NewtonBratu)
     ->ArgsProduct({{100, 316}, {kDeclared, kDetected}})
+    ->Unit(benchmark::kMillisecond);
+
+void BM_PseudoTransientBratu(benchmark::State& state) {
+  const Index s = state.range(0), n = s * s;
+  const bool krylov = state.range(1) == 1;
+  nlobs::SolverOptions options;
+  options.stop.residual_tolerance = 1e-10;
+  nlobs::PseudoTransientOptions ptc;
+  ptc.linear_solver = krylov ? "bicgstab:preconditioner=ilu0" : "klu";
+  int steps = 0;
+  for (auto _ : state) {
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
+    nlobs::PseudoTransientEngine<> engine(ptc, options);
+    const nlobs::Summary r = engine.solve(
+        nlobs::to_fixed_point(nlobs::RootProblem<>::with_autodiff(nlobs::test::bratu(s), n, n)), x);
+    if (r.status != nlobs::Status::kConverged || r.linear_solver.empty()) {
+      state.SkipWithError("not solved on the sparse path");
+      return;
+    }
+    steps = r.iterations;
+    benchmark::DoNotOptimize(x.data());
+  }
+  state.SetLabel(ptc.linear_solver);
+  state.counters["n"] = static_cast<double>(n);
+  state.counters["steps"] = steps;
+}
+BENCHMARK(BM_PseudoTransientBratu)
+    ->ArgsProduct({{100, 316}, {0, 1}})
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace

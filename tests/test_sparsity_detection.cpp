@@ -142,7 +142,11 @@ TEST(SparsityDetection, KeepsTheDensePathWhereFBranchesOrJIsDense) {
         << problem.sparse_jacobian_note();
     EXPECT_NEAR(x[0], 1.0 / 1.2, 1e-12);
   }
-  // The trace's limits end with it: an unbounded detection afterwards sees every entry.
+  // The trace's limits end with it: this thread's limits are the unbounded defaults again, and a
+  // detection afterwards sees every entry.
+  EXPECT_FALSE(detail::SparsityTracerLimits.exceeded);
+  EXPECT_EQ(detail::SparsityTracerLimits.largest_set, detail::SparsityTraceLimits{}.largest_set);
+  EXPECT_EQ(detail::SparsityTracerLimits.budget, detail::SparsityTraceLimits{}.budget);
   auto f = dense_rows();
   EXPECT_EQ(detect_sparsity(f, Vector<Dynamic>::Zero(n)).nonzeros(), n * n);
 }
@@ -203,13 +207,13 @@ TEST(SparsityDetection, DeclinesANonSquareF) {
       << problem.sparse_jacobian_note();
 }
 
-TEST(SparsityDetection, LetsAThrowingTracePassAndStaysToDo) {
+TEST(SparsityDetection, DeclinesWhereFThrowsWhileTracedAndLeavesNoCountBehind) {
   const Index n = 150;
   auto f = [](const auto& x) {
     using T = typename std::decay_t<decltype(x)>::Scalar;
     if constexpr (std::is_same_v<T, SparsityTracer>) {
-      T partial = x[0] + x[1];  // (a trace under way when F throws)
-      static_cast<void>(partial);
+      T partial = x[0] + x[1];
+      if (partial > 0.0) partial = -partial;  // (a branch counted before F throws)
       throw std::runtime_error("F refuses tracers");
     }
     Vector<Dynamic, T> r(x.size());
@@ -218,15 +222,27 @@ TEST(SparsityDetection, LetsAThrowingTracePassAndStaysToDo) {
   };
   const auto problem = RootProblem<>::with_autodiff(f, n, n);
   Vector<Dynamic> x = Vector<Dynamic>::Zero(n);
-  EXPECT_THROW(newton(problem, x), std::runtime_error);
+  const Summary s = newton(problem, x);
+  ASSERT_EQ(s.status, Status::kConverged) << s.message;
+  EXPECT_TRUE(s.linear_solver.empty()) << "the dense path, as before detection";
+  EXPECT_EQ(problem.sparse_jacobian_note(),
+            "not detected: F threw while traced: F refuses tracers");
+  // The thrown trace left this thread's counters and limits as they were before it.
+  EXPECT_EQ(detail::SparsityTracerBranches, 0);
+  EXPECT_FALSE(detail::SparsityTracerLimits.exceeded);
+  EXPECT_EQ(detail::SparsityTracerLimits.budget, detail::SparsityTraceLimits{}.budget);
+  // Also when the trace had limits and went past them.
+  EXPECT_THROW(detail::trace_sparsity(f, x, Dynamic, {.largest_set = 1, .budget = 1}),
+               std::runtime_error);
+  EXPECT_EQ(detail::SparsityTracerBranches, 0);
+  EXPECT_FALSE(detail::SparsityTracerLimits.exceeded);
+  EXPECT_EQ(detail::SparsityTracerLimits.largest_set, detail::SparsityTraceLimits{}.largest_set);
+}
+
+TEST(SparsityDetection, RefusesAPointOfAnotherSize) {
+  const auto problem = RootProblem<>::with_autodiff(broyden_tridiagonal(), 200, 200);
+  EXPECT_THROW(problem.sparse_jacobian(Vector<Dynamic>::Zero(199)), InvalidInput);
   EXPECT_TRUE(starts_with(problem.sparse_jacobian_note(), "not detected yet"));
-  // The thrown trace left no count or limit behind.
-  auto tridiagonal = broyden_tridiagonal();
-  const detail::SparsityTrace after =
-      detail::trace_sparsity(tridiagonal, Vector<Dynamic>::Zero(n), Dynamic, {});
-  EXPECT_EQ(after.branches, 0);
-  EXPECT_FALSE(after.exceeded);
-  EXPECT_EQ(after.pattern.nonzeros(), 3 * n - 2);
 }
 
 }  // namespace

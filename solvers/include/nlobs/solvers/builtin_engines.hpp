@@ -4,7 +4,9 @@
 // header only to give the built-in engines fixed-size entries at another size N:
 //   nlobs::add_builtin_engines<6>(nlobs::EngineRegistry<6>::global());
 // (it compiles every engine at that size in the including file).
+#include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -31,6 +33,29 @@ inline FiniteDifference parse_finite_difference(const char* engine, const std::s
   if (v == "central") return FiniteDifference::kCentral;
   if (v == "forward") return FiniteDifference::kForward;
   throw InvalidInput(std::string(engine) + ": fd=" + v + " is not forward or central");
+}
+
+// The keys linear=… and preconditioner=… of the engines with a sparse path, and their reading:
+// the linear-solver spec, or nullopt when neither is given.
+inline constexpr const char* kLinearKeyHelp =
+    "auto|dense|band-lu|sparse-lu|klu|gmres|bicgstab: the linear solver of a problem with a "
+    "sparse Jacobian; default auto (band-lu or klu)";
+inline constexpr const char* kPreconditionerKeyHelp =
+    "none|jacobi|ilu0|ilut, with linear=gmres|bicgstab; default none";
+inline std::optional<std::string> parse_linear_solver(const char* engine, EngineSpecReader& s,
+                                                      std::string linear) {
+  const std::optional<std::string> given = s.text("linear");
+  if (given) linear = *given;
+  const std::optional<std::string> preconditioner = s.text("preconditioner");
+  if (preconditioner) {
+    if (linear != "gmres" && linear != "bicgstab") {
+      throw InvalidInput(std::string(engine) + ": preconditioner=" + *preconditioner +
+                         " needs linear=gmres or linear=bicgstab");
+    }
+    linear += ":preconditioner=" + *preconditioner;
+  }
+  if (!given && !preconditioner) return std::nullopt;
+  return linear;
 }
 }  // namespace detail
 
@@ -76,10 +101,8 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
        {{"linesearch", "0/1 Armijo backtracking; default 0"},
         {"trustregion", "0/1 dogleg trust region, a Jacobian every iterate; default 0"},
         {"fd", "forward|central differences when no Jacobian; default central"},
-        {"linear",
-         "auto|dense|band-lu|sparse-lu|klu|gmres|bicgstab: the linear solver of a problem with "
-         "a sparse Jacobian; default auto (band-lu or klu)"},
-        {"preconditioner", "none|jacobi|ilu0|ilut, with linear=gmres|bicgstab; default none"}},
+        {"linear", detail::kLinearKeyHelp},
+        {"preconditioner", detail::kPreconditionerKeyHelp}},
        {"newton", "newton:linesearch=1", "newton:trustregion=1",
         "newton:linesearch=1,linear=gmres,preconditioner=ilu0"},
        [](EngineSpecReader& s, SolverOptions o) {
@@ -88,13 +111,8 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
          if (auto v = s.boolean("trustregion")) n.trust_region = *v;
          if (auto v = s.text("fd"))
            n.finite_difference = detail::parse_finite_difference("newton", *v);
-         if (auto v = s.text("linear")) n.linear_solver = *v;
-         if (auto v = s.text("preconditioner")) {
-           if (n.linear_solver != "gmres" && n.linear_solver != "bicgstab") {
-             throw InvalidInput("newton: preconditioner=" + *v +
-                                " needs linear=gmres or linear=bicgstab");
-           }
-           n.linear_solver += ":preconditioner=" + *v;
+         if (auto v = detail::parse_linear_solver("newton", s, n.linear_solver)) {
+           n.linear_solver = *v;
          }
          return std::make_unique<NewtonEngine<N>>(n, std::move(o));
        }});
@@ -174,8 +192,11 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
        {{"flow", "residual|fixed-point: dx/dt = -F = x - G(x) or G(x) - x; default residual"},
         {"delta0", "initial pseudo time step, >= 2.22e-16 (machine epsilon); default 1e-2"},
         {"delta_max", "largest pseudo time step; default 1e12"},
-        {"fd", "forward|central differences when no Jacobian; default central"}},
-       {"pseudo-transient:flow=fixed-point", "pseudo-transient:flow=fixed-point,delta0=1e-4"},
+        {"fd", "forward|central differences when no Jacobian; default central"},
+        {"linear", detail::kLinearKeyHelp},
+        {"preconditioner", detail::kPreconditionerKeyHelp}},
+       {"pseudo-transient:flow=fixed-point", "pseudo-transient:flow=fixed-point,delta0=1e-4",
+        "pseudo-transient:flow=fixed-point,linear=gmres,preconditioner=ilu0"},
        [](EngineSpecReader& s, SolverOptions o) {
          PseudoTransientOptions p;
          if (auto v = s.text("flow")) {
@@ -196,6 +217,9 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
          if (auto v = s.text("fd")) {
            p.finite_difference = detail::parse_finite_difference("pseudo-transient", *v);
          }
+         if (auto v = detail::parse_linear_solver("pseudo-transient", s, p.linear_solver)) {
+           p.linear_solver = *v;
+         }
          return std::make_unique<PseudoTransientEngine<N>>(p, std::move(o));
        }});
   add({"auto",
@@ -204,7 +228,10 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
         {"from", "start|best: each stage from x0 or from the best point so far; default start"},
         {"shared_minimum",
          "stop (local_minimum) when this many stages end at the same point without "
-         "progress, 0 = off; default 2"}},
+         "progress, 0 = off; default 2"},
+        {"dense_limit",
+         "on a problem with a sparse Jacobian and more unknowns than this, skip the stages "
+         "without a sparse path (dense n x n J), 0 = never; default 1000"}},
        {"auto", "auto:order=dogleg/levenberg-marquardt,from=best"},
        [](EngineSpecReader& s, SolverOptions o) {
          PolyalgorithmOptions p;
@@ -217,6 +244,9 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
              throw InvalidInput("auto: from=" + *v + " is not best or start");
          }
          if (auto v = s.integer("shared_minimum", 0, 1000)) p.shared_minimum = *v;
+         if (auto v = s.integer("dense_limit", 0, std::numeric_limits<int>::max())) {
+           p.dense_stage_limit = *v;
+         }
          const std::string order = s.text("order").value_or(kAutoOrder);
          std::vector<std::unique_ptr<Engine<N>>> stages;
          for (std::size_t at = 0; at <= order.size();) {

@@ -103,6 +103,11 @@ class Engine {
   // the others throw InvalidInput here, as do entries that are not finite and > 0. A scale of
   // another size than the problem's is refused by solve(). Empty scales remove the scaling.
   virtual bool accepts_scaling() const { return false; }
+  // Whether solve() takes the sparse path (J assembled sparse, steps by the linear-solver layer)
+  // for a problem that carries a sparse Jacobian, declared or detected: newton with a line search
+  // or full steps, pseudo-transient — not under a scaling, nor with linear_solver = "dense". The
+  // others build and factor a dense n×n J (auto skips them on a large sparse problem).
+  virtual bool has_sparse_path() const { return false; }
   void set_scaling(Scaling scaling) {
     if (scaled_solve_running_) {
       throw InvalidInput(std::string(name()) + ": set_scaling during a scaled solve");

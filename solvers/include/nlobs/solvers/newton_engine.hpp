@@ -36,6 +36,7 @@
 #include "nlobs/solvers/linear/forcing_term.hpp"
 #include "nlobs/solvers/linear/linear_solver.hpp"
 #include "nlobs/solvers/linear/make_linear_solver.hpp"
+#include "nlobs/solvers/sparse_path.hpp"
 #include "nlobs/solvers/square_system.hpp"
 #include "nlobs/solvers/stop_monitor.hpp"
 
@@ -76,14 +77,7 @@ class NewtonEngine : public Engine<N> {
       fail("backtrack_factor", newton_.backtrack_factor, "must lie in (0, 1)");
     }
     if (newton_.max_backtracks < 1) fail("max_backtracks", newton_.max_backtracks, "must be >= 1");
-    if (newton_.linear_solver != "auto" && newton_.linear_solver != "dense") {
-      try {
-        make_linear_solver(newton_.linear_solver);
-      } catch (const InvalidInput& e) {
-        throw InvalidInput(std::string("NewtonOptions::linear_solver: ") + e.what() +
-                           " (or auto, dense)");
-      }
-    }
+    detail::check_linear_solver_option("NewtonOptions::linear_solver", newton_.linear_solver);
     forcing_ = ForcingTerm(newton_.forcing);
     if (newton_.line_search && newton_.trust_region) {
       throw InvalidInput(
@@ -103,10 +97,19 @@ class NewtonEngine : public Engine<N> {
   bool accepts_bounds() const override { return true; }
   bool accepts_strict_bounds() const override { return true; }
   bool accepts_scaling() const override { return true; }
+  bool has_sparse_path() const override {
+    return detail::takes_sparse_path(newton_.linear_solver, dense_reason());
+  }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
 
  private:
+  // What sends a solve to the dense path whatever the problem carries; nullptr for nothing.
+  const char* dense_reason() const {
+    if (trust_region_) return "the trust region";
+    if (!this->scaling_.empty()) return "a scaling (set_scaling)";
+    return nullptr;
+  }
   // dx_ = −J_F⁻¹ f_ at x_ (dense: jac_, LU; sparse: sparse_jac_, linear_); nullopt or the status.
   std::optional<Status> dense_step(std::string& message, int iteration);
   std::optional<Status> sparse_step(std::string& message);
@@ -134,7 +137,7 @@ class NewtonEngine : public Engine<N> {
   Eigen::PartialPivLU<Matrix<N, N>> lu_;
   // The sparse path (run-time size only); the linear solver is made afresh for each solve.
   SparseJacobian sparse_jac_;
-  std::shared_ptr<LinearSolver> linear_;
+  detail::SparseLinearStep linear_;
   ForcingTerm forcing_;
   Vector<N> linear_residual_ = zero_vector<N>();  // F_k + J_k (x_{k+1} − x_k), for [EW96]
 };
@@ -167,25 +170,9 @@ std::optional<Status> NewtonEngine<N>::sparse_step(std::string& message) {
             system_.sparse_jacobian(x_, f_, sparse_jac_, message)) {
       return status;
     }
-    LinearStatus linear = linear_->setup(sparse_jac_);
-    if (linear == LinearStatus::kSolved) {
-      linear = linear_->solve(f_, dx_, forcing_.eta());
-      // Above η_k but below ‖F‖: with r = F + J Δx, ∇φᵀΔx = Fᵀ J Δx = Fᵀ r − ‖F‖² < 0 when
-      // ‖r‖ < ‖F‖: still a descent direction.
-      if (linear == LinearStatus::kNotConverged && linear_->stats().last_residual < 1.0) {
-        linear = LinearStatus::kSolved;
-      }
-    }
-    if (linear != LinearStatus::kSolved) {
-      // A direct solver's zero pivot is J's; a Krylov solver's breakdown or singular
-      // preconditioner need not be (BiCGSTAB breaks down on regular systems).
-      message = linear_->message();
-      if (linear == LinearStatus::kNonFinite) return Status::kNonFinite;
-      if (linear == LinearStatus::kSingular && !linear_->iterative()) {
-        return Status::kSingularJacobian;
-      }
-      return Status::kSolverFailure;
-    }
+    // (A Krylov step above η_k but below ‖F‖ is accepted: still a descent direction.)
+    const LinearStatus linear = linear_.solve(sparse_jac_, f_, dx_, forcing_.eta(), 1.0);
+    if (const std::optional<Status> failed = linear_.failure(linear, message)) return failed;
     dx_ = -dx_;
     return std::nullopt;
   } else {
@@ -217,17 +204,9 @@ double NewtonEngine<N>::merit_curvature(bool sparse) const {
 
 template <int N>
 Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
-  // A declared sparse Jacobian says the dense one may be out of reach; one still to be detected
-  // does not (the trust region and a scaling then take the dense path, as before detection).
-  const detail::SparseJacobianState* sparse_state = problem.sparse_jacobian_state().get();
-  if (sparse_state != nullptr && sparse_state->declared() && newton_.linear_solver != "dense" &&
-      (trust_region_ || !this->scaling_.empty())) {
-    // Both would take the dense n×n path: say so rather than allocate it.
-    throw InvalidInput(std::string("newton: ") +
-                       (trust_region_ ? "the trust region" : "a scaling (set_scaling)") +
-                       " is not on the sparse path yet; use the line search, or "
-                       "NewtonOptions::linear_solver = \"dense\" for a small problem");
-  }
+  detail::refuse_dense_path_for_declared(
+      name(), problem, newton_.linear_solver, dense_reason(),
+      "use the line search, or NewtonOptions::linear_solver = \"dense\" for a small problem");
   if (trust_region_) {
     Summary s = trust_region_->solve(problem, x);
     s.engine = name();
@@ -247,11 +226,10 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
   if constexpr (N == Dynamic) {
     for (Vector<N>* v : {&x_, &f_, &dx_, &xt_, &ft_, &gradient_}) v->resize(n);
     const SparseJacobianSource* source =
-        newton_.linear_solver == "dense" ? nullptr : problem.sparse_residual_jacobian(x);
+        detail::sparse_path_source(problem, x, newton_.linear_solver, dense_reason());
     sparse = source != nullptr;
     if (sparse) {
-      linear_ =
-          make_linear_solver(choose_linear_solver(newton_.linear_solver, *source->pattern, n));
+      linear_.choose(newton_.linear_solver, *source->pattern, n);
       forcing_.restart();
     } else {
       jac_.resize(n, n);
@@ -271,7 +249,7 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
   double t = 1.0;
   // An inexact (Krylov) step has ∇φᵀΔx = −‖F‖² + Fᵀr, not −‖F‖²: the Armijo test then takes the
   // slope from ∇φ = J_Fᵀ F as a projected step does.
-  const bool inexact = sparse && linear_->iterative();
+  const bool inexact = sparse && linear_.iterative();
   auto search = [&](const Vector<N>& d, double t0, bool armijo) {
     const double phi0 = f_.squaredNorm();
     t = t0;
@@ -377,11 +355,7 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
 
   x = x_;
   system_.finish(summary, *status, monitor, x, f_, stop);
-  if (sparse) {
-    summary.linear_solver = std::string(linear_->name());
-    summary.linear_setups = linear_->stats().setups;
-    summary.linear_iterations = linear_->stats().iterations;
-  }
+  if (sparse) linear_.report(summary);
   return summary;
 }
 

@@ -38,6 +38,13 @@ struct PolyalgorithmOptions {
   // 0 = never: every stage runs until one is usable or the budget is spent.
   int shared_minimum = 2;
   static constexpr double kSameMinimum = 1e-3;
+  // On a problem with a sparse Jacobian (declared, or detected at x0) of more than this many
+  // unknowns, the stages without a sparse path (Engine::has_sparse_path: dogleg,
+  // levenberg-marquardt, broyden, …) are not run: each would build and factor a dense n×n J —
+  // at n = 10⁴ 800 MB and minutes per factorisation, where newton and pseudo-transient take
+  // milliseconds on the sparse path — unless no stage has a sparse path (auto:order=dogleg, or
+  // every stage under a scaling): then all run, densely. 0: run them at any n. ≥ 0.
+  Index dense_stage_limit = 1000;
 };
 
 template <int N = Dynamic>
@@ -52,6 +59,10 @@ class PolyalgorithmEngine : public Engine<N> {
     if (poly_.shared_minimum < 0) {
       throw InvalidInput("auto: shared_minimum = " + std::to_string(poly_.shared_minimum) +
                          " is invalid: must be >= 0 (0 = off)");
+    }
+    if (poly_.dense_stage_limit < 0) {
+      throw InvalidInput("auto: dense_stage_limit = " + std::to_string(poly_.dense_stage_limit) +
+                         " is invalid: must be >= 0 (0 = no limit)");
     }
     for (const auto& s : stages_) {
       if (!s) throw InvalidInput("auto: a stage engine is null");
@@ -77,6 +88,10 @@ class PolyalgorithmEngine : public Engine<N> {
     return std::all_of(stages_.begin(), stages_.end(),
                        [](const auto& s) { return s->accepts_scaling(); });
   }
+  bool has_sparse_path() const override {
+    return std::any_of(stages_.begin(), stages_.end(),
+                       [](const auto& s) { return s->has_sparse_path(); });
+  }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override {
     detail::check_initial_guess(name(), problem, x);
@@ -99,8 +114,23 @@ class PolyalgorithmEngine : public Engine<N> {
       if (history.tellp() > 0) history << "; ";
       history << what;
     };
+    // The stages skipped on a large sparse problem are noted when the run reaches them (a stage
+    // before them that succeeds leaves no note).
+    const std::vector<bool> run = stages_to_run(problem, x);
+    std::string skipped;
+    auto note_skipped = [&] {
+      if (skipped.empty()) return;
+      note(skipped + " not run (no sparse path, and n = " + std::to_string(x.size()) +
+           " > dense_stage_limit " + std::to_string(poly_.dense_stage_limit) + ")");
+      skipped.clear();
+    };
     for (std::size_t k = 0; k < stages_.size(); ++k) {
       Engine<N>& stage = *stages_[k];
+      if (!run[k]) {
+        skipped += (skipped.empty() ? "" : ", ") + stage.label();
+        continue;
+      }
+      note_skipped();
       const int left = budget - evaluations;
       if (left < 1) break;
       stage.limit_evaluations(std::min(left, caps_[k]));
@@ -177,6 +207,7 @@ class PolyalgorithmEngine : public Engine<N> {
         end_statuses.push_back(last.status);
       }
     }
+    note_skipped();
     Summary s;
     if (have_best) {
       s = std::move(best_summary);
@@ -217,6 +248,24 @@ class PolyalgorithmEngine : public Engine<N> {
   }
 
  private:
+  // Every stage, but those without a sparse path on a problem with a sparse Jacobian larger than
+  // dense_stage_limit (detected here, at x, if that is still to do) — unless no stage with one
+  // would be left, when all run, densely, as before the sparse path existed.
+  std::vector<bool> stages_to_run(const FixedPointProblem<N>& problem, const Vector<N>& x) const {
+    std::vector<bool> run(stages_.size(), true);
+    if constexpr (N == Dynamic) {
+      const bool any_sparse = std::any_of(stages_.begin(), stages_.end(),
+                                          [](const auto& s) { return s->has_sparse_path(); });
+      if (!any_sparse || poly_.dense_stage_limit == 0 || x.size() <= poly_.dense_stage_limit ||
+          problem.sparse_residual_jacobian(x) == nullptr) {
+        return run;
+      }
+      for (std::size_t k = 0; k < stages_.size(); ++k) run[k] = stages_[k]->has_sparse_path();
+    } else {
+      static_cast<void>(problem), static_cast<void>(x);
+    }
+    return run;
+  }
   static bool stopped_without_progress(Status status) {
     return status == Status::kStagnated || status == Status::kRoundingFloor ||
            status == Status::kBlockedByBound;

@@ -121,6 +121,7 @@ class FixedPointProblem {
   }
   const SparseJacobianSource* sparse_residual_jacobian(const VectorType& x) const {
     if constexpr (N == Dynamic) {
+      detail::check_size("sparse_residual_jacobian: x", n_, x.size());
       if (sparse_) return sparse_->resolve(x);
     }
     return nullptr;
@@ -249,6 +250,7 @@ class RootProblem {
   const SparseJacobianSource* sparse_jacobian() const { return sparse_ ? sparse_->get() : nullptr; }
   const SparseJacobianSource* sparse_jacobian(const VectorType& x) const {
     if constexpr (N == Dynamic && M == Dynamic) {
+      detail::check_size("sparse_jacobian: x", n_, x.size());
       if (sparse_) return sparse_->resolve(x);
     }
     return nullptr;
@@ -296,8 +298,8 @@ class RootProblem {
   Map f_;
   JacobianMap df_;
   JacobianSource source_;
-  // Shared by the problem's copies, workspace included (evaluate() holds its scratch): solve
-  // copies of a problem with a sparse Jacobian one at a time, not concurrently.
+  // Shared by the problem's copies, workspace included (evaluate() holds its scratch; the state
+  // locks around it, so copies solved concurrently take turns evaluating J).
   std::shared_ptr<detail::SparseJacobianState> sparse_;
 };
 

@@ -25,18 +25,29 @@
 // Bounds (Engine::set_bounds): x_{k+1} = P(x_k + p_k), the projection onto the box (a step the
 // box cut short is no step criterion); where the box holds x_k in place the flow leaves the box
 // there, and the run ends blocked_by_bound.
+//
+// Sparse path (run-time size, a problem with a sparse Jacobian, declared or detected: as
+// NewtonEngine's): δ⁻¹I ∓ J is assembled sparse on J's pattern and solved by
+// PseudoTransientOptions::linear_solver (nlobs/solvers/linear/), a Krylov solver to
+// linear_tolerance (the Newton-like step test assumes the step solves its system). A singular
+// δ⁻¹I ∓ J halves δ as on the dense path, and so does a Krylov solve that breaks down or misses
+// the tolerance (a smaller δ makes the matrix more diagonally dominant); the linear solver's other
+// failures end the run, named.
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
 #include <sstream>
+#include <string>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
+#include "nlobs/solvers/sparse_path.hpp"
 #include "nlobs/solvers/square_system.hpp"
 #include "nlobs/solvers/stop_monitor.hpp"
 
@@ -55,6 +66,11 @@ struct PseudoTransientOptions {
   static constexpr double kMinPseudoStep = std::numeric_limits<double>::epsilon();
   // Used only when the problem carries no Jacobian.
   FiniteDifference finite_difference = FiniteDifference::kCentral;
+  // The sparse path's linear solver: as NewtonOptions::linear_solver ("auto", "dense", or a
+  // make_linear_solver spec). Read only for problems with a sparse Jacobian.
+  std::string linear_solver = "auto";
+  // ‖b − A p‖₂ ≤ linear_tolerance ‖b‖₂ for a Krylov solver, in (0, 1) (direct ones solve exactly).
+  double linear_tolerance = 1e-6;
 };
 
 template <int N = Dynamic>
@@ -80,6 +96,9 @@ class PseudoTransientEngine : public Engine<N> {
     require(ptc_.min_pseudo_step >= floor && ptc_.min_pseudo_step <= ptc_.initial_pseudo_step,
             "min_pseudo_step", ptc_.min_pseudo_step,
             "must lie in [2.22e-16 (machine epsilon), initial_pseudo_step]");
+    require(ptc_.linear_tolerance > 0.0 && ptc_.linear_tolerance < 1.0, "linear_tolerance",
+            ptc_.linear_tolerance, "must lie in (0, 1)");
+    detail::check_linear_solver_option("PseudoTransientOptions::linear_solver", ptc_.linear_solver);
     detail::require_lipschitz_for_error_bound(name(), this->options_.stop);
   }
 
@@ -88,6 +107,9 @@ class PseudoTransientEngine : public Engine<N> {
   bool accepts_bounds() const override { return true; }
   bool accepts_strict_bounds() const override { return true; }
   bool accepts_scaling() const override { return true; }
+  bool has_sparse_path() const override {
+    return detail::takes_sparse_path(ptc_.linear_solver, dense_reason());
+  }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
 
@@ -97,6 +119,24 @@ class PseudoTransientEngine : public Engine<N> {
             xt_ = zero_vector<N>(), ft_ = zero_vector<N>();
   Matrix<N, N> jac_, shifted_;
   Eigen::PartialPivLU<Matrix<N, N>> lu_;
+  // The sparse path (run-time size only): J, δ⁻¹I ∓ J, where each row's diagonal entry lies in
+  // their value arrays, the linear solver.
+  SparseJacobian sparse_jac_, sparse_shifted_;
+  std::vector<Index> diagonal_;
+  detail::SparseLinearStep linear_;
+  // What sends a solve to the dense path whatever the problem carries; nullptr for nothing.
+  const char* dense_reason() const {
+    return this->scaling_.empty() ? nullptr : "a scaling (set_scaling)";
+  }
+  // J_F at x_ into sparse_jac_ (sparse path); nullopt or the status.
+  std::optional<Status> sparse_jacobian(std::string& message);
+  // p_ = (δ⁻¹I − σJ)⁻¹ F (then negated for σ = −1) by LU of shifted_ or by linear_: nullopt, or
+  // the status with `retry` set when a smaller δ may succeed (a singular matrix, a Krylov solve
+  // that failed): δ is then halved and the step tried again.
+  std::optional<Status> dense_shifted_solve(double delta, int sigma, bool& retry,
+                                            std::string& message);
+  std::optional<Status> sparse_shifted_solve(double delta, int sigma, bool& retry,
+                                             std::string& message);
   // Doublings of δ per iteration for steps lost to rounding: from ε to 1e12 takes 93.
   static constexpr int kMaxLostSteps = 200;
   detail::SquareSystem<N> system_;
@@ -104,6 +144,9 @@ class PseudoTransientEngine : public Engine<N> {
 
 template <int N>
 Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
+  detail::refuse_dense_path_for_declared(
+      name(), problem, ptc_.linear_solver, dense_reason(),
+      "PseudoTransientOptions::linear_solver = \"dense\" for a small problem");
   if (std::optional<Summary> scaled =
           this->solve_scaled(problem, x, [this](const FixedPointProblem<N>& p, Vector<N>& y) {
             return PseudoTransientEngine<N>::solve(p, y);
@@ -115,10 +158,33 @@ Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vec
   system_.start(name(), problem, x, this->bounds_, ptc_.finite_difference, stop);
   const detail::Box<N>& box = system_.box();
   const Index n = x.size();
+  bool sparse = false;
   if constexpr (N == Dynamic) {
     for (Vector<N>* v : {&x_, &f_, &p_, &xt_, &ft_}) v->resize(n);
-    jac_.resize(n, n), shifted_.resize(n, n);
-    if (lu_.rows() != n) lu_ = Eigen::PartialPivLU<Matrix<N, N>>(n);
+    const SparseJacobianSource* source =
+        detail::sparse_path_source(problem, x, ptc_.linear_solver, dense_reason());
+    sparse = source != nullptr;
+    if (sparse) {
+      const SparsityPattern& pattern = *source->pattern;
+      diagonal_.assign(static_cast<std::size_t>(n), -1);
+      for (Index i = 0; i < n; ++i) {
+        for (Index k = pattern.row_start[i]; k < pattern.row_start[i + 1]; ++k) {
+          if (pattern.columns[k] == i) diagonal_[i] = k;
+        }
+        if (diagonal_[i] < 0) {
+          throw InvalidInput(
+              "pseudo-transient: the sparse Jacobian's pattern lacks the diagonal "
+              "entry (" +
+              std::to_string(i) + ", " + std::to_string(i) +
+              "), where delta^-1 I is added (the problems of "
+              "sparse_problem.hpp have every one)");
+        }
+      }
+      linear_.choose(ptc_.linear_solver, pattern, n);
+    } else {
+      jac_.resize(n, n), shifted_.resize(n, n);
+      if (lu_.rows() != n) lu_ = Eigen::PartialPivLU<Matrix<N, N>>(n);
+    }
   }
   Summary summary;
   summary.engine = name();
@@ -167,37 +233,35 @@ Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vec
       status = spent_status();
       break;
     }
-    if ((status = system_.jacobian(x_, f_, jac_, summary.message))) break;  // J_F = ∂G − I
+    if (sparse) {
+      status = sparse_jacobian(summary.message);
+    } else {
+      status = system_.jacobian(x_, f_, jac_, summary.message);  // J_F = ∂G − I
+    }
+    if (status) break;
     // Trial steps from x_k: a non-finite F(x_k + p) halves δ and tries again.
     bool stepped = false;
     int lost_steps = 0;
     while (!status && !stepped) {
-      // σ = +1: (δ⁻¹I − J) p = F;  σ = −1: (δ⁻¹I + J) p = −F.
-      if (sigma > 0) {
-        shifted_ = -jac_;
-      } else {
-        shifted_ = jac_;
-      }
-      shifted_.diagonal().array() += 1.0 / delta;
-      lu_.compute(shifted_);
-      const double smallest_pivot = lu_.matrixLU().diagonal().cwiseAbs().minCoeff();
+      // σ = +1: (δ⁻¹I − J) p = F;  σ = −1: (δ⁻¹I + J) p = −F, p in p_.
+      bool retry = false;
+      std::string failure;  // the summary's message only if the run ends with it
+      status = sparse ? sparse_shifted_solve(delta, sigma, retry, failure)
+                      : dense_shifted_solve(delta, sigma, retry, failure);
       // δ⁻¹ at an eigenvalue of ±J makes the system singular though J is not: a smaller δ moves
       // away from it, as after a non-finite trial.
-      if (!(smallest_pivot > 1e-13 * shifted_.cwiseAbs().maxCoeff()) &&
-          delta * 0.5 >= ptc_.min_pseudo_step) {
+      if (retry && delta * 0.5 >= ptc_.min_pseudo_step) {
+        status.reset();
         delta *= 0.5;
         continue;
       }
-      if (!(smallest_pivot > 1e-13 * shifted_.cwiseAbs().maxCoeff())) {
+      if (status) {
         std::ostringstream os;
-        os << (sigma > 0 ? "delta^-1 I - J" : "delta^-1 I + J") << " is singular at iteration "
-           << monitor.iterations() + 1 << " (delta " << delta << ", smallest LU pivot "
-           << smallest_pivot << ")";
+        os << (sigma > 0 ? "delta^-1 I - J" : "delta^-1 I + J") << " at iteration "
+           << monitor.iterations() + 1 << " (delta " << delta << "): " << failure;
         summary.message = os.str();
-        status = Status::kSingularJacobian;
         break;
       }
-      p_ = lu_.solve(f_);
       if (sigma < 0) p_ = -p_;
       if (system_.budget_spent()) {
         status = spent_status();
@@ -261,7 +325,65 @@ Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vec
 
   x = x_;
   system_.finish(summary, *status, monitor, x, f_, this->options_.stop);
+  if (sparse) linear_.report(summary);
   return summary;
+}
+
+template <int N>
+std::optional<Status> PseudoTransientEngine<N>::dense_shifted_solve(double delta, int sigma,
+                                                                    bool& retry,
+                                                                    std::string& message) {
+  if (sigma > 0) {
+    shifted_ = -jac_;
+  } else {
+    shifted_ = jac_;
+  }
+  shifted_.diagonal().array() += 1.0 / delta;
+  lu_.compute(shifted_);
+  const double smallest_pivot = lu_.matrixLU().diagonal().cwiseAbs().minCoeff();
+  if (!(smallest_pivot > 1e-13 * shifted_.cwiseAbs().maxCoeff())) {
+    std::ostringstream os;
+    os << "singular (smallest LU pivot " << smallest_pivot << ")";
+    message = os.str();
+    retry = true;
+    return Status::kSingularJacobian;
+  }
+  p_ = lu_.solve(f_);
+  return std::nullopt;
+}
+
+template <int N>
+std::optional<Status> PseudoTransientEngine<N>::sparse_jacobian(std::string& message) {
+  if constexpr (N == Dynamic) {
+    return system_.sparse_jacobian(x_, f_, sparse_jac_, message);
+  } else {
+    static_cast<void>(message);
+    return Status::kInvalidInput;  // unreachable: fixed sizes have no sparse path
+  }
+}
+
+template <int N>
+std::optional<Status> PseudoTransientEngine<N>::sparse_shifted_solve(double delta, int sigma,
+                                                                     bool& retry,
+                                                                     std::string& message) {
+  if constexpr (N == Dynamic) {
+    sparse_shifted_ = sparse_jac_;
+    double* values = sparse_shifted_.valuePtr();
+    if (sigma > 0) {
+      for (Index k = 0; k < sparse_shifted_.nonZeros(); ++k) values[k] = -values[k];
+    }
+    for (const Index k : diagonal_) values[k] += 1.0 / delta;
+    const LinearStatus linear =
+        linear_.solve(sparse_shifted_, f_, p_, ptc_.linear_tolerance, ptc_.linear_tolerance);
+    retry = linear == LinearStatus::kSingular ||
+            (linear_.iterative() &&
+             (linear == LinearStatus::kNotConverged || linear == LinearStatus::kBreakdown));
+    return linear_.failure(linear, message);
+  } else {
+    static_cast<void>(delta), static_cast<void>(sigma), static_cast<void>(retry);
+    static_cast<void>(message);
+    return Status::kInvalidInput;  // unreachable: fixed sizes have no sparse path
+  }
 }
 
 // Compiled once in the library for its sizes (nlobs/solvers/library_sizes.hpp).

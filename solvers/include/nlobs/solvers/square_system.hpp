@@ -12,6 +12,7 @@
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
 #include "nlobs/solvers/linear/linear_solver.hpp"
+#include "nlobs/solvers/sparse/sparsity_pattern.hpp"
 #include "nlobs/solvers/stop_monitor.hpp"
 
 namespace nlobs::detail {
@@ -80,15 +81,28 @@ class SquareSystem {
   }
 
   // jac = J_F(x) from the problem's sparse residual Jacobian (run-time size; the caller checked
-  // problem().sparse_residual_jacobian()), f = F(x). As jacobian(): nullopt or the status.
+  // problem().sparse_residual_jacobian()), f = F(x). As jacobian(): nullopt or the status. A J of
+  // another structure than the source's pattern (a user's evaluate) is refused: the engines
+  // address its entries through the pattern.
   std::optional<Status> sparse_jacobian(const Vector<N>& x, const Vector<N>& f, SparseJacobian& jac,
                                         std::string& message) {
-    const SparseJacobianSource& sparse = *problem_->sparse_residual_jacobian();
+    SparseJacobianState& state = *problem_->sparse_jacobian_state();
+    const SparseJacobianSource& sparse = *state.get();
     if (evaluations_ + sparse.evaluations_per_jacobian > max_evaluations_) {
       return Status::kMaxEvaluations;
     }
-    evaluations_ += sparse.evaluate(x, f, jac);
+    evaluations_ += state.evaluate(x, f, jac);
     ++jacobians_;
+    const SparsityPattern& pattern = *sparse.pattern;
+    if (jac.rows() != pattern.rows || jac.cols() != pattern.cols || !jac.isCompressed() ||
+        jac.nonZeros() != pattern.nonzeros()) {
+      throw InvalidInput(
+          "the sparse Jacobian's evaluate returned a " + std::to_string(jac.rows()) + "x" +
+          std::to_string(jac.cols()) + " matrix with " + std::to_string(jac.nonZeros()) +
+          " stored entries" + (jac.isCompressed() ? "" : " (not compressed)") +
+          ", not the structure of its pattern (" + std::to_string(pattern.rows) + "x" +
+          std::to_string(pattern.cols) + ", " + std::to_string(pattern.nonzeros()) + " entries)");
+    }
     if (detail::first_non_finite_row(jac) >= 0) {
       message = "the Jacobian of F is not finite";
       return Status::kNonFinite;

@@ -2,8 +2,10 @@
 // How a problem carries a sparse Jacobian of F at run-time size, for the engines' sparse path
 // (docs/solvers.md, "Sparse Jacobians"). Light on purpose: problem.hpp includes it, and Eigen's
 // sparse module is only declared here (nlobs/solvers/sparse/sparse_jacobian.hpp defines it).
+#include <exception>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <utility>
@@ -45,6 +47,8 @@ inline void check_sparse_source(const char* owner, const SparseJacobianSource& s
 // A problem's sparse Jacobian, shared by the problem's copies: declared (a source from the
 // start), or to be detected at the first point an engine asks with (RootProblem::with_autodiff at
 // run-time size). Detection runs once; its answer — a source or none — and the reason are kept.
+// Copies may be solved from several threads: detection and each evaluation of J (whose workspace
+// the copies share) take a lock, so the copies' Jacobian evaluations take turns.
 class SparseJacobianState {
  public:
   // Finds the source at x, or nullopt with the reason in `note`.
@@ -65,24 +69,44 @@ class SparseJacobianState {
     return state;
   }
 
-  // The source, detecting it at x first if that is still to do; nullptr for none. When F throws
-  // while it is traced, the exception passes and detection stays to do.
+  // The source, detecting it at x first if that is still to do; nullptr for none. An F that
+  // throws (a std::exception) while it is traced declines detection, the exception's text in the
+  // note: the engines then take the dense path, as before detection existed.
   const SparseJacobianSource* resolve(const Vector<Dynamic>& x) {
+    const std::lock_guard<std::mutex> lock(mutex_);
     if (detect_) {
       std::string note;
-      source_ = detect_(x, note);
+      try {
+        source_ = detect_(x, note);
+      } catch (const std::exception& e) {
+        source_.reset();
+        note = std::string("not detected: F threw while traced: ") + e.what();
+      }
       note_ = std::move(note);
       detect_ = nullptr;
     }
-    return get();
+    return source_ ? &*source_ : nullptr;
   }
-  const SparseJacobianSource* get() const { return source_ ? &*source_ : nullptr; }
+  const SparseJacobianSource* get() const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return source_ ? &*source_ : nullptr;
+  }
+  // J = ∂F(x) by the source (resolved: get() != nullptr), f = F(x); returns the evaluations of F
+  // it made. Under the lock: the source's workspace is the copies' common one.
+  int evaluate(const Vector<Dynamic>& x, const Vector<Dynamic>& f, SparseJacobian& jac) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return source_->evaluate(x, f, jac);
+  }
   // Declared by the user, not found by detection (an engine that cannot take the sparse path
   // refuses the first and falls back to the dense Jacobian for the second).
   bool declared() const { return !by_detection_; }
-  const std::string& note() const { return note_; }
+  std::string note() const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return note_;
+  }
 
  private:
+  mutable std::mutex mutex_;
   std::optional<SparseJacobianSource> source_;
   Detector detect_;
   std::string note_;

@@ -22,7 +22,7 @@ namespace nlobs {
 template <typename F>
 RootProblem<> sparse_autodiff_problem(F f, const SparsityPattern& pattern) {
   SparseJacobianSource source = detail::autodiff_jacobian_source(f, pattern);
-  return RootProblem<>::with_autodiff(std::move(f), pattern.cols, pattern.rows)
+  return RootProblem<>::with_dense_autodiff(std::move(f), pattern.cols, pattern.rows)
       .with_sparse_jacobian(std::move(source));
 }
 

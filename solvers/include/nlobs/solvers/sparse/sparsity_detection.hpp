@@ -10,7 +10,8 @@
 //   most kBudgetPerUnknown · n indices in all   (dense rows: the dense path is cheaper, and the
 //                                               trace stops early rather than cost O(n²)).
 // Otherwise the engines use the dense AD Jacobian, as without detection; the problem's
-// sparse_jacobian_note() says which rule decided. with_dense_jacobian() switches detection off;
+// sparse_jacobian_note() says which rule decided (or that F threw while traced: declined too).
+// with_dense_jacobian() switches detection off;
 // sparse_autodiff_problem(f, pattern) declares a pattern instead (for F with branches).
 #include <algorithm>
 #include <optional>
