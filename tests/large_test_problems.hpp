@@ -1,7 +1,7 @@
 #pragma once
 // Two large sparse problems nlobs does not ship, written generic in the scalar type as a user
 // writes for with_autodiff, shared by the sparse tests and bench/ (until `nlobs suite large`
-// holds them):
+// holds them), and the stop options the tests solve them with:
 //   Broyden's tridiagonal function  F_i = (3 − 2x_i) x_i − x_{i−1} − 2x_{i+1} + 1,
 //                                   x_0 = x_{n+1} = 0 (the returning call shape)
 //   2-D Bratu (PETSc's SNES ex5)    (4u − Σ neighbours)/h² − λ e^u on an s×s interior grid,
@@ -9,6 +9,7 @@
 #include <cmath>
 #include <type_traits>
 
+#include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/types.hpp"
 
 namespace nlobs::test {
@@ -45,6 +46,14 @@ inline auto bratu(Index s, double lambda = 6.0) {
       }
     }
   };
+}
+
+// ‖F‖∞ ≤ residual_tolerance within max_iterations, the other stop rules at their defaults.
+inline SolverOptions residual_stop(double residual_tolerance = 1e-10, int max_iterations = 100) {
+  SolverOptions o;
+  o.stop.residual_tolerance = residual_tolerance;
+  o.stop.max_iterations = max_iterations;
+  return o;
 }
 
 }  // namespace nlobs::test

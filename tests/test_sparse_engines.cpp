@@ -21,15 +21,8 @@
 namespace nlobs {
 namespace {
 
-SolverOptions tight() {
-  SolverOptions o;
-  o.stop.residual_tolerance = 1e-9;
-  o.stop.max_iterations = 200;
-  return o;
-}
-
 Summary flow(const RootProblem<>& problem, Vector<Dynamic>& x, PseudoTransientOptions ptc = {}) {
-  PseudoTransientEngine<> engine(ptc, tight());
+  PseudoTransientEngine<> engine(ptc, test::residual_stop(1e-9, 200));
   return engine.solve(to_fixed_point(problem), x);
 }
 
@@ -140,7 +133,7 @@ TEST(SparsePseudoTransient, RefusesWhatTheSparsePathCannotTake) {
   const Vector<Dynamic> x0 = Vector<Dynamic>::Zero(n);
   // A scaling on a declared sparse Jacobian.
   const auto declared = sparse_autodiff_problem(test::broyden_tridiagonal(), x0);
-  PseudoTransientEngine<> scaled({}, tight());
+  PseudoTransientEngine<> scaled({}, test::residual_stop(1e-9, 200));
   scaled.set_scaling({.u_scale = Vector<Dynamic>::Constant(n, 2.0)});
   Vector<Dynamic> x = x0;
   EXPECT_THROW(scaled.solve(to_fixed_point(declared), x), InvalidInput);
@@ -153,7 +146,7 @@ TEST(SparsePseudoTransient, RefusesWhatTheSparsePathCannotTake) {
   const auto user = RootProblem<>::from_map(f, n, n).with_sparse_jacobian(
       {pattern, [](const Vector<Dynamic>&, const Vector<Dynamic>&, SparseJacobian&) { return 0; },
        0});
-  PseudoTransientEngine<> engine({}, tight());
+  PseudoTransientEngine<> engine({}, test::residual_stop(1e-9, 200));
   EXPECT_EQ(test::message_of([&] { engine.solve(to_fixed_point(user), x); }),
             "pseudo-transient: the sparse Jacobian's pattern lacks the diagonal entry (0, 0), "
             "where delta^-1 I is added (the problems of sparse_problem.hpp have every one)");
@@ -182,15 +175,19 @@ TEST(SparsePseudoTransient, RefusesWhatTheSparsePathCannotTake) {
 TEST(SparsePseudoTransient, IsReachableByEngineSpec) {
   const Index s = 12, n = s * s;
   auto& registry = EngineRegistry<Dynamic>::global();
-  auto engine = registry.create("pseudo-transient:linear=gmres,preconditioner=ilu0", tight());
+  auto engine = registry.create("pseudo-transient:linear=gmres,preconditioner=ilu0",
+                                test::residual_stop(1e-9, 200));
   Vector<Dynamic> x = Vector<Dynamic>::Zero(n);
   const Summary r =
       engine->solve(to_fixed_point(RootProblem<>::with_autodiff(test::bratu(s), n, n)), x);
   ASSERT_EQ(r.status, Status::kConverged) << r.message;
   EXPECT_EQ(r.linear_solver, "gmres");
   EXPECT_GT(r.linear_iterations, 0);
-  EXPECT_THROW(registry.create("pseudo-transient:preconditioner=ilu0", tight()), InvalidInput);
-  EXPECT_THROW(registry.create("pseudo-transient:linear=nonsense", tight()), InvalidInput);
+  EXPECT_THROW(
+      registry.create("pseudo-transient:preconditioner=ilu0", test::residual_stop(1e-9, 200)),
+      InvalidInput);
+  EXPECT_THROW(registry.create("pseudo-transient:linear=nonsense", test::residual_stop(1e-9, 200)),
+               InvalidInput);
 }
 
 TEST(SparseAuto, RunsOnlyTheStagesWithASparsePathOnALargeSparseProblem) {
@@ -200,7 +197,8 @@ TEST(SparseAuto, RunsOnlyTheStagesWithASparsePathOnALargeSparseProblem) {
   const auto problem = RootProblem<>::with_autodiff(test::broyden_tridiagonal(), n, n);
   // The default order: newton solves it on the sparse path; the stages after it are not reached.
   Vector<Dynamic> x = x0;
-  const Summary a = registry.create("auto", tight())->solve(to_fixed_point(problem), x);
+  const Summary a =
+      registry.create("auto", test::residual_stop(1e-9, 200))->solve(to_fixed_point(problem), x);
   ASSERT_EQ(a.status, Status::kConverged) << a.message;
   EXPECT_EQ(a.stage, "newton");
   EXPECT_EQ(a.linear_solver, "band-lu");
@@ -208,16 +206,18 @@ TEST(SparseAuto, RunsOnlyTheStagesWithASparsePathOnALargeSparseProblem) {
 
   // dogleg first: not run (a dense 3000×3000 J), said so; pseudo-transient solves it.
   x = x0;
-  const Summary b =
-      registry.create("auto:order=dogleg/levenberg-marquardt/pseudo-transient", tight())
-          ->solve(to_fixed_point(problem), x);
+  const Summary b = registry
+                        .create("auto:order=dogleg/levenberg-marquardt/pseudo-transient",
+                                test::residual_stop(1e-9, 200))
+                        ->solve(to_fixed_point(problem), x);
   ASSERT_EQ(b.status, Status::kConverged) << b.message;
   EXPECT_EQ(b.stage, "pseudo-transient");
   EXPECT_EQ(b.linear_solver, "band-lu");
   EXPECT_EQ(b.message,
             "after dogleg, levenberg-marquardt not run (no sparse path, and n = 3000 > "
             "dense_stage_limit 1000)");
-  EXPECT_THROW(registry.create("auto:dense_limit=-1", tight()), InvalidInput);
+  EXPECT_THROW(registry.create("auto:dense_limit=-1", test::residual_stop(1e-9, 200)),
+               InvalidInput);
 }
 
 TEST(SparseAuto, RunsDenseStagesBelowTheLimitWithoutOneOrWhenNoneHasASparsePath) {
@@ -229,14 +229,17 @@ TEST(SparseAuto, RunsDenseStagesBelowTheLimitWithoutOneOrWhenNoneHasASparsePath)
        {"auto:order=dogleg", "auto:order=dogleg,dense_limit=0",
         "auto:order=dogleg,dense_limit=100" /* no stage with a sparse path: all run */}) {
     Vector<Dynamic> x = x0;
-    const Summary r = registry.create(spec, tight())->solve(to_fixed_point(problem), x);
+    const Summary r =
+        registry.create(spec, test::residual_stop(1e-9, 200))->solve(to_fixed_point(problem), x);
     ASSERT_EQ(r.status, Status::kConverged) << spec << ": " << r.message;
     EXPECT_EQ(r.stage, "dogleg") << spec;
     EXPECT_TRUE(r.linear_solver.empty()) << "dogleg's dense J";
     EXPECT_EQ(r.message, "") << spec;
   }
   Vector<Dynamic> x = x0;
-  const Summary r = registry.create("auto:order=dogleg/pseudo-transient,dense_limit=100", tight())
+  const Summary r = registry
+                        .create("auto:order=dogleg/pseudo-transient,dense_limit=100",
+                                test::residual_stop(1e-9, 200))
                         ->solve(to_fixed_point(problem), x);
   ASSERT_EQ(r.status, Status::kConverged) << r.message;
   EXPECT_EQ(r.stage, "pseudo-transient");

@@ -23,17 +23,10 @@ namespace {
 using test::bratu;
 using test::broyden_tridiagonal;
 
-SolverOptions tight() {
-  SolverOptions o;
-  o.stop.residual_tolerance = 1e-10;
-  o.stop.max_iterations = 100;
-  return o;
-}
-
 Summary solve_with(const std::string& linear, const RootProblem<>& problem, Vector<Dynamic>& x,
                    bool line_search = true) {
   NewtonEngine<> newton(NewtonOptions{.line_search = line_search, .linear_solver = linear},
-                        tight());
+                        test::residual_stop());
   return newton.solve(to_fixed_point(problem), x);
 }
 
@@ -138,7 +131,7 @@ TEST(SparseNewton, KeepsABindingBoxAsTheDensePathDoes) {
     std::vector<Vector<Dynamic>> answers;
     for (const std::string linear : {"dense", "klu", "gmres:preconditioner=ilu0"}) {
       NewtonEngine<> newton(NewtonOptions{.line_search = line_search, .linear_solver = linear},
-                            tight());
+                            test::residual_stop());
       newton.set_bounds({Vector<Dynamic>::Constant(n, -2.0), Vector<Dynamic>::Constant(n, upper)});
       Vector<Dynamic> x = x0;
       summaries.push_back(newton.solve(to_fixed_point(problem), x));
@@ -164,7 +157,8 @@ TEST(SparseNewton, RefusesWhatWouldTakeTheDensePathAtLargeSize) {
   NewtonEngine<> scaled(NewtonOptions{.line_search = true});
   scaled.set_scaling({.u_scale = Vector<Dynamic>::Constant(50, 2.0)});
   EXPECT_THROW(scaled.solve(problem, x), InvalidInput);
-  NewtonEngine<> dense(NewtonOptions{.trust_region = true, .linear_solver = "dense"}, tight());
+  NewtonEngine<> dense(NewtonOptions{.trust_region = true, .linear_solver = "dense"},
+                       test::residual_stop());
   EXPECT_EQ(dense.solve(problem, x).status, Status::kConverged);
 }
 
@@ -177,7 +171,8 @@ TEST(SparseNewton, UsesColouredDifferences) {
   };
   const RootProblem<> problem =
       sparse_difference_problem(on_doubles, SparsityPattern::band(n, 1, 1));
-  NewtonEngine<> newton(NewtonOptions{.line_search = true, .linear_solver = "klu"}, tight());
+  NewtonEngine<> newton(NewtonOptions{.line_search = true, .linear_solver = "klu"},
+                        test::residual_stop());
   Vector<Dynamic> x = x0;
   const Summary s = newton.solve(to_fixed_point(problem), x);
   ASSERT_EQ(s.status, Status::kConverged) << s.message;
@@ -210,7 +205,7 @@ TEST(SparseNewton, IsReachableByEngineSpecAndRefusesBadSpecs) {
   const Vector<Dynamic> x0 = Vector<Dynamic>::Constant(50, -1.0);
   const RootProblem<> problem = sparse_autodiff_problem(broyden_tridiagonal(), x0);
   auto engine = EngineRegistry<Dynamic>::global().create(
-      "newton:linesearch=1,linear=bicgstab,preconditioner=jacobi", tight());
+      "newton:linesearch=1,linear=bicgstab,preconditioner=jacobi", test::residual_stop());
   Vector<Dynamic> x = x0;
   const Summary s = engine->solve(to_fixed_point(problem), x);
   ASSERT_EQ(s.status, Status::kConverged) << s.message;

@@ -23,15 +23,8 @@ namespace {
 
 using test::broyden_tridiagonal;
 
-SolverOptions tight() {
-  SolverOptions o;
-  o.stop.residual_tolerance = 1e-10;
-  o.stop.max_iterations = 100;
-  return o;
-}
-
 Summary newton(const RootProblem<>& problem, Vector<Dynamic>& x, NewtonOptions options = {}) {
-  NewtonEngine<> engine(options, tight());
+  NewtonEngine<> engine(options, test::residual_stop());
   return engine.solve(to_fixed_point(problem), x);
 }
 
@@ -65,7 +58,7 @@ TEST(SparsityDetection, GivesAnUnchangedWithAutodiffProblemTheSparsePath) {
   EXPECT_LE((detected - declared).lpNorm<Eigen::Infinity>(), 1e-14);
 
   // And by name, as a user of the registry or the CLI reaches it.
-  auto by_name = EngineRegistry<Dynamic>::global().create("newton", tight());
+  auto by_name = EngineRegistry<Dynamic>::global().create("newton", test::residual_stop());
   Vector<Dynamic> x = x0;
   const Summary r =
       by_name->solve(to_fixed_point(RootProblem<>::with_autodiff(broyden_tridiagonal(), n, n)), x);
