@@ -26,6 +26,13 @@ Summary flow(const RootProblem<>& problem, Vector<Dynamic>& x, PseudoTransientOp
   return engine.solve(to_fixed_point(problem), x);
 }
 
+// The engine a spec names, from the process-wide registry, on problem from x.
+Summary by_spec(const std::string& spec, const RootProblem<>& problem, Vector<Dynamic>& x) {
+  return EngineRegistry<Dynamic>::global()
+      .create(spec, test::residual_stop(1e-9, 200))
+      ->solve(to_fixed_point(problem), x);
+}
+
 TEST(SparsePseudoTransient, FollowsTheDensePathOnBratuWithDirectAndKrylovSolvers) {
   const Index s = 20, n = s * s;  // bandwidth 20 > 16: auto is klu
   const Vector<Dynamic> x0 = Vector<Dynamic>::Zero(n);
@@ -197,8 +204,7 @@ TEST(SparseAuto, RunsOnlyTheStagesWithASparsePathOnALargeSparseProblem) {
   const auto problem = RootProblem<>::with_autodiff(test::broyden_tridiagonal(), n, n);
   // The default order: newton solves it on the sparse path; the stages after it are not reached.
   Vector<Dynamic> x = x0;
-  const Summary a =
-      registry.create("auto", test::residual_stop(1e-9, 200))->solve(to_fixed_point(problem), x);
+  const Summary a = by_spec("auto", problem, x);
   ASSERT_EQ(a.status, Status::kConverged) << a.message;
   EXPECT_EQ(a.stage, "newton");
   EXPECT_EQ(a.linear_solver, "band-lu");
@@ -206,10 +212,7 @@ TEST(SparseAuto, RunsOnlyTheStagesWithASparsePathOnALargeSparseProblem) {
 
   // dogleg first: not run (a dense 3000×3000 J), said so; pseudo-transient solves it.
   x = x0;
-  const Summary b = registry
-                        .create("auto:order=dogleg/levenberg-marquardt/pseudo-transient",
-                                test::residual_stop(1e-9, 200))
-                        ->solve(to_fixed_point(problem), x);
+  const Summary b = by_spec("auto:order=dogleg/levenberg-marquardt/pseudo-transient", problem, x);
   ASSERT_EQ(b.status, Status::kConverged) << b.message;
   EXPECT_EQ(b.stage, "pseudo-transient");
   EXPECT_EQ(b.linear_solver, "band-lu");
@@ -221,7 +224,6 @@ TEST(SparseAuto, RunsOnlyTheStagesWithASparsePathOnALargeSparseProblem) {
 }
 
 TEST(SparseAuto, RunsDenseStagesBelowTheLimitWithoutOneOrWhenNoneHasASparsePath) {
-  auto& registry = EngineRegistry<Dynamic>::global();
   const Index n = 300;  // detected (≥ 100), below the default dense_stage_limit 1000
   const Vector<Dynamic> x0 = Vector<Dynamic>::Constant(n, -1.0);
   const auto problem = RootProblem<>::with_autodiff(test::broyden_tridiagonal(), n, n);
@@ -229,18 +231,14 @@ TEST(SparseAuto, RunsDenseStagesBelowTheLimitWithoutOneOrWhenNoneHasASparsePath)
        {"auto:order=dogleg", "auto:order=dogleg,dense_limit=0",
         "auto:order=dogleg,dense_limit=100" /* no stage with a sparse path: all run */}) {
     Vector<Dynamic> x = x0;
-    const Summary r =
-        registry.create(spec, test::residual_stop(1e-9, 200))->solve(to_fixed_point(problem), x);
+    const Summary r = by_spec(spec, problem, x);
     ASSERT_EQ(r.status, Status::kConverged) << spec << ": " << r.message;
     EXPECT_EQ(r.stage, "dogleg") << spec;
     EXPECT_TRUE(r.linear_solver.empty()) << "dogleg's dense J";
     EXPECT_EQ(r.message, "") << spec;
   }
   Vector<Dynamic> x = x0;
-  const Summary r = registry
-                        .create("auto:order=dogleg/pseudo-transient,dense_limit=100",
-                                test::residual_stop(1e-9, 200))
-                        ->solve(to_fixed_point(problem), x);
+  const Summary r = by_spec("auto:order=dogleg/pseudo-transient,dense_limit=100", problem, x);
   ASSERT_EQ(r.status, Status::kConverged) << r.message;
   EXPECT_EQ(r.stage, "pseudo-transient");
   EXPECT_EQ(r.message,

@@ -6,6 +6,7 @@
 // throws while traced.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -230,6 +231,32 @@ TEST(SparsityDetection, DeclinesWhereFThrowsWhileTracedAndLeavesNoCountBehind) {
   EXPECT_EQ(detail::SparsityTracerBranches, 0);
   EXPECT_FALSE(detail::SparsityTracerLimits.exceeded);
   EXPECT_EQ(detail::SparsityTracerLimits.largest_set, detail::SparsityTraceLimits{}.largest_set);
+}
+
+TEST(SparsityDetection, ReachesAHundredThousandUnknownsFromUnchangedCode) {
+  // A dense path here would need an 80 GB Jacobian: only the detected sparse path finishes.
+  const Index n = 100000;
+  const auto problem = RootProblem<>::with_autodiff(broyden_tridiagonal(), n, n);
+  Vector<Dynamic> x = Vector<Dynamic>::Constant(n, -1.0);
+  const Summary s = newton(problem, x, NewtonOptions{.line_search = true});
+  ASSERT_EQ(s.status, Status::kConverged) << s.message;
+  EXPECT_EQ(s.linear_solver, "band-lu");
+  EXPECT_LE(s.residual_norm, 1e-10);
+  EXPECT_EQ(problem.sparse_jacobian_note(), "detected: 299998 entries");
+}
+
+TEST(SparsityDetection, DetectsNothingFromANonFiniteStart) {
+  // x0 is refused before detection: the problem keeps detection to do for a good start.
+  const Index n = 200;
+  const auto problem = RootProblem<>::with_autodiff(broyden_tridiagonal(), n, n);
+  Vector<Dynamic> x = Vector<Dynamic>::Constant(n, -1.0);
+  x[7] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(newton(problem, x), InvalidInput);
+  EXPECT_TRUE(starts_with(problem.sparse_jacobian_note(), "not detected yet"))
+      << problem.sparse_jacobian_note();
+  x.setConstant(-1.0);
+  ASSERT_EQ(newton(problem, x).status, Status::kConverged);
+  EXPECT_TRUE(starts_with(problem.sparse_jacobian_note(), "detected"));
 }
 
 TEST(SparsityDetection, RefusesAPointOfAnotherSize) {
