@@ -58,7 +58,7 @@ void print_list(const std::string& what, std::ostream& out) {
     for (const auto& s : builtin_scenarios()) out << "  " << s << '\n';
   }
   if (all || what == "problems") {
-    out << "problem sets (nlobs suite SET; nlobs solve SET/NAME[:n=K]):\n";
+    out << "problem sets (nlobs suite SET[:n=K]; nlobs solve SET/NAME[:n=K]):\n";
     const auto& sets = problem_set_registry();
     for (const ProblemSetEntry* set : sets.entries()) {
       out << "  " << set->name << " — " << set->description
@@ -66,6 +66,7 @@ void print_list(const std::string& what, std::ostream& out) {
           << " (D_f = diag(f_scale) of a scaled problem, else the identity)";
       const std::string source = sets.source(set->name);
       if (source != "built-in") out << "; from " << source;
+      if (set->problems_of_size) out << "; any size (" << set->name << ":n=K)";
       out << '\n';
       try {
         for (const TestProblem& p : build_problem_set(*set)) {

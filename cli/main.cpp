@@ -109,8 +109,8 @@ nlobs::cli::SuiteArguments::Progress progress_mode() {
 // The options `nlobs suite` and `nlobs solve SET/NAME` share.
 void add_suite_options(CLI::App* app, nlobs::cli::SuiteArguments& a) {
   app->add_option("--solvers,--engines", a.solvers,
-                  "Comma-separated engine specs and references (default: the suite's list; "
-                  "nlobs list engines)");
+                  "Comma-separated engine specs and references (default: the set's own list, "
+                  "else the suite's; nlobs list engines)");
   app->add_option("--starts", a.starts, "Comma-separated start labels (default: all)");
   app->add_option("--threshold", a.threshold,
                   "Solved when |D_f F|2 <= this at the returned point (D_f: the problem's "
@@ -179,7 +179,8 @@ int run_command_line(int argc, char** argv) {
   suite
       ->add_option("set", suite_set,
                    "Problem set: " + nlobs::problem_set_registry().valid_list() +
-                       ", or a plugin's (nlobs list problems)")
+                       ", or a plugin's (nlobs list problems); SET:n=K for a set of "
+                       "run-time size (large:n=100000)")
       ->required();
   add_suite_options(suite, suite_args);
 

@@ -61,17 +61,21 @@ void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArg
   options.time_limit_s = args.time_limit_s;
   options.starts =
       args.starts.empty() ? std::vector<std::string>() : reference::split_spec_list(args.starts);
+  // --solvers, or none: each set's own default list (ProblemSetEntry::default_solvers), else the
+  // suite's.
   std::vector<std::string> solvers;
   // A solver or problem named twice runs once (a second row would only repeat the first), said
   // on `err`.
-  for (std::string& spec : args.solvers.empty() ? reference::default_suite_solvers()
-                                                : reference::split_spec_list(args.solvers)) {
+  for (std::string& spec : reference::split_spec_list(args.solvers)) {
     if (std::find(solvers.begin(), solvers.end(), spec) != solvers.end()) {
       err << "nlobs " << command << ": solver '" << nlobs::printable(spec, 60)
           << "' is listed more than once; it runs once\n";
     } else {
       solvers.push_back(std::move(spec));
     }
+  }
+  if (!args.solvers.empty() && solvers.empty()) {
+    throw std::invalid_argument("nlobs " + command + " --solvers: no solver listed");
   }
   // Every selection is built and checked before the first solve.
   std::vector<ProblemSelection> selections;
@@ -132,6 +136,7 @@ void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArg
   for (const ProblemSelection& s : selections) {
     total += reference::count_suite_pairs(s.problems, options);
   }
+  const std::vector<std::string> default_solvers = reference::default_suite_solvers();
   std::vector<reference::SuiteRow> rows;
   using Clock = std::chrono::steady_clock;
   const Clock::time_point started = Clock::now();
@@ -162,7 +167,11 @@ void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArg
             << std::flush;
       };
     }
-    const auto part = reference::run_suite(*s.set, s.problems, solvers, o);
+    const std::vector<std::string>& set_solvers = !solvers.empty() ? solvers
+                                                  : s.set->default_solvers.empty()
+                                                      ? default_solvers
+                                                      : s.set->default_solvers;
+    const auto part = reference::run_suite(*s.set, s.problems, set_solvers, o);
     before += reference::count_suite_pairs(s.problems, options);
     rows.insert(rows.end(), part.begin(), part.end());
   }

@@ -9,8 +9,10 @@
 namespace nlobs::cli {
 
 struct SuiteArguments {
-  std::string solvers{};  // comma list of engine specs and references; empty: the default list
-  std::string starts{};   // comma list of start labels; empty: every start
+  // Comma list of engine specs and references; empty: each set's default_solvers, else the
+  // suite's default list.
+  std::string solvers{};
+  std::string starts{};  // comma list of start labels; empty: every start
   double threshold = std::numeric_limits<double>::quiet_NaN();  // NaN: each set's own
   long evaluations_per_dimension = 1000;
   bool json = false;
@@ -26,8 +28,8 @@ struct SuiteArguments {
   double progress_interval_s = 10.0;
 };
 
-// Runs every selector ("SET", "SET/NAME", "SET/NAME:n=K") in turn and prints the table (or
-// the JSON array) to `out`; `command` ("suite" or "solve") names the command in messages.
+// Runs every selector ("SET", "SET:n=K", "SET/NAME", "SET/NAME:n=K") in turn and prints the table
+// (or the JSON array) to `out`; `command` ("suite" or "solve") names the command in messages.
 // Throws std::invalid_argument (an unknown set, problem, solver or start, a bad threshold) before
 // anything runs.
 void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArguments& args,

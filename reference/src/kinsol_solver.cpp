@@ -4,13 +4,20 @@
 #include <kinsol/kinsol_ls.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_band.h>
 #include <sunlinsol/sunlinsol_dense.h>
+#include <sunlinsol/sunlinsol_klu.h>
+#include <sunlinsol/sunlinsol_spgmr.h>
+#include <sunmatrix/sunmatrix_band.h>
 #include <sunmatrix/sunmatrix_dense.h>
+#include <sunmatrix/sunmatrix_sparse.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <new>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -22,15 +29,16 @@ struct KinsolSolver::Impl {
   KinsolOptions options;
   Function function;
   Jacobian jacobian;
+  KinsolSparseJacobian sparse;
   SUNContext context = nullptr;
   void* kinsol = nullptr;
   N_Vector u = nullptr, u_scale = nullptr, f_scale = nullptr;
   SUNMatrix matrix = nullptr;
   SUNLinearSolver linear_solver = nullptr;
-  Eigen::VectorXd x_in, f_out;
-  Eigen::MatrixXd jac_out;
-  long calls = 0;  // evaluations of F (or G), whoever asked
-  long cap = 0;    // the evaluations KINSOL may make (0: any number)
+  Eigen::VectorXd x_in, f_out, f_in;
+  Eigen::MatrixXd jac_out;  // kDense with a Jacobian only (n² doubles)
+  long calls = 0;           // evaluations of F (or G), whoever asked
+  long cap = 0;             // the evaluations KINSOL may make (0: any number)
   bool refused = false;
 
   static int residual(N_Vector u_vec, N_Vector f_vec, void* data) {
@@ -62,15 +70,156 @@ struct KinsolSolver::Impl {
     Eigen::Map<Eigen::MatrixXd>(SUNDenseMatrix_Data(jac), self->n, self->n) = self->jac_out;
     return 0;
   }
+  static int sparse_jacobian(N_Vector u_vec, N_Vector f_vec, SUNMatrix jac, void* data, N_Vector,
+                             N_Vector) {
+    auto* self = static_cast<Impl*>(data);
+    self->x_in = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(u_vec), self->n);
+    self->f_in = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(f_vec), self->n);
+    // KINSOL zeroes the matrix before each call, its index arrays included: the pattern is
+    // written every time.
+    std::copy(self->sparse.row_starts.begin(), self->sparse.row_starts.end(),
+              SUNSparseMatrix_IndexPointers(jac));
+    std::copy(self->sparse.columns.begin(), self->sparse.columns.end(),
+              SUNSparseMatrix_IndexValues(jac));
+    try {
+      self->sparse.values(self->x_in, self->f_in, SUNSparseMatrix_Data(jac));
+    } catch (...) {
+      return -1;
+    }
+    return 0;
+  }
   static void silent(int, const char*, const char*, char*, void*) {}
+
+  // Frees what the constructor made, also when it threw half-way (a failed allocation).
+  ~Impl() {
+    if (kinsol) KINFree(&kinsol);
+    if (linear_solver) SUNLinSolFree(linear_solver);
+    if (matrix) SUNMatDestroy(matrix);
+    for (N_Vector v : {u, u_scale, f_scale}) {
+      if (v) N_VDestroy(v);
+    }
+    if (context) SUNContext_Free(&context);
+  }
+
+  // The linear solver and its matrix for options.linear_solver (Newton).
+  void attach_linear_solver() {
+    switch (options.linear_solver) {
+      case KinsolLinearSolver::kDense:
+        matrix = SUNDenseMatrix(n, n, context);
+        break;
+      case KinsolLinearSolver::kBand:
+        // SUNDIALS 6: the band matrix keeps room for the LU's fill itself.
+        matrix = SUNBandMatrix(n, options.upper_bandwidth, options.lower_bandwidth, context);
+        break;
+      case KinsolLinearSolver::kKlu:
+        matrix = SUNSparseMatrix(n, n, static_cast<sunindextype>(sparse.columns.size()), CSR_MAT,
+                                 context);
+        break;
+      case KinsolLinearSolver::kSpgmr:
+        break;
+    }
+    // A matrix SUNDIALS could not allocate is null, and its linear solver would dereference it.
+    if (options.linear_solver != KinsolLinearSolver::kSpgmr && matrix == nullptr) {
+      throw std::bad_alloc();
+    }
+    switch (options.linear_solver) {
+      case KinsolLinearSolver::kDense:
+        linear_solver = SUNLinSol_Dense(u, matrix, context);
+        break;
+      case KinsolLinearSolver::kBand:
+        linear_solver = SUNLinSol_Band(u, matrix, context);
+        break;
+      case KinsolLinearSolver::kKlu:
+        linear_solver = SUNLinSol_KLU(u, matrix, context);
+        break;
+      case KinsolLinearSolver::kSpgmr:
+        linear_solver = SUNLinSol_SPGMR(u, SUN_PREC_NONE, 15, context);
+        if (linear_solver) check(SUNLinSol_SPGMRSetMaxRestarts(linear_solver, 2), "restarts");
+        break;
+    }
+    if (linear_solver == nullptr) {
+      throw std::runtime_error("KINSOL: creating the linear solver " +
+                               KinsolSolver::name(options.linear_solver) + " failed");
+    }
+    check(KINSetLinearSolver(kinsol, linear_solver, matrix), "KINSetLinearSolver");
+    if (options.linear_solver == KinsolLinearSolver::kDense && jacobian) {
+      check(KINSetJacFn(kinsol, &Impl::dense_jacobian), "KINSetJacFn");
+    }
+    if (options.linear_solver == KinsolLinearSolver::kKlu) {
+      check(KINSetJacFn(kinsol, &Impl::sparse_jacobian), "KINSetJacFn");
+    }
+    check(KINSetMaxSetupCalls(kinsol, options.max_setup_calls), "KINSetMaxSetupCalls");
+    check(KINSetMaxSubSetupCalls(kinsol, options.max_sub_setup_calls), "KINSetMaxSubSetupCalls");
+  }
 
   void check(int flag, const char* call) {
     if (flag < 0) throw std::runtime_error(std::string("KINSOL: ") + call + " failed");
   }
 };
 
-KinsolSolver::KinsolSolver(int n, KinsolOptions options, Function function, Jacobian jacobian)
+namespace {
+
+constexpr double kMaxBandEntries = 1.25e8;
+
+// std::invalid_argument for a band or a sparse pattern that does not describe an n×n matrix.
+void check_linear_solver_input(int n, const KinsolOptions& options,
+                               const KinsolSparseJacobian& sparse) {
+  if (options.strategy != KinsolStrategy::kNewtonLineSearch) return;
+  const auto fail = [](const std::string& what) {
+    throw std::invalid_argument("KinsolSolver: " + what);
+  };
+  if (options.max_setup_calls < 0) fail("max_setup_calls must be >= 0");
+  if (options.max_sub_setup_calls < 0) fail("max_sub_setup_calls must be >= 0");
+  if (options.linear_solver == KinsolLinearSolver::kBand) {
+    for (const auto& [width, side] : {std::pair{options.lower_bandwidth, "lower"},
+                                      std::pair{options.upper_bandwidth, "upper"}}) {
+      if (width < 0 || width >= std::max(n, 1)) {
+        fail(std::string(side) + " bandwidth " + std::to_string(width) + " is not in 0 .. " +
+             std::to_string(n - 1));
+      }
+    }
+    // SUNBandMatrix keeps n (2 lower + upper + 1) doubles (room for the LU's fill): a 2-D grid's
+    // band of widths √n takes 24 GB at n = 10⁶.
+    const double entries =
+        static_cast<double>(n) *
+        static_cast<double>(2 * options.lower_bandwidth + options.upper_bandwidth + 1);
+    if (entries > kMaxBandEntries) {
+      std::ostringstream os;
+      os << "a band of widths " << options.lower_bandwidth << " (lower) and "
+         << options.upper_bandwidth << " (upper) at n = " << n << " takes " << entries
+         << " doubles, above the limit of " << kMaxBandEntries
+         << " (1 GB); kinsol:newton-klu stores only the Jacobian's entries";
+      fail(os.str());
+    }
+  }
+  if (options.linear_solver != KinsolLinearSolver::kKlu) return;
+  const auto& starts = sparse.row_starts;
+  const auto& columns = sparse.columns;
+  if (!sparse.values) fail("kinsol:newton-klu needs the sparse Jacobian's values function");
+  if (starts.size() != static_cast<std::size_t>(n) + 1 || starts.front() != 0 ||
+      starts.back() != static_cast<long>(columns.size())) {
+    fail("the sparse Jacobian's row_starts must have n + 1 = " + std::to_string(n + 1) +
+         " entries from 0 to the number of columns listed");
+  }
+  for (int i = 0; i < n; ++i) {
+    if (starts[i + 1] < starts[i] || starts[i + 1] > starts.back()) {
+      fail("row_starts is not non-decreasing at row " + std::to_string(i));
+    }
+    for (long k = starts[i]; k < starts[i + 1]; ++k) {
+      if (columns[k] < 0 || columns[k] >= n || (k > starts[i] && columns[k] <= columns[k - 1])) {
+        fail("row " + std::to_string(i) +
+             " of the sparse Jacobian lists a column outside 0 .. n - 1 or out of order");
+      }
+    }
+  }
+}
+
+}  // namespace
+
+KinsolSolver::KinsolSolver(int n, KinsolOptions options, Function function, Jacobian jacobian,
+                           KinsolSparseJacobian sparse)
     : impl_(std::make_unique<Impl>()) {
+  check_linear_solver_input(n, options, sparse);
   if (!(options.max_newton_step >= 0.0 && std::isfinite(options.max_newton_step))) {
     throw std::invalid_argument("KinsolOptions::max_newton_step must be finite and >= 0");
   }
@@ -97,13 +246,19 @@ KinsolSolver::KinsolSolver(int n, KinsolOptions options, Function function, Jaco
   s.cap = options.max_evaluations > 0 ? options.max_evaluations - 1 : 0;
   s.function = std::move(function);
   s.jacobian = std::move(jacobian);
+  s.sparse = std::move(sparse);
   s.x_in.resize(n);
   s.f_out.resize(n);
-  s.jac_out.resize(n, n);
+  s.f_in.resize(n);  // the callbacks must not allocate outside their try
+  if (options.strategy == KinsolStrategy::kNewtonLineSearch &&
+      options.linear_solver == KinsolLinearSolver::kDense && s.jacobian) {
+    s.jac_out.resize(n, n);
+  }
   s.check(SUNContext_Create(nullptr, &s.context), "SUNContext_Create");
   s.u = N_VNew_Serial(n, s.context);
   s.u_scale = N_VNew_Serial(n, s.context);
   s.f_scale = N_VNew_Serial(n, s.context);
+  if (!s.u || !s.u_scale || !s.f_scale) throw std::bad_alloc();
   for (auto [vector, scale] :
        {std::pair{s.u_scale, &options.u_scale}, std::pair{s.f_scale, &options.f_scale}}) {
     if (scale->size() == n) {
@@ -124,25 +279,10 @@ KinsolSolver::KinsolSolver(int n, KinsolOptions options, Function function, Jaco
   s.check(KINSetFuncNormTol(s.kinsol, options.tolerance), "KINSetFuncNormTol");
   s.check(KINSetScaledStepTol(s.kinsol, options.tolerance), "KINSetScaledStepTol");
   s.check(KINSetNumMaxIters(s.kinsol, options.max_iterations), "KINSetNumMaxIters");
-  if (options.strategy == KinsolStrategy::kNewtonLineSearch) {
-    s.matrix = SUNDenseMatrix(n, n, s.context);
-    s.linear_solver = SUNLinSol_Dense(s.u, s.matrix, s.context);
-    s.check(KINSetLinearSolver(s.kinsol, s.linear_solver, s.matrix), "KINSetLinearSolver");
-    if (s.jacobian) s.check(KINSetJacFn(s.kinsol, &Impl::dense_jacobian), "KINSetJacFn");
-    s.check(KINSetMaxSetupCalls(s.kinsol, 1), "KINSetMaxSetupCalls");  // exact Newton
-  }
+  if (options.strategy == KinsolStrategy::kNewtonLineSearch) s.attach_linear_solver();
 }
 
-KinsolSolver::~KinsolSolver() {
-  Impl& s = *impl_;
-  KINFree(&s.kinsol);
-  if (s.linear_solver) SUNLinSolFree(s.linear_solver);
-  if (s.matrix) SUNMatDestroy(s.matrix);
-  N_VDestroy(s.u);
-  N_VDestroy(s.u_scale);
-  N_VDestroy(s.f_scale);
-  SUNContext_Free(&s.context);
-}
+KinsolSolver::~KinsolSolver() = default;
 
 KinsolResult KinsolSolver::solve(Eigen::VectorXd& x) {
   Impl& s = *impl_;
@@ -161,7 +301,8 @@ KinsolResult KinsolSolver::solve(Eigen::VectorXd& x) {
   r.flag_name = name ? name : "?";
   free(name);
   KINGetNumNonlinSolvIters(s.kinsol, &r.iterations);
-  if (s.linear_solver) KINGetNumJacEvals(s.kinsol, &r.jacobian_evaluations);
+  if (s.matrix) KINGetNumJacEvals(s.kinsol, &r.jacobian_evaluations);
+  if (s.linear_solver) KINGetNumLinIters(s.kinsol, &r.linear_iterations);
   x = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(s.u), s.n);
   // Judge the returned point ourselves (one more evaluation, counted).
   r.residual = std::numeric_limits<double>::infinity();
@@ -213,11 +354,33 @@ std::string KinsolResult::status() const {
 }
 
 std::optional<KinsolStrategy> KinsolSolver::strategy(const std::string& name) {
-  for (KinsolStrategy s : {KinsolStrategy::kFixedPoint, KinsolStrategy::kFixedPointAnderson,
-                           KinsolStrategy::kNewtonLineSearch}) {
+  for (KinsolStrategy s : {KinsolStrategy::kFixedPoint, KinsolStrategy::kFixedPointAnderson}) {
     if (KinsolSolver::name(s) == name) return s;
   }
+  if (linear_solver(name)) return KinsolStrategy::kNewtonLineSearch;
   return std::nullopt;
+}
+
+std::optional<KinsolLinearSolver> KinsolSolver::linear_solver(const std::string& name) {
+  for (KinsolLinearSolver l : {KinsolLinearSolver::kDense, KinsolLinearSolver::kBand,
+                               KinsolLinearSolver::kKlu, KinsolLinearSolver::kSpgmr}) {
+    if (KinsolSolver::name(l) == name) return l;
+  }
+  return std::nullopt;
+}
+
+std::string KinsolSolver::name(KinsolLinearSolver linear_solver) {
+  switch (linear_solver) {
+    case KinsolLinearSolver::kDense:
+      return "kinsol:newton";
+    case KinsolLinearSolver::kBand:
+      return "kinsol:newton-band";
+    case KinsolLinearSolver::kKlu:
+      return "kinsol:newton-klu";
+    case KinsolLinearSolver::kSpgmr:
+      return "kinsol:newton-spgmr";
+  }
+  return "kinsol:?";
 }
 
 std::string KinsolSolver::name(KinsolStrategy strategy) {

@@ -9,6 +9,8 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
 
 #include "nlobs/common/printable.hpp"
 #include "nlobs/reference/kinsol_solver.hpp"
@@ -16,6 +18,8 @@
 #include "nlobs/reference/timing.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 #include "nlobs/solvers/root_adapter.hpp"
+#include "nlobs/solvers/sparse/sparse_jacobian.hpp"
+#include "nlobs/solvers/sparse/sparsity_pattern.hpp"
 
 namespace nlobs::reference {
 namespace {
@@ -228,9 +232,15 @@ FixedPointProblem<Dynamic> metered(const FixedPointProblem<Dynamic>& g, Meter& m
     jac.setConstant(p->size(), p->size(), std::numeric_limits<double>::quiet_NaN());
     return true;
   };
+  // The sparse Jacobian (declared, or detected at the engine's start) goes with the residual
+  // form: an engine with a sparse path takes it, as it would from the problem itself.
+  const auto with_sparse = [&g](FixedPointProblem<Dynamic> out) {
+    return g.sparse_jacobian_state() ? out.with_sparse_jacobian_state(g.sparse_jacobian_state())
+                                     : out;
+  };
   if (!g.has_jacobian()) {
     auto out = FixedPointProblem<Dynamic>::from_map(map, g.size());
-    return g.has_residual() ? out.with_residual(residual) : out;
+    return g.has_residual() ? with_sparse(out.with_residual(residual)) : out;
   }
   auto jacobian = [p, late](const Eigen::VectorXd& x, Eigen::MatrixXd& jac) {
     if (!late(jac)) p->jacobian(x, jac);
@@ -238,9 +248,56 @@ FixedPointProblem<Dynamic> metered(const FixedPointProblem<Dynamic>& g, Meter& m
   auto out =
       FixedPointProblem<Dynamic>::with_jacobian(map, jacobian, g.size(), g.jacobian_source());
   if (!g.has_residual()) return out;
-  return out.with_residual(residual, [p, late](const Eigen::VectorXd& x, Eigen::MatrixXd& jac) {
-    if (!late(jac)) p->residual_jacobian(x, jac);
-  });
+  return with_sparse(
+      out.with_residual(residual, [p, late](const Eigen::VectorXd& x, Eigen::MatrixXd& jac) {
+        if (!late(jac)) p->residual_jacobian(x, jac);
+      }));
+}
+
+// The widths of the band holding `pattern` (an n×n pattern): max(i − j) and max(j − i).
+std::pair<long, long> bandwidths(const SparsityPattern& pattern) {
+  long lower = 0, upper = 0;
+  for (Index i = 0; i < pattern.rows; ++i) {
+    const auto first = static_cast<std::size_t>(pattern.row_start[static_cast<std::size_t>(i)]);
+    const auto end = static_cast<std::size_t>(pattern.row_start[static_cast<std::size_t>(i) + 1]);
+    if (first == end) continue;
+    lower = std::max<long>(lower, i - pattern.columns[first]);
+    upper = std::max<long>(upper, pattern.columns[end - 1] - i);
+  }
+  return {lower, upper};
+}
+
+// ∂F for kinsol:newton-klu: the problem's sparse Jacobian (declared or detected at x), its values
+// copied in the pattern's row order. std::invalid_argument (an invalid_input row) without one.
+KinsolSparseJacobian kinsol_sparse_jacobian(const TestProblem& problem, const Eigen::VectorXd& x) {
+  const SparseJacobianSource* source = problem.residual.sparse_jacobian(x);
+  if (!source) {
+    throw std::invalid_argument("kinsol:newton-klu needs a sparse Jacobian, and F has none (" +
+                                problem.residual.sparse_jacobian_note() + ")");
+  }
+  const SparsityPattern& pattern = *source->pattern;
+  KinsolSparseJacobian out;
+  out.row_starts.assign(pattern.row_start.begin(), pattern.row_start.end());
+  out.columns.assign(pattern.columns.begin(), pattern.columns.end());
+  // Through the problem's state: its lock guards the workspace the problem's copies share.
+  std::shared_ptr<detail::SparseJacobianState> state = problem.residual.sparse_jacobian_state();
+  auto jac = std::make_shared<SparseJacobian>();
+  const auto nonzeros = static_cast<Eigen::Index>(out.columns.size());
+  out.values = [state, jac, nonzeros](const Eigen::VectorXd& at, const Eigen::VectorXd& f,
+                                      double* values) {
+    state->evaluate(at, f, *jac);
+    if (jac->nonZeros() != nonzeros) {  // the callback makes this KINSOL's Jacobian failure
+      throw std::logic_error("the sparse Jacobian's structure is not its pattern's");
+    }
+    std::copy(jac->valuePtr(), jac->valuePtr() + nonzeros, values);
+  };
+  return out;
+}
+
+// The references that keep dense n×n matrices: not run above kMaxProblemDimension.
+bool dense_reference(const std::string& solver) {
+  return solver == "minpack:hybrj" || solver == "gsl:hybridsj" || solver == "gsl:gnewton" ||
+         solver == "kinsol:newton";
 }
 
 // KINSOL's options and set-up may refuse (std::invalid_argument): the caller makes that row
@@ -249,6 +306,12 @@ FixedPointProblem<Dynamic> metered(const FixedPointProblem<Dynamic>& g, Meter& m
 Outcome run_reference(const std::string& solver, const TestProblem& problem,
                       const RootProblem<Dynamic>& residual, const FixedPointProblem<Dynamic>& g,
                       Eigen::VectorXd& x, long budget) {
+  if (dense_reference(solver) && residual.size() > kMaxProblemDimension) {
+    throw std::invalid_argument(
+        solver + " keeps dense n x n matrices: not run at n = " + std::to_string(residual.size()) +
+        ", above " + std::to_string(kMaxProblemDimension) +
+        " (kinsol:newton-band, -klu and -spgmr are KINSOL's sparse forms)");
+  }
   ReferenceOptions o;
   o.max_evaluations = budget;
   if (solver == "minpack:hybrj") {
@@ -278,10 +341,32 @@ Outcome run_reference(const std::string& solver, const TestProblem& problem,
   const int n = static_cast<int>(residual.size());
   std::unique_ptr<KinsolSolver> k;
   if (ko.strategy == KinsolStrategy::kNewtonLineSearch) {
+    ko.linear_solver = KinsolSolver::linear_solver(solver).value_or(KinsolLinearSolver::kDense);
+    KinsolSolver::Jacobian dense;
+    KinsolSparseJacobian sparse;
     const RootProblem<Dynamic>* f = &residual;
+    switch (ko.linear_solver) {
+      case KinsolLinearSolver::kDense:  // exact Newton on our Jacobian, as in the small sets
+        dense = [f](const Eigen::VectorXd& v, Eigen::MatrixXd& j) { f->jacobian(v, j); };
+        break;
+      case KinsolLinearSolver::kBand: {  // the widths of F's pattern; the full band without one
+        const SparseJacobianSource* source = problem.residual.sparse_jacobian(x);
+        std::tie(ko.lower_bandwidth, ko.upper_bandwidth) =
+            source ? bandwidths(*source->pattern) : std::pair<long, long>{n - 1, n - 1};
+        ko.max_setup_calls = 0;  // KINSOL's default: modified Newton
+        break;
+      }
+      case KinsolLinearSolver::kKlu:
+        sparse = kinsol_sparse_jacobian(problem, x);
+        ko.max_setup_calls = 0;
+        break;
+      case KinsolLinearSolver::kSpgmr:
+        ko.max_setup_calls = 0;
+        break;
+    }
     k = std::make_unique<KinsolSolver>(
         n, ko, [f](const Eigen::VectorXd& v, Eigen::VectorXd& out) { f->evaluate(v, out); },
-        [f](const Eigen::VectorXd& v, Eigen::MatrixXd& j) { f->jacobian(v, j); });
+        std::move(dense), std::move(sparse));
   } else {
     const FixedPointProblem<Dynamic>* gp = &g;
     k = std::make_unique<KinsolSolver>(
@@ -343,8 +428,10 @@ std::vector<std::string> reference_suite_solvers() {
 
 std::vector<std::string> all_reference_solvers() {
   std::vector<std::string> s = reference_suite_solvers();
-  s.push_back("kinsol:fp");
-  s.push_back("kinsol:fp-aa2");
+  for (const char* more : {"kinsol:fp", "kinsol:fp-aa2", "kinsol:newton-band", "kinsol:newton-klu",
+                           "kinsol:newton-spgmr"}) {
+    s.emplace_back(more);
+  }
   return s;
 }
 
@@ -439,6 +526,13 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
     const FixedPointProblem<Dynamic> safe_g = guarded(g, &meter);
     const FixedPointProblem<Dynamic> engine_g = metered(g, meter);
     meter.f_scale = &p.f_scale;
+    // The pattern of a with_autodiff F is detected once per problem (at the first start), here
+    // and untimed: the first solver of the list would otherwise be timed with it. What it
+    // throws, an engine meets again (and its row says so).
+    try {
+      (void)p.residual.sparse_jacobian(p.starts.front().x);
+    } catch (...) {
+    }
     for (const ProblemStart& start : p.starts) {
       if (!selected(start, options)) continue;
       for (const std::string& s : solvers) {

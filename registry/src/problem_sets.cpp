@@ -34,10 +34,10 @@ void validate_test_problem(const TestProblem& p, std::string_view where,
                        registry_name_problem(p.name) + " (" + std::string(kRegistryNameRule) + ")");
   }
   if (n <= 0) fail(where, p, "it has no unknowns: n must be at least 1");
-  if (n > kMaxProblemDimension) {
+  if (n > kMaxSparseProblemDimension) {
     fail(where, p,
-         "n = " + shape(n) + " is above the limit of " + shape(kMaxProblemDimension) +
-             " unknowns (every solver keeps dense n x n matrices)");
+         "n = " + shape(n) + " is above the limit of " + shape(kMaxSparseProblemDimension) +
+             " unknowns");
   }
   if (p.residual.residual_size() != n) {
     fail(where, p,
@@ -119,6 +119,22 @@ void validate_test_problem(const TestProblem& p, std::string_view where,
       fail(where, p, which + ": x[" + shape(*i) + "] is outside the bounds");
     }
   }
+  if (n > kMaxProblemDimension) {  // the dense solvers could not hold it: F must be sparse
+    std::string why;
+    try {
+      if (!p.residual.sparse_jacobian(p.starts.front().x)) why = p.residual.sparse_jacobian_note();
+    } catch (...) {
+      why = "detecting it threw: " + current_exception_text();
+    }
+    if (!why.empty()) {
+      fail(where, p,
+           "n = " + shape(n) + " is above the limit of " + shape(kMaxProblemDimension) +
+               " unknowns for a dense Jacobian, and F has no sparse one (declare it with "
+               "sparse_autodiff_problem, or build F with_autodiff for nlobs to detect it; "
+               "detection: " +
+               printable(why, 200) + ")");
+    }
+  }
   for (std::size_t k = 0; k < p.solutions.size(); ++k) {
     const std::string which = "known solution " + std::to_string(k);
     if (p.solutions[k].size() != n) {
@@ -153,21 +169,38 @@ NamedRegistry<ProblemSetEntry>& problem_set_registry() {
   return registry;
 }
 
-std::vector<TestProblem> build_problem_set(const ProblemSetEntry& set) {
+namespace {
+
+// The set's problems as its functions build them, not yet validated.
+std::vector<TestProblem> unchecked_problems(const ProblemSetEntry& set, std::optional<Index> n) {
   const std::string where = "problem set '" + set.name + "'";
   if (!set.problems) throw InvalidInput(where + ": no function builds its problems");
   if (!(set.solved_threshold > 0.0) || !std::isfinite(set.solved_threshold)) {
     throw InvalidInput(where + ": solved_threshold must be finite and > 0");
   }
+  if (n && !set.problems_of_size) {
+    throw InvalidInput(where + " has fixed sizes (':n=K' after a problem's name selects one)");
+  }
+  if (n && (*n < 1 || *n > kMaxSparseProblemDimension)) {
+    throw InvalidInput(where + ": n = " + std::to_string(*n) + " is not in 1 .. " +
+                       std::to_string(kMaxSparseProblemDimension));
+  }
   std::vector<TestProblem> problems;
   try {  // a user's function (a plugin's): anything it throws is named by the set
-    problems = set.problems();
+    problems = n ? set.problems_of_size(*n) : set.problems();
   } catch (const std::bad_alloc&) {
     throw InvalidInput(where + ": building its problems ran out of memory (std::bad_alloc)");
   } catch (...) {
     throw InvalidInput(where + ": building its problems threw: " + current_exception_text());
   }
   if (problems.empty()) throw InvalidInput(where + ": it has no problems");
+  return problems;
+}
+
+// Each problem valid, (name, n) unique. Validation costs (detection at 10⁶ unknowns takes
+// seconds): a selection validates only what it selected.
+void validate_problems(const ProblemSetEntry& set, const std::vector<TestProblem>& problems) {
+  const std::string where = "problem set '" + set.name + "'";
   std::set<std::pair<std::string, Index>> seen;
   for (const TestProblem& p : problems) {
     validate_test_problem(p, where, set.solved_threshold);
@@ -175,46 +208,68 @@ std::vector<TestProblem> build_problem_set(const ProblemSetEntry& set) {
       fail(where, p, "listed twice (a name is unique per size)");
     }
   }
+}
+
+}  // namespace
+
+std::vector<TestProblem> build_problem_set(const ProblemSetEntry& set, std::optional<Index> n) {
+  std::vector<TestProblem> problems = unchecked_problems(set, n);
+  validate_problems(set, problems);
   return problems;
 }
+
+namespace {
+
+// Splits "NAME:n=K" into NAME and K (none without a colon); InvalidInput for another suffix.
+std::optional<Index> take_size(std::string& name, const std::string& selector) {
+  const std::size_t colon = name.find(':');
+  if (colon == std::string::npos) return std::nullopt;
+  const std::string size_text = name.substr(colon + 1);
+  name.resize(colon);
+  const bool digits = size_text.size() > 2 && size_text.size() <= 11 &&
+                      size_text.compare(0, 2, "n=") == 0 &&
+                      size_text.find_first_not_of("0123456789", 2) == std::string::npos;
+  if (!digits) {
+    throw InvalidInput("problem '" + selector.substr(0, 60) +
+                       "': after the name, ':n=K' with K a positive integer selects a size");
+  }
+  return std::stol(size_text.substr(2));
+}
+
+}  // namespace
 
 ProblemSelection select_problems(std::string_view selector,
                                  const NamedRegistry<ProblemSetEntry>& registry) {
   const std::string text(selector);
   const std::size_t slash = text.find('/');
-  const std::string set_name = text.substr(0, slash);
+  std::string set_name = text.substr(0, slash);
+  std::string name = slash == std::string::npos ? std::string() : text.substr(slash + 1);
+  std::optional<Index> n = take_size(slash == std::string::npos ? set_name : name, text);
   const ProblemSetEntry* set = registry.find(set_name);
   if (!set) {
     throw InvalidInput("unknown problem set '" + set_name.substr(0, 60) +
                        "'; valid problem sets: " + registry.valid_list());
   }
-  ProblemSelection out{set, build_problem_set(*set)};
-  if (slash == std::string::npos) return out;
-
-  std::string name = text.substr(slash + 1);
-  std::optional<Index> n;
-  if (const std::size_t colon = name.find(':'); colon != std::string::npos) {
-    const std::string size_text = name.substr(colon + 1);
-    name.resize(colon);
-    const bool digits = size_text.size() > 2 && size_text.size() <= 11 &&
-                        size_text.compare(0, 2, "n=") == 0 &&
-                        size_text.find_first_not_of("0123456789", 2) == std::string::npos;
-    if (!digits) {
-      throw InvalidInput("problem '" + text.substr(0, 60) +
-                         "': after the name, ':n=K' with K a positive integer selects a size");
-    }
-    n = std::stol(size_text.substr(2));
+  // A set of run-time size builds its problems at n itself: each at the size nearest n it has.
+  const bool sized = n && set->problems_of_size;
+  ProblemSelection out{
+      set, unchecked_problems(*set, sized || slash == std::string::npos ? n : std::nullopt)};
+  if (slash == std::string::npos) {
+    validate_problems(*set, out.problems);
+    return out;
   }
+
   std::vector<TestProblem> chosen;
   std::string names;
   for (TestProblem& p : out.problems) {
     names += (names.empty() ? "" : ", ") + p.name + ":n=" + std::to_string(p.size());
-    if (p.name == name && (!n || *n == p.size())) chosen.push_back(std::move(p));
+    if (p.name == name && (!n || sized || *n == p.size())) chosen.push_back(std::move(p));
   }
   if (chosen.empty()) {
     throw InvalidInput("problem set '" + set->name + "' has no problem '" +
                        text.substr(slash + 1, 60) + "'; its problems: " + names);
   }
+  validate_problems(*set, chosen);
   out.problems = std::move(chosen);
   return out;
 }

@@ -2,6 +2,7 @@
 
 #include "nlobs/registry/problem_sets/bounded_set.hpp"
 #include "nlobs/registry/problem_sets/chua_window_set.hpp"
+#include "nlobs/registry/problem_sets/large_set.hpp"
 #include "nlobs/registry/problem_sets/mgh_problems.hpp"
 #include "nlobs/registry/problem_sets/published_set.hpp"
 
@@ -12,6 +13,7 @@ void add_builtin_problem_sets(NamedRegistry<ProblemSetEntry>& registry) {
   registry.add(mgh_problem_set());
   registry.add(bounded_problem_set());
   registry.add(published_problem_set());
+  registry.add(large_problem_set());
 }
 
 }  // namespace nlobs::detail

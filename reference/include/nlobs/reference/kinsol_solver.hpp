@@ -1,24 +1,59 @@
 #pragma once
 // KINSOL (SUNDIALS) as a reference solver for the same problems our engines solve: fixed
-// point, fixed point with Anderson acceleration, Newton with line search and a dense direct
-// linear solver. KINSOL is set up once in the constructor and re-run by solve(), so a timing
-// of solve() measures the iteration, not the set-up — the same treatment our engines get.
+// point, fixed point with Anderson acceleration, Newton with line search on a dense, band, KLU or
+// SPGMR linear solver. KINSOL is set up once in the constructor and re-run by solve(), so a
+// timing of solve() measures the iteration, not the set-up — the same treatment our engines get.
 #include <Eigen/Core>
 #include <functional>
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace nlobs::reference {
 
 enum class KinsolStrategy {
   kFixedPoint,          // "kinsol:fp"      KIN_FP, G given
   kFixedPointAnderson,  // "kinsol:fp-aa2"  KIN_FP with Anderson depth anderson_depth
-  kNewtonLineSearch,    // "kinsol:newton"  KIN_LINESEARCH, F and its Jacobian given
+  kNewtonLineSearch,    // "kinsol:newton…" KIN_LINESEARCH on KinsolOptions::linear_solver
+};
+
+// The linear solver of KIN_LINESEARCH, each set up as KINSOL's own example drivers set it up.
+enum class KinsolLinearSolver {
+  kDense,  // "kinsol:newton"        SUNLinSol_Dense; the Jacobian given (else KINSOL's DQ)
+  // "kinsol:newton-band"   SUNLinSol_Band on SUNBandMatrix(n, upper, lower) with KINSOL's own
+  // difference-quotient band Jacobian (lower + upper + 1 evaluations of F), as kinLaplace_bnd
+  kBand,
+  // "kinsol:newton-klu"    SUNLinSol_KLU on a CSR SUNSparseMatrix; the sparse Jacobian given
+  // (KINSOL has no difference quotients for a sparse matrix)
+  kKlu,
+  // "kinsol:newton-spgmr"  SUNLinSol_SPGMR, no preconditioner, KINSOL's difference-quotient J·v,
+  // Krylov dimension 15 and 2 restarts, as kinFoodWeb_kry
+  kSpgmr,
+};
+
+// ∂F as compressed sparse rows for kKlu: the pattern once (row_starts of size n + 1, columns
+// sorted within a row), and `values(x, f, v)` writing the nnz values in that order at x, where
+// f = F(x).
+struct KinsolSparseJacobian {
+  std::vector<long> row_starts{}, columns{};
+  std::function<void(const Eigen::VectorXd& x, const Eigen::VectorXd& f, double* values)> values{};
 };
 
 struct KinsolOptions {
   KinsolStrategy strategy = KinsolStrategy::kFixedPoint;
+  KinsolLinearSolver linear_solver = KinsolLinearSolver::kDense;  // Newton only
+  // kBand: J_ij = 0 for i − j > lower_bandwidth or j − i > upper_bandwidth; each in 0 .. n − 1,
+  // and the band's storage, n (2 lower + upper + 1) doubles, at most 1.25e8 (1 GB).
+  long lower_bandwidth = 0, upper_bandwidth = 0;
+  // KINSetMaxSetupCalls (Newton): the Jacobian and its factorisation are renewed at least every
+  // this many iterations. 1: exact Newton, what "kinsol:newton" runs; 0: KINSOL's default, 10
+  // (modified Newton, with its own tests for renewing earlier), what the band, KLU and SPGMR
+  // forms run.
+  long max_setup_calls = 1;
+  // KINSetMaxSubSetupCalls: how often (in iterations) modified Newton tests whether to renew the
+  // Jacobian early; 0: KINSOL's default, 5.
+  long max_sub_setup_calls = 0;
   double tolerance = 1e-8;  // KINSOL's fnormtol (‖F‖∞, or ‖G(u)−u‖∞ for FP) and scsteptol
   int anderson_depth = 2;
   long max_iterations = 10000;  // KINSetNumMaxIters: KINSOL counts iterations, not evaluations
@@ -55,7 +90,8 @@ struct KinsolResult {
   // (KINGetNumFuncEvals leaves them out) and the final check above, counted at the callback,
   // so the column compares with our engines' function_evaluations.
   long evaluations = 0;
-  long jacobian_evaluations = 0;  // KINGetNumJacEvals (Newton only)
+  long jacobian_evaluations = 0;  // KINGetNumJacEvals (Newton on a matrix)
+  long linear_iterations = 0;     // KINGetNumLinIters (Newton; SPGMR's Krylov iterations)
   bool budget_spent = false;      // an evaluation beyond max_evaluations was refused
   // "converged", "non_finite" or "residual_above_tolerance" (flag >= 0 that does not stand);
   // "max_evaluations" (budget_spent), "max_iterations" (KIN_MAXITER_REACHED), "non_finite"
@@ -70,9 +106,11 @@ class KinsolSolver {
   using Function = std::function<void(const Eigen::VectorXd&, Eigen::VectorXd&)>;
   using Jacobian = std::function<void(const Eigen::VectorXd&, Eigen::MatrixXd&)>;
 
-  // For fixed-point strategies `function` is G; for Newton it is F and `jacobian` its
-  // Jacobian (empty: KINSOL's difference quotients).
-  KinsolSolver(int n, KinsolOptions options, Function function, Jacobian jacobian = {});
+  // For fixed-point strategies `function` is G; for Newton it is F and `jacobian` its dense
+  // Jacobian (kDense; empty: KINSOL's difference quotients), `sparse` its sparse one (kKlu,
+  // required). std::invalid_argument for options out of range or a malformed sparse pattern.
+  KinsolSolver(int n, KinsolOptions options, Function function, Jacobian jacobian = {},
+               KinsolSparseJacobian sparse = {});
   ~KinsolSolver();
   KinsolSolver(const KinsolSolver&) = delete;
   KinsolSolver& operator=(const KinsolSolver&) = delete;
@@ -81,8 +119,13 @@ class KinsolSolver {
   KinsolResult solve(Eigen::VectorXd& x);
 
   static std::string name(KinsolStrategy strategy);
-  // The inverse of name(): "kinsol:fp", "kinsol:fp-aa2", "kinsol:newton"; none for another.
+  // "kinsol:newton", "kinsol:newton-band", "kinsol:newton-klu", "kinsol:newton-spgmr".
+  static std::string name(KinsolLinearSolver linear_solver);
+  // The inverse of the names: "kinsol:fp", "kinsol:fp-aa2" and the four Newton names (each
+  // kNewtonLineSearch); none for another.
   static std::optional<KinsolStrategy> strategy(const std::string& name);
+  // The linear solver a Newton name runs; none for another name.
+  static std::optional<KinsolLinearSolver> linear_solver(const std::string& name);
 
  private:
   struct Impl;

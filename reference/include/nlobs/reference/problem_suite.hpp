@@ -79,8 +79,14 @@ struct SuiteOptions {
 std::vector<std::string> default_suite_solvers();
 // The references run by default: minpack:hybrj, kinsol:newton, gsl:hybridsj, gsl:gnewton.
 std::vector<std::string> reference_suite_solvers();
-// Every reference name accepted: the default ones and KINSOL's fixed-point strategies
-// kinsol:fp and kinsol:fp-aa2 (on G: the problem's own, or x + F(x)).
+// Every reference name accepted: the default ones, KINSOL's fixed-point strategies kinsol:fp and
+// kinsol:fp-aa2 (on G: the problem's own, or x + F(x)), and its Newton on sparse linear solvers,
+// each with KINSOL's default modified Newton (a Jacobian at least every 10 iterations):
+// kinsol:newton-band (its difference-quotient band Jacobian, the widths of F's pattern),
+// kinsol:newton-klu (F's sparse Jacobian, declared or detected; invalid_input without one) and
+// kinsol:newton-spgmr (difference-quotient J·v, no preconditioner). The dense references
+// (minpack:hybrj, gsl:*, kinsol:newton) are not run above kMaxProblemDimension unknowns: their
+// rows are invalid_input, saying why.
 std::vector<std::string> all_reference_solvers();
 
 // The threshold `options` give for `set` (its own when options leave it NaN); InvalidInput for

@@ -102,12 +102,17 @@ TestProblem fixed_point_test_problem(std::string name, Index n, G g,
                      .starts = std::move(starts)};
 }
 
-// The largest n a problem set may hold: every solver of the suite keeps dense n×n matrices (a
-// Jacobian, its factorisation, MINPACK's and KINSOL's copies), 32 MB each at n = 2000.
+// The largest n of a problem whose Jacobian is dense: the dense solvers of the suite keep n×n
+// matrices (a Jacobian, its factorisation, MINPACK's and KINSOL's copies), 32 MB each at
+// n = 2000. A problem above it needs a sparse Jacobian (declared, or detected by with_autodiff at
+// its first start), and the suite runs no dense reference solver on it.
 inline constexpr Index kMaxProblemDimension = 2000;
+// The largest n of any problem (10⁷ unknowns: 80 MB a vector).
+inline constexpr Index kMaxSparseProblemDimension = 10'000'000;
 
-// Throws InvalidInput naming `where` and the problem: a bad name, n = 0 or n above
-// kMaxProblemDimension, a non-square F or one without a Jacobian, a fixed-point map of another
+// Throws InvalidInput naming `where` and the problem: a bad name, n = 0, n above
+// kMaxProblemDimension without a sparse Jacobian (or above kMaxSparseProblemDimension), a
+// non-square F or one without a Jacobian, a fixed-point map of another
 // size, no start, a start, bound or solution of the wrong size, a non-finite start or solution,
 // lower > upper, a start outside the bounds, a u_scale or f_scale of the wrong size or with an
 // entry not finite and > 0, and a known solution (named by its index) outside the bounds or not a
@@ -126,17 +131,28 @@ struct ProblemSetEntry {
   // The default of --threshold: solved when ‖D_f F(x)‖₂ ≤ this at the returned point (D_f the
   // problem's f_scale, the identity without one).
   double solved_threshold = 1e-8;
+  // A set of run-time size ("SET:n=K", "SET/NAME:n=K"): its problems built for about K unknowns
+  // (each takes the size nearest K its structure allows, a square grid's m² for instance). Empty:
+  // the set's sizes are those `problems` builds.
+  std::function<std::vector<TestProblem>(Index n)> problems_of_size{};
+  // What `nlobs suite SET` runs when --solvers is not given (empty: the suite's default list,
+  // reference::default_suite_solvers()).
+  std::vector<std::string> default_solvers{};
 };
 
 NamedRegistry<ProblemSetEntry>& problem_set_registry();
 
 // The set's problems, each validated (known solutions at the set's solved_threshold), (name, n)
 // unique: InvalidInput "problem set 'S': …", also when problems() throws (anything: its text,
-// "a non-standard exception" for `throw 42`, "not enough memory" for std::bad_alloc).
-std::vector<TestProblem> build_problem_set(const ProblemSetEntry& set);
+// "a non-standard exception" for `throw 42`, "not enough memory" for std::bad_alloc). With `n`,
+// problems_of_size(n) builds them: InvalidInput for a set without it, or n outside
+// 1 .. kMaxSparseProblemDimension.
+std::vector<TestProblem> build_problem_set(const ProblemSetEntry& set,
+                                           std::optional<Index> n = std::nullopt);
 
-// "SET" (all its problems), "SET/NAME" (every size of NAME) or "SET/NAME:n=K": the problems it
-// selects. InvalidInput for an unknown set (listing the sets) or problem (listing the set's).
+// "SET" (all its problems), "SET:n=K" (a set of run-time size at K), "SET/NAME" (every size of
+// NAME) or "SET/NAME:n=K": the problems it selects. InvalidInput for an unknown set (listing the
+// sets) or problem (listing the set's), or a size the set does not have.
 struct ProblemSelection {
   const ProblemSetEntry* set = nullptr;
   std::vector<TestProblem> problems{};
