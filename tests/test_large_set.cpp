@@ -222,6 +222,18 @@ TEST(LargeSet, KluWithoutASparseJacobianIsAnInvalidInputRow) {
   }
 }
 
+// ex5's Bratu is F scaled by h²: its slowest mode (eigenvalue ≈ 2π²h²) sets how fast ‖F‖ falls,
+// and with it how fast switched evolution relaxation lets δ grow — thousands of steps at n = 400.
+// γ = 1.1 (PETSc TSPseudo's increment) grows δ regardless: tens.
+TEST(LargeSet, PseudoStepGrowthTakesTheSlowModeInTensOfSteps) {
+  const auto rows =
+      run_large("large/bratu2d:n=400", {"pseudo-transient", "pseudo-transient:growth=1.1"});
+  ASSERT_EQ(rows.size(), 2u);
+  for (const SuiteRow& r : rows) EXPECT_TRUE(r.solved) << r.solver << " " << r.status;
+  EXPECT_GT(rows[0].f_evals, 1000);
+  EXPECT_LT(rows[1].f_evals, 100);
+}
+
 // SUNDIALS' kinLaplace_bnd.out: nni = 7, nfe = 8, nje = 1, nfeB = 63 (the difference-quotient
 // band Jacobian's evaluations: 2·31 + 1), with modified Newton (mset = 100, msubset = 1),
 // fnormtol 1e-12, from 0, on its 31 × 31 grid.

@@ -135,9 +135,20 @@ TEST(PseudoTransient, BudgetAndOptions) {
               PseudoTransientEngine<1>({.min_pseudo_step = 1.0});
             }).find("min_pseudo_step"),
             std::string::npos);
+  for (const double growth : {0.5, 10.5, std::nan("")}) {
+    EXPECT_NE(test::message_of([growth] {
+                PseudoTransientEngine<1>({.pseudo_step_growth = growth});
+              }).find("pseudo_step_growth (growth)"),
+              std::string::npos)
+        << growth;
+  }
   auto& registry = EngineRegistry<>::global();
   EXPECT_EQ(registry.create("pseudo-transient:flow=residual,delta0=1e-4,delta_max=1e6")->name(),
             "pseudo-transient");
+  EXPECT_NE(test::message_of([&] {
+              registry.create("pseudo-transient:growth=0.9");
+            }).find("must lie in [1, 10]"),
+            std::string::npos);
   EXPECT_NE(test::message_of([&] { registry.create("pseudo-transient:flow=down"); }).find("flow"),
             std::string::npos);
   EXPECT_NE(test::message_of([&] {

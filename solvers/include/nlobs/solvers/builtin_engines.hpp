@@ -192,6 +192,7 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
        {{"flow", "residual|fixed-point: dx/dt = -F = x - G(x) or G(x) - x; default residual"},
         {"delta0", "initial pseudo time step, >= 2.22e-16 (machine epsilon); default 1e-2"},
         {"delta_max", "largest pseudo time step; default 1e12"},
+        {"growth", "factor gamma >= 1 on the SER step update (PETSc: 1.1), <= 10; default 1"},
         {"fd", "forward|central differences when no Jacobian; default central"},
         {"linear", detail::kLinearKeyHelp},
         {"preconditioner", detail::kPreconditionerKeyHelp}},
@@ -209,6 +210,7 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
          }
          if (auto v = s.number("delta0")) p.initial_pseudo_step = *v;
          if (auto v = s.number("delta_max")) p.max_pseudo_step = *v;
+         if (auto v = s.number("growth")) p.pseudo_step_growth = *v;
          // δ_min follows a δ₀ below its default (δ₀ itself is checked by the engine: >= ε).
          if (p.min_pseudo_step > p.initial_pseudo_step) {
            p.min_pseudo_step =

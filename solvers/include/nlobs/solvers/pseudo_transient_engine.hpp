@@ -3,7 +3,10 @@
 // state by linearly implicit Euler steps whose pseudo time step δ grows as ‖F‖ falls (switched
 // evolution relaxation):
 //   ẋ = σ F(x):   (δ_k⁻¹ I − σ J(x_k)) p_k = σ F(x_k),   x_{k+1} = x_k + p_k,
-//   δ_{k+1} = δ_k ‖F(x_{k−1})‖₂/‖F(x_k)‖₂, capped at max_pseudo_step.
+//   δ_{k+1} = γ δ_k ‖F(x_{k−1})‖₂/‖F(x_k)‖₂, capped at max_pseudo_step,
+// γ = pseudo_step_growth ≥ 1 (1: Kelley–Keyes' SER; PETSc's TSPseudo multiplies by 1.1, its
+// -ts_pseudo_increment): with γ = 1, δ grows only as fast as ‖F‖ falls, which on a discretised
+// elliptic problem scaled by h² its slowest mode (eigenvalue ~ 2π²h²) sets — thousands of steps.
 // σ = −1 (Flow::kResidual, the default): ẋ = −F(x), Kelley–Keyes' u_t = −F(u) for a root
 // problem F(x) = 0 adapted with Ψ = I (to_fixed_point); its roots attract where the eigenvalues
 // of J have positive real parts (discretised elliptic problems, gradients of convex functions).
@@ -61,6 +64,8 @@ struct PseudoTransientOptions {
   // |F| ≤ |x|, and the flow is not followed at all.
   double initial_pseudo_step = 1e-2;
   double max_pseudo_step = 1e12;  // δ_max ≥ δ₀, finite: beyond it the step is Newton's
+  // γ in δ_{k+1} = γ δ_k ‖F_{k−1}‖/‖F_k‖: finite, in [1, 10].
+  double pseudo_step_growth = 1.0;
   double min_pseudo_step =
       1e-12;  // δ_min ∈ [kMinPseudoStep, δ₀]: after NaN trials, give up below it
   static constexpr double kMinPseudoStep = std::numeric_limits<double>::epsilon();
@@ -96,6 +101,8 @@ class PseudoTransientEngine : public Engine<N> {
     require(ptc_.min_pseudo_step >= floor && ptc_.min_pseudo_step <= ptc_.initial_pseudo_step,
             "min_pseudo_step", ptc_.min_pseudo_step,
             "must lie in [2.22e-16 (machine epsilon), initial_pseudo_step]");
+    require(ptc_.pseudo_step_growth >= 1.0 && ptc_.pseudo_step_growth <= 10.0,
+            "pseudo_step_growth (growth)", ptc_.pseudo_step_growth, "must lie in [1, 10]");
     require(ptc_.linear_tolerance > 0.0 && ptc_.linear_tolerance < 1.0, "linear_tolerance",
             ptc_.linear_tolerance, "must lie in (0, 1)");
     detail::check_linear_solver_option("PseudoTransientOptions::linear_solver", ptc_.linear_solver);
@@ -319,7 +326,8 @@ Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vec
     if (!status && fnorm == 0.0) status = Status::kConverged;
     // Switched evolution relaxation.
     if (fnorm > 0.0) {
-      delta = std::clamp(delta * previous / fnorm, ptc_.min_pseudo_step, ptc_.max_pseudo_step);
+      delta = std::clamp(ptc_.pseudo_step_growth * delta * previous / fnorm, ptc_.min_pseudo_step,
+                         ptc_.max_pseudo_step);
     }
   }
 
