@@ -143,8 +143,8 @@ ProblemSetEntry large_problem_set() {
           .problems_of_size = problems_of_size,
           .default_solvers = {"newton", "newton:linesearch=1",
                               "newton:linesearch=1,linear=gmres,preconditioner=ilu0",
-                              "pseudo-transient:growth=1.1", "auto", "anderson", "kinsol:newton-band",
-                              "kinsol:newton-klu", "kinsol:newton-spgmr"}};
+                              "pseudo-transient:growth=1.1", "auto", "anderson",
+                              "kinsol:newton-band", "kinsol:newton-klu", "kinsol:newton-spgmr"}};
 }
 
 }  // namespace nlobs
