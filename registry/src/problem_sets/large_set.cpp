@@ -141,7 +141,7 @@ ProblemSetEntry large_problem_set() {
               },
           .solved_threshold = 1e-8,
           .problems_of_size = problems_of_size,
-          .default_solvers = {"newton", "newton:linesearch=1",
+          .default_solvers = {"newton", "newton:linesearch=1", "newton:linesearch=1,reuse=10",
                               "newton:linesearch=1,linear=gmres,preconditioner=ilu0",
                               "pseudo-transient:growth=1.1", "auto", "anderson",
                               "kinsol:newton-band", "kinsol:newton-klu", "kinsol:newton-spgmr"}};

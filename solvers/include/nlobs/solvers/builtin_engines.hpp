@@ -102,13 +102,17 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
         {"trustregion", "0/1 dogleg trust region, a Jacobian every iterate; default 0"},
         {"fd", "forward|central differences when no Jacobian; default central"},
         {"linear", detail::kLinearKeyHelp},
-        {"preconditioner", detail::kPreconditionerKeyHelp}},
+        {"preconditioner", detail::kPreconditionerKeyHelp},
+        {"reuse",
+         "1..1000 iterations one Jacobian (and its factorisation) serves: modified Newton "
+         "(KINSOL: 10); default 1"}},
        {"newton", "newton:linesearch=1", "newton:trustregion=1",
-        "newton:linesearch=1,linear=gmres,preconditioner=ilu0"},
+        "newton:linesearch=1,linear=gmres,preconditioner=ilu0", "newton:linesearch=1,reuse=10"},
        [](EngineSpecReader& s, SolverOptions o) {
          NewtonOptions n;
          if (auto v = s.boolean("linesearch")) n.line_search = *v;
          if (auto v = s.boolean("trustregion")) n.trust_region = *v;
+         if (auto v = s.integer("reuse", 1, 1000)) n.jacobian_reuse = *v;
          if (auto v = s.text("fd"))
            n.finite_difference = detail::parse_finite_difference("newton", *v);
          if (auto v = detail::parse_linear_solver("newton", s, n.linear_solver)) {

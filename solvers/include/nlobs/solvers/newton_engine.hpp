@@ -58,6 +58,11 @@ struct NewtonOptions {
   std::string linear_solver = "auto";
   // η_k of the Krylov solvers (ignored by the direct ones).
   ForcingTermOptions forcing{};
+  // Modified Newton (KINSOL's msbset, 10 there by default): one Jacobian, with its factorisation
+  // or preconditioner, serves up to this many iterations, 1 to 1000; 1 is Newton. A stale one is
+  // renewed early when its step did not halve ‖F‖₂, and a line search that fails on a stale one
+  // is retried with a fresh one. Not with trust_region.
+  int jacobian_reuse = 1;
 };
 
 template <int N = Dynamic>
@@ -77,6 +82,14 @@ class NewtonEngine : public Engine<N> {
       fail("backtrack_factor", newton_.backtrack_factor, "must lie in (0, 1)");
     }
     if (newton_.max_backtracks < 1) fail("max_backtracks", newton_.max_backtracks, "must be >= 1");
+    if (newton_.jacobian_reuse < 1 || newton_.jacobian_reuse > 1000) {
+      fail("jacobian_reuse", newton_.jacobian_reuse, "must lie in 1 .. 1000");
+    }
+    if (newton_.jacobian_reuse > 1 && newton_.trust_region) {
+      throw InvalidInput(
+          "NewtonOptions: jacobian_reuse > 1 (modified Newton) is for the line search or the "
+          "plain step; the trust region evaluates J at every iterate");
+    }
     detail::check_linear_solver_option("NewtonOptions::linear_solver", newton_.linear_solver);
     forcing_ = ForcingTerm(newton_.forcing);
     if (newton_.line_search && newton_.trust_region) {
@@ -110,9 +123,10 @@ class NewtonEngine : public Engine<N> {
     if (!this->scaling_.empty()) return "a scaling (set_scaling)";
     return nullptr;
   }
-  // dx_ = −J_F⁻¹ f_ at x_ (dense: jac_, LU; sparse: sparse_jac_, linear_); nullopt or the status.
-  std::optional<Status> dense_step(std::string& message, int iteration);
-  std::optional<Status> sparse_step(std::string& message);
+  // dx_ = −J_F⁻¹ f_ (dense: jac_, LU; sparse: sparse_jac_, linear_), J_F evaluated at x_ when
+  // `fresh`, else the last one reused (modified Newton); nullopt or the status.
+  std::optional<Status> dense_step(std::string& message, int iteration, bool fresh);
+  std::optional<Status> sparse_step(std::string& message, bool fresh);
   // ∇φ = J_Fᵀ f_ (φ = ½‖F‖²) into gradient_, and ‖J_F gradient_‖², at the last Jacobian.
   void merit_gradient(bool sparse);
   double merit_curvature(bool sparse) const;
@@ -143,16 +157,20 @@ class NewtonEngine : public Engine<N> {
 };
 
 template <int N>
-std::optional<Status> NewtonEngine<N>::dense_step(std::string& message, int iteration) {
-  if (const std::optional<Status> status = system_.jacobian(x_, f_, jac_, message)) return status;
-  lu_.compute(jac_);
-  const double smallest_pivot = lu_.matrixLU().diagonal().cwiseAbs().minCoeff();
-  if (!(smallest_pivot > kSingularPivot * jac_.cwiseAbs().maxCoeff())) {
-    std::ostringstream os;
-    os << "Jacobian of F is singular at iteration " << iteration + 1 << " (smallest LU pivot "
-       << smallest_pivot << ")";
-    message = os.str();
-    return Status::kSingularJacobian;
+std::optional<Status> NewtonEngine<N>::dense_step(std::string& message, int iteration, bool fresh) {
+  if (fresh) {
+    if (const std::optional<Status> status = system_.jacobian(x_, f_, jac_, message)) {
+      return status;
+    }
+    lu_.compute(jac_);
+    const double smallest_pivot = lu_.matrixLU().diagonal().cwiseAbs().minCoeff();
+    if (!(smallest_pivot > kSingularPivot * jac_.cwiseAbs().maxCoeff())) {
+      std::ostringstream os;
+      os << "Jacobian of F is singular at iteration " << iteration + 1 << " (smallest LU pivot "
+         << smallest_pivot << ")";
+      message = os.str();
+      return Status::kSingularJacobian;
+    }
   }
   dx_ = lu_.solve(f_);
   dx_ = -dx_;
@@ -164,19 +182,22 @@ std::optional<Status> NewtonEngine<N>::dense_step(std::string& message, int iter
 }
 
 template <int N>
-std::optional<Status> NewtonEngine<N>::sparse_step(std::string& message) {
+std::optional<Status> NewtonEngine<N>::sparse_step(std::string& message, bool fresh) {
   if constexpr (N == Dynamic) {
-    if (const std::optional<Status> status =
-            system_.sparse_jacobian(x_, f_, sparse_jac_, message)) {
-      return status;
+    if (fresh) {
+      if (const std::optional<Status> status =
+              system_.sparse_jacobian(x_, f_, sparse_jac_, message)) {
+        return status;
+      }
     }
     // (A Krylov step above η_k but below ‖F‖ is accepted: still a descent direction.)
-    const LinearStatus linear = linear_.solve(sparse_jac_, f_, dx_, forcing_.eta(), 1.0);
+    const LinearStatus linear = fresh ? linear_.solve(sparse_jac_, f_, dx_, forcing_.eta(), 1.0)
+                                      : linear_.resolve(f_, dx_, forcing_.eta(), 1.0);
     if (const std::optional<Status> failed = linear_.failure(linear, message)) return failed;
     dx_ = -dx_;
     return std::nullopt;
   } else {
-    static_cast<void>(message);
+    static_cast<void>(message), static_cast<void>(fresh);
     return Status::kInvalidInput;  // unreachable: fixed sizes have no sparse path
   }
 }
@@ -278,6 +299,9 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
     status = Status::kConverged;
   }
   double fnorm = f_.template lpNorm<Eigen::Infinity>();
+  // Modified Newton: iterations the current J has served (0: none yet), and whether to renew it.
+  int jacobian_age = 0;
+  bool renew = true;
 
   while (!status) {
     if (system_.budget_spent()) {
@@ -286,10 +310,13 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
       status = system_.spent_status(summary.message, x_, dx_, fnorm);
       break;
     }
-    if ((status = sparse ? sparse_step(summary.message)
-                         : dense_step(summary.message, monitor.iterations()))) {
+    const bool fresh = renew || jacobian_age >= newton_.jacobian_reuse;
+    if ((status = sparse ? sparse_step(summary.message, fresh)
+                         : dense_step(summary.message, monitor.iterations(), fresh))) {
       break;
     }
+    jacobian_age = fresh ? 1 : jacobian_age + 1;
+    renew = false;
     if (box.active() || inexact) merit_gradient(sparse);
 
     // The Newton step (backtracked with a line search); in a box, when that finds no decrease,
@@ -303,6 +330,10 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
         accepted = search(dx_, gradient_.squaredNorm() / curvature, true);
         descent_step = true;
       }
+    }
+    if (!accepted && !fresh && !system_.budget_spent()) {
+      renew = true;  // a stale J's step: try again from x_ with J evaluated there
+      continue;
     }
     if (!accepted) {
       // Blocked: without a line search where the box holds the Newton step in place; with one
@@ -342,6 +373,8 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
         }
       }
     }
+    // A J that no longer halves ‖F‖₂ is renewed (KINSOL renews on its own residual tests too).
+    if (newton_.jacobian_reuse > 1 && ft_.squaredNorm() > 0.25 * f_.squaredNorm()) renew = true;
     x_ = xt_;
     f_ = ft_;
     fnorm = f_.template lpNorm<Eigen::Infinity>();

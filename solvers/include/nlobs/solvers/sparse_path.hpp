@@ -76,9 +76,14 @@ class SparseLinearStep {
   // a descent direction of ‖F‖² (Fᵀ J Δx = Fᵀ r − ‖F‖² < 0).
   LinearStatus solve(const SparseJacobian& a, const Vector<Dynamic>& b, Vector<Dynamic>& x,
                      double tolerance, double accept_below) {
-    LinearStatus status = solver_->setup(a);
+    const LinearStatus status = solver_->setup(a);
     if (status != LinearStatus::kSolved) return status;
-    status = solver_->solve(b, x, tolerance);
+    return resolve(b, x, tolerance, accept_below);
+  }
+  // The same with the matrix of the last setup (modified Newton: its factorisation reused).
+  LinearStatus resolve(const Vector<Dynamic>& b, Vector<Dynamic>& x, double tolerance,
+                       double accept_below) {
+    const LinearStatus status = solver_->solve(b, x, tolerance);
     if (status == LinearStatus::kNotConverged && solver_->stats().last_residual < accept_below) {
       return LinearStatus::kSolved;
     }
