@@ -148,6 +148,8 @@ class NewtonEngine : public Engine<N> {
   // Partial pivoting (3–4× cheaper than full pivoting at n = 3); a pivot below this fraction
   // of the largest |J_ij| is treated as a zero pivot: the Newton step would be meaningless.
   static constexpr double kSingularPivot = 1e-13;
+  // Backtracks a stale Jacobian's step gets before J is renewed (modified Newton).
+  static constexpr int kStaleBacktracks = 3;
   Eigen::PartialPivLU<Matrix<N, N>> lu_;
   // The sparse path (run-time size only); the linear solver is made afresh for each solve.
   SparseJacobian sparse_jac_;
@@ -271,10 +273,10 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
   // An inexact (Krylov) step has ∇φᵀΔx = −‖F‖² + Fᵀr, not −‖F‖²: the Armijo test then takes the
   // slope from ∇φ = J_Fᵀ F as a projected step does.
   const bool inexact = sparse && linear_.iterative();
-  auto search = [&](const Vector<N>& d, double t0, bool armijo) {
+  auto search = [&](const Vector<N>& d, double t0, bool armijo, int max_backtracks) {
     const double phi0 = f_.squaredNorm();
     t = t0;
-    for (int k = 0; k <= newton_.max_backtracks && !system_.budget_spent(); ++k) {
+    for (int k = 0; k <= max_backtracks && !system_.budget_spent(); ++k) {
       xt_ = x_ + t * d;
       projected = box.project(xt_, x_);
       held_in_place = projected && xt_ == x_;
@@ -313,6 +315,13 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
     const bool fresh = renew || jacobian_age >= newton_.jacobian_reuse;
     if ((status = sparse ? sparse_step(summary.message, fresh)
                          : dense_step(summary.message, monitor.iterations(), fresh))) {
+      // A Krylov solve that fails on a stale J is tried again on a fresh one.
+      if (!fresh && *status == Status::kSolverFailure) {
+        status.reset();
+        summary.message.clear();
+        renew = true;
+        continue;
+      }
       break;
     }
     jacobian_age = fresh ? 1 : jacobian_age + 1;
@@ -322,18 +331,25 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
     // The Newton step (backtracked with a line search); in a box, when that finds no decrease,
     // the projected steepest-descent path from the Cauchy point of the linear model.
     bool descent_step = false;
-    bool accepted = search(dx_, 1.0, newton_.line_search);
+    // A stale J's step gets a few backtracks (and without a line search must lower ‖F‖₂): when
+    // it fails, J is renewed at x_ at once, before any fallback that would judge by it.
+    bool accepted =
+        search(dx_, 1.0, newton_.line_search,
+               fresh ? newton_.max_backtracks : std::min(newton_.max_backtracks, kStaleBacktracks));
+    if (accepted && !fresh && !newton_.line_search && !(ft_.squaredNorm() < f_.squaredNorm())) {
+      accepted = false;
+    }
+    if (!accepted && !fresh && !system_.budget_spent()) {
+      renew = true;
+      continue;
+    }
     if (!accepted && newton_.line_search && box.active() && !system_.budget_spent()) {
       const double curvature = merit_curvature(sparse);
       if (curvature > 0.0) {
         dx_ = -gradient_;
-        accepted = search(dx_, gradient_.squaredNorm() / curvature, true);
+        accepted = search(dx_, gradient_.squaredNorm() / curvature, true, newton_.max_backtracks);
         descent_step = true;
       }
-    }
-    if (!accepted && !fresh && !system_.budget_spent()) {
-      renew = true;  // a stale J's step: try again from x_ with J evaluated there
-      continue;
     }
     if (!accepted) {
       // Blocked: without a line search where the box holds the Newton step in place; with one
@@ -379,8 +395,9 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
     f_ = ft_;
     fnorm = f_.template lpNorm<Eigen::Infinity>();
     // A step the box cut short, or a descent step, says nothing about the distance to a root.
+    // A stale J's step is no Newton step: its size says nothing of the distance to a root.
     status = monitor.update(step, fnorm, x_.template lpNorm<Eigen::Infinity>(),
-                            !projected && !descent_step);
+                            !projected && !descent_step && fresh);
     if (this->options_.record_trace) {
       summary.trace.push_back({monitor.iterations(), step, fnorm, x_});
     }
