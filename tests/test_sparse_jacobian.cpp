@@ -16,6 +16,7 @@
 #include "large_test_problems.hpp"
 #include "nlobs/solvers/autodiff.hpp"
 #include "nlobs/solvers/sparse/compressed_jacobian.hpp"
+#include "nlobs/solvers/sparse/pattern_bandwidths.hpp"
 #include "nlobs/solvers/sparse/sparse_jacobian.hpp"
 #include "test_support.hpp"
 
@@ -158,6 +159,28 @@ TEST(SparsityDetection, ABranchOnXIsRefusedAndMinMaxAbsAreNot) {
   EXPECT_EQ(p, SparsityPattern::from_entries(2, 4, {{0, 0}, {0, 1}, {1, 2}, {1, 3}}));
   // The refusal leaves nothing behind: the next detection starts clean.
   EXPECT_NO_THROW(detect_sparsity(unions, Eigen::VectorXd::Ones(4)));
+}
+
+// The band holding a pattern (what auto's band-LU choice and KINSOL's band are sized by): a band
+// declared with its widths, an arrow whose first column and last row widen it to n − 1, an empty
+// row, and the 5-point stencil, whose widths are the grid's side.
+TEST(SparsityPattern, BandwidthsAreThoseOfTheBandHoldingIt) {
+  const PatternBandwidths band = pattern_bandwidths(SparsityPattern::band(10, 2, 3));
+  EXPECT_EQ(band.lower, 2);
+  EXPECT_EQ(band.upper, 3);
+  const PatternBandwidths arrow =
+      pattern_bandwidths(SparsityPattern::from_entries(5, 5, {{0, 0}, {4, 0}, {1, 4}, {2, 2}}));
+  EXPECT_EQ(arrow.lower, 4);
+  EXPECT_EQ(arrow.upper, 3);
+  const PatternBandwidths empty = pattern_bandwidths(SparsityPattern::from_entries(3, 3, {}));
+  EXPECT_EQ(empty.lower, 0);
+  EXPECT_EQ(empty.upper, 0);
+  const Index s = 7;
+  auto f = test::bratu(s);
+  const PatternBandwidths stencil =
+      pattern_bandwidths(detect_sparsity(f, Vector<Dynamic>::Zero(s * s), s * s));
+  EXPECT_EQ(stencil.lower, s);
+  EXPECT_EQ(stencil.upper, s);
 }
 
 TEST(ColumnColouring, IsValidAndAsSmallAsTheLongestRowOnStructuredPatterns) {

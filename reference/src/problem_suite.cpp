@@ -9,7 +9,6 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
-#include <tuple>
 #include <utility>
 
 #include "nlobs/common/printable.hpp"
@@ -18,6 +17,7 @@
 #include "nlobs/reference/timing.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 #include "nlobs/solvers/root_adapter.hpp"
+#include "nlobs/solvers/sparse/pattern_bandwidths.hpp"
 #include "nlobs/solvers/sparse/sparse_jacobian.hpp"
 #include "nlobs/solvers/sparse/sparsity_pattern.hpp"
 
@@ -254,19 +254,6 @@ FixedPointProblem<Dynamic> metered(const FixedPointProblem<Dynamic>& g, Meter& m
       }));
 }
 
-// The widths of the band holding `pattern` (an n×n pattern): max(i − j) and max(j − i).
-std::pair<long, long> bandwidths(const SparsityPattern& pattern) {
-  long lower = 0, upper = 0;
-  for (Index i = 0; i < pattern.rows; ++i) {
-    const auto first = static_cast<std::size_t>(pattern.row_start[static_cast<std::size_t>(i)]);
-    const auto end = static_cast<std::size_t>(pattern.row_start[static_cast<std::size_t>(i) + 1]);
-    if (first == end) continue;
-    lower = std::max<long>(lower, i - pattern.columns[first]);
-    upper = std::max<long>(upper, pattern.columns[end - 1] - i);
-  }
-  return {lower, upper};
-}
-
 // ∂F for kinsol:newton-klu: the problem's sparse Jacobian (declared or detected at x), its values
 // copied in the pattern's row order. std::invalid_argument (an invalid_input row) without one.
 KinsolSparseJacobian kinsol_sparse_jacobian(const TestProblem& problem, const Eigen::VectorXd& x) {
@@ -351,8 +338,10 @@ Outcome run_reference(const std::string& solver, const TestProblem& problem,
         break;
       case KinsolLinearSolver::kBand: {  // the widths of F's pattern; the full band without one
         const SparseJacobianSource* source = problem.residual.sparse_jacobian(x);
-        std::tie(ko.lower_bandwidth, ko.upper_bandwidth) =
-            source ? bandwidths(*source->pattern) : std::pair<long, long>{n - 1, n - 1};
+        const PatternBandwidths band =
+            source ? pattern_bandwidths(*source->pattern) : PatternBandwidths{n - 1, n - 1};
+        ko.lower_bandwidth = band.lower;
+        ko.upper_bandwidth = band.upper;
         ko.max_setup_calls = 0;  // KINSOL's default: modified Newton
         break;
       }

@@ -11,6 +11,7 @@
 #include "nlobs/solvers/linear/klu.hpp"
 #include "nlobs/solvers/linear/preconditioners.hpp"
 #include "nlobs/solvers/linear/sparse_lu.hpp"
+#include "nlobs/solvers/sparse/pattern_bandwidths.hpp"
 #include "nlobs/solvers/sparse/sparsity_pattern.hpp"
 
 namespace nlobs {
@@ -121,15 +122,8 @@ std::string choose_linear_solver(const std::string& requested, const SparsityPat
                        " unknowns");
   }
   if (requested != "auto") return requested;
-  Index width = 0;
-  for (Index i = 0; i < pattern.rows; ++i) {
-    const Index first = pattern.row_start[static_cast<std::size_t>(i)];
-    const Index end = pattern.row_start[static_cast<std::size_t>(i) + 1];
-    if (first == end) continue;
-    width = std::max({width, i - pattern.columns[static_cast<std::size_t>(first)],
-                      pattern.columns[static_cast<std::size_t>(end) - 1] - i});
-  }
-  return width <= kAutoBandWidth ? "band-lu" : "klu";
+  const PatternBandwidths band = pattern_bandwidths(pattern);
+  return std::max(band.lower, band.upper) <= kAutoBandWidth ? "band-lu" : "klu";
 }
 
 }  // namespace nlobs

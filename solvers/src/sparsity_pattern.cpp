@@ -1,5 +1,25 @@
 #include "nlobs/solvers/sparse/sparsity_pattern.hpp"
 
+#include <algorithm>
+
+#include "nlobs/solvers/sparse/pattern_bandwidths.hpp"
+
+namespace nlobs {
+
+PatternBandwidths pattern_bandwidths(const SparsityPattern& pattern) {
+  PatternBandwidths out;
+  for (Index i = 0; i < pattern.rows; ++i) {
+    const auto first = static_cast<std::size_t>(pattern.row_start[static_cast<std::size_t>(i)]);
+    const auto end = static_cast<std::size_t>(pattern.row_start[static_cast<std::size_t>(i) + 1]);
+    if (first == end) continue;  // columns are sorted: the first and last bound the row
+    out.lower = std::max(out.lower, i - pattern.columns[first]);
+    out.upper = std::max(out.upper, pattern.columns[end - 1] - i);
+  }
+  return out;
+}
+
+}  // namespace nlobs
+
 namespace nlobs::detail {
 
 SparsityPattern with_diagonal(const SparsityPattern& pattern) {
