@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "nlobs/common/printable.hpp"
+#include "nlobs/reference/petsc_solver.hpp"
 #include "nlobs/reference/problem_suite.hpp"
 #include "nlobs/registry/problem_sets.hpp"
 #include "output_file.hpp"
@@ -167,10 +168,19 @@ void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArg
             << std::flush;
       };
     }
-    const std::vector<std::string>& set_solvers = !solvers.empty() ? solvers
-                                                  : s.set->default_solvers.empty()
-                                                      ? default_solvers
-                                                      : s.set->default_solvers;
+    std::vector<std::string> set_solvers = !solvers.empty() ? solvers
+                                           : s.set->default_solvers.empty()
+                                               ? default_solvers
+                                               : s.set->default_solvers;
+    // A set's own list names PETSc (large); a build without it leaves those rows out, saying so.
+    if (solvers.empty() && !reference::petsc_available()) {
+      std::erase_if(set_solvers, [&err, &command](const std::string& name) {
+        if (!reference::PetscSnesSolver::is_name(name)) return false;
+        err << "nlobs " << command << ": " << name
+            << " left out: this nlobs was built without PETSc\n";
+        return true;
+      });
+    }
     const auto part = reference::run_suite(*s.set, s.problems, set_solvers, o);
     before += reference::count_suite_pairs(s.problems, options);
     rows.insert(rows.end(), part.begin(), part.end());

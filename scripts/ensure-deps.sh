@@ -16,6 +16,7 @@ packages=(
   libgoogle-glog-dev   # Ceres' logging; the CLI silences it
   libnlopt-cxx-dev     # bounded minimisation engine
   libsundials-dev      # KINSOL: reference solver compared in the same run
+  petsc-dev            # PETSc SNES: reference solver (libsundials-dev depends on it already)
   libcminpack-dev      # MINPACK hybrj: reference solver of the MGH suite
   libgsl-dev           # GSL hybridsj / gnewton: reference solvers of the MGH suite
   libboost-dev         # Boost.Odeint (integration, Rosenbrock), Boost.Math, Boost.Interval

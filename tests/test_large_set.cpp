@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "invalid_argument_message.hpp"
 #include "nlobs/reference/kinsol_solver.hpp"
 #include "nlobs/reference/problem_suite.hpp"
 #include "nlobs/registry/problem_sets.hpp"
@@ -31,16 +32,7 @@ std::string selection_error(const std::string& selector) {
   return "<accepted>";
 }
 
-// KinsolSolver refuses with std::invalid_argument (InvalidInput is one).
-template <typename F>
-std::string what_of(F&& f) {
-  try {
-    f();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "<no exception>";
-}
+using test::invalid_argument_of;
 
 std::map<std::string, Index> sizes(const std::vector<TestProblem>& problems) {
   std::map<std::string, Index> out;
@@ -269,7 +261,7 @@ TEST(LargeSet, KinsolRefusesABandItCannotStore) {
   o.strategy = reference::KinsolStrategy::kNewtonLineSearch;
   o.linear_solver = reference::KinsolLinearSolver::kBand;
   o.lower_bandwidth = o.upper_bandwidth = 1000;
-  const std::string m = what_of([&] {
+  const std::string m = invalid_argument_of([&] {
     reference::KinsolSolver(1'000'000, o,
                             [](const Eigen::VectorXd& x, Eigen::VectorXd& y) { y = x; });
   });
@@ -317,22 +309,24 @@ TEST(LargeSet, KinsolRefusesABadBandOrPattern) {
   o.strategy = reference::KinsolStrategy::kNewtonLineSearch;
   o.linear_solver = reference::KinsolLinearSolver::kBand;
   o.lower_bandwidth = 4;  // n = 4: widths 0 .. 3
-  EXPECT_NE(what_of([&] { reference::KinsolSolver(4, o, f); }).find("lower bandwidth 4"),
-            std::string::npos);
+  EXPECT_NE(
+      invalid_argument_of([&] { reference::KinsolSolver(4, o, f); }).find("lower bandwidth 4"),
+      std::string::npos);
   o.linear_solver = reference::KinsolLinearSolver::kKlu;
-  EXPECT_NE(what_of([&] { reference::KinsolSolver(4, o, f); }).find("values function"),
+  EXPECT_NE(invalid_argument_of([&] { reference::KinsolSolver(4, o, f); }).find("values function"),
             std::string::npos);
   reference::KinsolSparseJacobian bad;
   bad.row_starts = {0, 1, 2, 3, 4};
   bad.columns = {0, 1, 7, 3};  // a column outside 0 .. 3
   bad.values = [](const Eigen::VectorXd&, const Eigen::VectorXd&, double*) {};
-  EXPECT_NE(what_of([&] { reference::KinsolSolver(4, o, f, {}, bad); }).find("row 2"),
+  EXPECT_NE(invalid_argument_of([&] { reference::KinsolSolver(4, o, f, {}, bad); }).find("row 2"),
             std::string::npos);
   bad.row_starts = {0, 100, 2, 3, 4};  // past the columns listed: never read
-  EXPECT_NE(what_of([&] { reference::KinsolSolver(4, o, f, {}, bad); }).find("row_starts"),
-            std::string::npos);
+  EXPECT_NE(
+      invalid_argument_of([&] { reference::KinsolSolver(4, o, f, {}, bad); }).find("row_starts"),
+      std::string::npos);
   bad.row_starts = {0, 1, 2, 3};  // n + 1 = 5 needed
-  EXPECT_NE(what_of([&] { reference::KinsolSolver(4, o, f, {}, bad); }).find("n + 1"),
+  EXPECT_NE(invalid_argument_of([&] { reference::KinsolSolver(4, o, f, {}, bad); }).find("n + 1"),
             std::string::npos);
 }
 

@@ -13,6 +13,7 @@
 
 #include "nlobs/common/printable.hpp"
 #include "nlobs/reference/kinsol_solver.hpp"
+#include "nlobs/reference/petsc_solver.hpp"
 #include "nlobs/reference/root_reference.hpp"
 #include "nlobs/reference/timing.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
@@ -20,6 +21,7 @@
 #include "nlobs/solvers/sparse/pattern_bandwidths.hpp"
 #include "nlobs/solvers/sparse/sparse_jacobian.hpp"
 #include "nlobs/solvers/sparse/sparsity_pattern.hpp"
+#include "petsc_option_rules.hpp"
 
 namespace nlobs::reference {
 namespace {
@@ -65,6 +67,7 @@ constexpr double kTimingNs = 1e6;
 constexpr long kMaxTimedCalls = 201;
 
 bool is_reference(const std::string& s) {
+  if (PetscSnesSolver::is_name(s)) return true;  // any petsc:TYPE[:-key=value...]
   const auto refs = all_reference_solvers();
   return std::find(refs.begin(), refs.end(), s) != refs.end();
 }
@@ -281,6 +284,55 @@ KinsolSparseJacobian kinsol_sparse_jacobian(const TestProblem& problem, const Ei
   return out;
 }
 
+// PETSc SNES as its drivers run it with -snes_fd_color: PETSc's coloured differences on F's
+// pattern (declared or detected; a dense pattern without one, n ≤ kMaxProblemDimension), its
+// defaults otherwise (newtonls: bt line search, GMRES + ILU(0)); converged at ‖F‖₂ ≤ 1e-10 as
+// KINSOL at ‖F‖∞ ≤ 1e-10. PETSc takes neither the problem's scaling nor its box.
+Outcome run_petsc(const std::string& solver, const TestProblem& problem,
+                  const RootProblem<Dynamic>& residual, Eigen::VectorXd& x, long budget) {
+  PetscSnesOptions o = PetscSnesSolver::parse_name(solver);
+  o.absolute_tolerance = 1e-10;
+  o.max_iterations = std::min<long>(budget, std::numeric_limits<int>::max());
+  o.max_evaluations = budget;
+  PetscPattern pattern;
+  if (const SparseJacobianSource* source = problem.residual.sparse_jacobian(x)) {
+    pattern.row_starts.assign(source->pattern->row_start.begin(), source->pattern->row_start.end());
+    pattern.columns.assign(source->pattern->columns.begin(), source->pattern->columns.end());
+  } else if (residual.size() > kMaxProblemDimension) {
+    throw std::invalid_argument(
+        solver + " needs F's sparse pattern at n = " + std::to_string(residual.size()) + " (" +
+        problem.residual.sparse_jacobian_note() + ")");
+  }
+  const RootProblem<Dynamic>* f = &residual;
+  PetscSnesSolver snes(
+      static_cast<int>(residual.size()), std::move(o),
+      [f](const Eigen::VectorXd& v, Eigen::VectorXd& out) { f->evaluate(v, out); },
+      std::move(pattern));
+  const PetscSnesResult r = snes.solve(x);
+  std::string message = r.error.empty() ? r.reason_text : r.error;
+  if (!r.reason_name.empty() && !r.success) {
+    message = r.reason_name + (message.empty() ? "" : ": " + message);
+  }
+  return {r.status(), r.evaluations, r.jacobian_evaluations, message};
+}
+
+// MPI's start and PETSc's first use of each of its types (their registration, ~10 ms) happen
+// here, untimed: one solve of a 2-unknown system with the name's type and options (its printing
+// viewers left out). A failure here is the row's to report.
+void warm_up_petsc(const std::string& name) {
+  initialize_petsc();
+  try {
+    PetscSnesOptions o = PetscSnesSolver::parse_name(name);
+    std::erase_if(o.options, [](const auto& kv) { return petsc_rules::names_a_viewer(kv.first); });
+    PetscSnesSolver snes(2, std::move(o), [](const Eigen::VectorXd& v, Eigen::VectorXd& f) {
+      f = v.array() * v.array() - 1.0;
+    });
+    Eigen::VectorXd x = Eigen::VectorXd::Constant(2, 2.0);
+    (void)snes.solve(x);
+  } catch (...) {
+  }
+}
+
 // The references that keep dense n×n matrices: not run above kMaxProblemDimension.
 bool dense_reference(const std::string& solver) {
   return solver == "minpack:hybrj" || solver == "gsl:hybridsj" || solver == "gsl:gnewton" ||
@@ -299,6 +351,7 @@ Outcome run_reference(const std::string& solver, const TestProblem& problem,
         ", above " + std::to_string(kMaxProblemDimension) +
         " (kinsol:newton-band, -klu and -spgmr are KINSOL's sparse forms)");
   }
+  if (PetscSnesSolver::is_name(solver)) return run_petsc(solver, problem, residual, x, budget);
   ReferenceOptions o;
   o.max_evaluations = budget;
   if (solver == "minpack:hybrj") {
@@ -421,6 +474,9 @@ std::vector<std::string> all_reference_solvers() {
                            "kinsol:newton-spgmr"}) {
     s.emplace_back(more);
   }
+  if (petsc_available()) {
+    for (const std::string& name : PetscSnesSolver::names()) s.push_back(name);
+  }
   return s;
 }
 
@@ -476,6 +532,11 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
   base.stop.residual_tolerance = 1e-10;
   // Validate every name and start label before running anything.
   for (const std::string& s : solvers) {
+    if (PetscSnesSolver::is_name(s)) {
+      (void)PetscSnesSolver::parse_name(s);  // its syntax now; PETSc's own refusals in its row
+      if (petsc_available()) warm_up_petsc(s);
+      continue;
+    }
     if (is_reference(s)) continue;
     try {
       (void)registry.create(s, base);

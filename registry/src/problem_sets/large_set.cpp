@@ -144,7 +144,10 @@ ProblemSetEntry large_problem_set() {
           .default_solvers = {"newton", "newton:linesearch=1", "newton:linesearch=1,reuse=10",
                               "newton:linesearch=1,linear=gmres,preconditioner=ilu0",
                               "pseudo-transient:growth=1.1", "auto", "anderson",
-                              "kinsol:newton-band", "kinsol:newton-klu", "kinsol:newton-spgmr"}};
+                              "kinsol:newton-band", "kinsol:newton-klu", "kinsol:newton-spgmr",
+                              // PETSc's SNES ex5 form (-snes_fd_color); invalid_input rows in a
+                              // build without PETSc
+                              "petsc:newtonls"}};
 }
 
 }  // namespace nlobs

@@ -86,7 +86,9 @@ std::vector<std::string> reference_suite_solvers();
 // kinsol:newton-klu (F's sparse Jacobian, declared or detected; invalid_input without one) and
 // kinsol:newton-spgmr (difference-quotient J·v, no preconditioner). The dense references
 // (minpack:hybrj, gsl:*, kinsol:newton) are not run above kMaxProblemDimension unknowns: their
-// rows are invalid_input, saying why.
+// rows are invalid_input, saying why. With PETSc (petsc_available()): PETSc's SNES as
+// petsc:newtonls, newtontr, ngmres, anderson, qn and nrichardson (petsc_solver.hpp: PETSc's
+// coloured differences on F's pattern); run_suite also takes any petsc:TYPE[:-key=value...].
 std::vector<std::string> all_reference_solvers();
 
 // The threshold `options` give for `set` (its own when options leave it NaN); InvalidInput for
