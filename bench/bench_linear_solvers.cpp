@@ -19,15 +19,16 @@ namespace {
 
 using nlobs::Index;
 
-constexpr std::array<const char*, 9> kSolvers = {"dense-lu",
-                                                 "band-lu",
-                                                 "sparse-lu",
-                                                 "klu",
-                                                 "gmres",
-                                                 "gmres:preconditioner=jacobi",
-                                                 "gmres:preconditioner=ilu0",
-                                                 "gmres:preconditioner=ilut",
-                                                 "bicgstab:preconditioner=ilu0"};
+constexpr std::array<const char*, 10> kSolvers = {"dense-lu",
+                                                  "band-lu",
+                                                  "sparse-lu",
+                                                  "klu",
+                                                  "gmres",
+                                                  "gmres:preconditioner=jacobi",
+                                                  "gmres:preconditioner=ilu0",
+                                                  "gmres:preconditioner=ilut",
+                                                  "bicgstab:preconditioner=ilu0",
+                                                  "umfpack"};
 
 // J = ∂f(x) by the compressed AD path, the pattern detected at x.
 template <typename F>
@@ -74,16 +75,16 @@ void BM_LinearSolveBratu(benchmark::State& state) {
 // Grid side s (n = s²): 32 (≈ 10³), 100 (10⁴), 316 (≈ 10⁵); dense LU only at s = 32, band LU
 // (width s, O(s³·s) = O(n²) work) up to 10⁴.
 BENCHMARK(BM_LinearSolveBratu)
-    ->ArgsProduct({{0, 1, 2, 3, 4, 5, 6, 7, 8}, {32}})
-    ->ArgsProduct({{1, 2, 3, 4, 5, 6, 7, 8}, {100}})
-    ->ArgsProduct({{2, 3, 5, 6, 7, 8}, {316}})
+    ->ArgsProduct({{0, 1, 2, 3, 4, 5, 6, 7, 8, 9}, {32}})
+    ->ArgsProduct({{1, 2, 3, 4, 5, 6, 7, 8, 9}, {100}})
+    ->ArgsProduct({{2, 3, 5, 6, 7, 8, 9}, {316}})
     ->Unit(benchmark::kMillisecond);
 
 void BM_LinearSolveBroydenTridiagonal(benchmark::State& state) {
   run(state, broyden_tridiagonal_jacobian(state.range(1)));
 }
 BENCHMARK(BM_LinearSolveBroydenTridiagonal)
-    ->ArgsProduct({{1, 2, 3, 6}, {10000, 100000, 1000000}})
+    ->ArgsProduct({{1, 2, 3, 6, 9}, {10000, 100000, 1000000}})
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace

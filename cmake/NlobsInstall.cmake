@@ -32,6 +32,7 @@ write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/nlobsConfigVersion.
                                  COMPATIBILITY SameMinorVersion)
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/nlobsConfig.cmake ${PROJECT_SOURCE_DIR}/cmake/FindADOLC.cmake
               ${PROJECT_SOURCE_DIR}/cmake/FindKLU.cmake
+              ${PROJECT_SOURCE_DIR}/cmake/FindUMFPACK.cmake
               ${PROJECT_SOURCE_DIR}/cmake/NlobsPlugin.cmake
               ${CMAKE_CURRENT_BINARY_DIR}/nlobsConfigVersion.cmake
         DESTINATION ${NLOBS_CMAKE_DIR})

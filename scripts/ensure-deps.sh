@@ -12,7 +12,7 @@ packages=(
   time                 # /usr/bin/time: scripts/compile-cost's per-unit wall time and memory
   libeigen3-dev        # linear algebra, fixed-size vectors
   libceres-dev         # ceres::Jet forward-mode AD, least-squares engine (Ceres, TinySolver)
-  libsuitesparse-dev   # KLU: the sparse direct linear solver (solvers/linear/klu.hpp)
+  libsuitesparse-dev   # KLU, UMFPACK: the sparse direct linear solvers (solvers/linear/)
   libgoogle-glog-dev   # Ceres' logging; the CLI silences it
   libnlopt-cxx-dev     # bounded minimisation engine
   libsundials-dev      # KINSOL: reference solver compared in the same run

@@ -25,6 +25,7 @@
 #include "nlobs/solvers/linear/preconditioners.hpp"
 #include "nlobs/solvers/linear/sparse_lu.hpp"
 #include "nlobs/solvers/sparse/compressed_jacobian.hpp"
+#include "nlobs/solvers/sparse/sparsity_pattern.hpp"
 #include "test_support.hpp"
 
 namespace nlobs {
@@ -102,6 +103,8 @@ const std::vector<std::string> kEverySolver = {"dense-lu",
                                                "band-lu",
                                                "sparse-lu",
                                                "klu",
+                                               "umfpack",
+                                               "umfpack:ordering=metis",
                                                "gmres",
                                                "gmres:preconditioner=jacobi",
                                                "gmres:preconditioner=ilu0",
@@ -219,6 +222,68 @@ TEST(KluSolver, RefactorsWithTheLastPivotOrderAndFactorsAfreshWhenItGoesBad) {
   EXPECT_NEAR(x[1], 1.0, 1e-14);
 }
 
+// A 5-point operator with unsymmetric, solution-dependent values, as a 2-D Newton step gives:
+// UMFPACK keeps its analysis across values of one pattern, takes a new pattern afresh, and
+// agrees with dense LU (and so with KLU) each time.
+TEST(UmfpackSolver, KeepsItsAnalysisForOnePatternAndAgreesWithDenseLu) {
+  const Index s = 30, n = s * s;
+  const auto grid = [&](double shift, bool extra) {
+    std::vector<Eigen::Triplet<double, int>> t;
+    for (Index r = 0; r < s; ++r) {
+      for (Index c = 0; c < s; ++c) {
+        const int p = static_cast<int>(r * s + c);
+        t.emplace_back(p, p, 4.0 + shift + 0.01 * static_cast<double>(p % 7));
+        if (r > 0) t.emplace_back(p, p - static_cast<int>(s), -1.0 - shift);
+        if (r + 1 < s) t.emplace_back(p, p + static_cast<int>(s), -0.9);
+        if (c > 0) t.emplace_back(p, p - 1, -1.2);
+        if (c + 1 < s) t.emplace_back(p, p + 1, -0.8 + shift);
+        if (extra && p + 2 * static_cast<int>(s) < static_cast<int>(n)) {
+          t.emplace_back(p, p + 2 * static_cast<int>(s), 0.3);
+        }
+      }
+    }
+    SparseJacobian jac(n, n);
+    jac.setFromTriplets(t.begin(), t.end());
+    jac.makeCompressed();
+    return jac;
+  };
+  const Vector<Dynamic> b = random_vector(n, 5);
+  for (const char* spec : {"umfpack", "umfpack:ordering=metis"}) {
+    std::unique_ptr<LinearSolver> solver = make_linear_solver(spec);
+    for (const auto& [shift, extra] : {std::pair{0.0, false}, {0.5, false}, {0.5, true}}) {
+      const SparseJacobian jac = grid(shift, extra);
+      ASSERT_EQ(solver->setup(jac), LinearStatus::kSolved) << spec << ": " << solver->message();
+      Vector<Dynamic> x;
+      ASSERT_EQ(solver->solve(b, x, 0.0), LinearStatus::kSolved) << solver->message();
+      const Vector<Dynamic> expected = dense_solution(jac, b);
+      EXPECT_LE((x - expected).norm(), 1e-10 * expected.norm()) << spec << " shift " << shift;
+    }
+    EXPECT_EQ(solver->stats().setups, 3);
+    EXPECT_EQ(solver->stats().failures, 0);
+  }
+}
+
+// auto's choice by pattern and size: a narrow band is band-lu at any size; a wide one (the
+// 5-point stencil's width is the grid's side) is klu below kAutoMultifrontalSize and umfpack
+// from there; a named solver is kept.
+TEST(ChooseLinearSolver, TakesUmfpackForWideBandsFromTwentyThousandUnknowns) {
+  const auto five_point = [](Index s) {
+    std::vector<std::pair<Index, Index>> e;
+    for (Index p = 0; p < s * s; ++p) {
+      e.emplace_back(p, p);
+      if (p >= s) e.emplace_back(p, p - s);
+      if (p + s < s * s) e.emplace_back(p, p + s);
+    }
+    return SparsityPattern::from_entries(s * s, s * s, e);
+  };
+  EXPECT_EQ(choose_linear_solver("auto", SparsityPattern::band(100000, 1, 1), 100000), "band-lu");
+  EXPECT_EQ(choose_linear_solver("auto", five_point(100), 10000), "klu");
+  EXPECT_EQ(choose_linear_solver("auto", five_point(141), 141 * 141), "klu");      // 19 881
+  EXPECT_EQ(choose_linear_solver("auto", five_point(142), 142 * 142), "umfpack");  // 20 164
+  EXPECT_EQ(choose_linear_solver("klu", five_point(142), 142 * 142), "klu");
+  static_assert(141 * 141 < kAutoMultifrontalSize && 142 * 142 >= kAutoMultifrontalSize);
+}
+
 TEST(DirectSolvers, ReportASingularJacobianWithTheirMessage) {
   // Row 2 is zero: structurally singular.
   Triplets entries;
@@ -236,7 +301,7 @@ TEST(DirectSolvers, ReportASingularJacobianWithTheirMessage) {
                                                       {1, 1, 0.7 * third},
                                                       {2, 2, 3.0},
                                                       {1, 2, 0.0}});
-  for (const std::string name : {"dense-lu", "band-lu", "sparse-lu", "klu"}) {
+  for (const std::string name : {"dense-lu", "band-lu", "sparse-lu", "klu", "umfpack"}) {
     for (const SparseJacobian* jac : {&zero_row, &equal_rows}) {
       std::unique_ptr<LinearSolver> solver = make_linear_solver(name);
       EXPECT_EQ(solver->setup(*jac), LinearStatus::kSingular) << name << ": " << solver->message();
@@ -257,7 +322,7 @@ TEST(DirectSolvers, JudgeSingularityAfterEquilibratingRows) {
   for (Index i = 0; i < jac.rows(); ++i) jac.row(i) *= std::pow(10.0, i % 2 == 0 ? 15.0 : -15.0);
   const Vector<Dynamic> b = random_vector(40, 22);
   const Vector<Dynamic> expected = dense_solution(jac, b);
-  for (const std::string name : {"dense-lu", "band-lu", "sparse-lu", "klu"}) {
+  for (const std::string name : {"dense-lu", "band-lu", "sparse-lu", "klu", "umfpack"}) {
     std::unique_ptr<LinearSolver> solver = make_linear_solver(name);
     ASSERT_EQ(solver->setup(jac), LinearStatus::kSolved) << name << ": " << solver->message();
     Vector<Dynamic> x;
@@ -545,7 +610,10 @@ TEST(LinearSolverOptions, AreValidatedWhereTheyAreBuilt) {
   EXPECT_THROW(IlutPreconditioner(IlutOptions{.fill_factor = 0}), InvalidInput);
   EXPECT_EQ(test::message_of([] { make_linear_solver("cholesky"); }),
             "linear solver 'cholesky' is unknown; valid: dense-lu, band-lu, sparse-lu, klu, "
-            "gmres, bicgstab");
+            "umfpack, gmres, bicgstab");
+  EXPECT_EQ(test::message_of([] { make_linear_solver("umfpack:ordering=colamd"); }),
+            "linear solver umfpack: ordering 'colamd' is unknown; valid: amd, metis");
+  EXPECT_THROW(make_linear_solver("umfpack:drop_tolerance=0.1"), InvalidInput);
   EXPECT_THROW(make_linear_solver("gmres:restart=0"), InvalidInput);
   EXPECT_THROW(make_linear_solver("gmres:preconditioner=amg"), InvalidInput);
   EXPECT_THROW(make_linear_solver("gmres:tolerance=1e-3"), InvalidInput);

@@ -195,6 +195,22 @@ TEST(SparsePseudoTransient, IsReachableByEngineSpec) {
       InvalidInput);
   EXPECT_THROW(registry.create("pseudo-transient:linear=nonsense", test::residual_stop(1e-9, 200)),
                InvalidInput);
+  // UMFPACK's ordering, by spec; ordering= belongs to linear=umfpack only.
+  for (const char* spec : {"pseudo-transient:linear=umfpack,ordering=metis",
+                           "newton:linesearch=1,linear=umfpack,ordering=metis"}) {
+    auto by_spec = registry.create(spec, test::residual_stop(1e-9, 200));
+    Vector<Dynamic> y = Vector<Dynamic>::Zero(n);
+    const Summary u =
+        by_spec->solve(to_fixed_point(RootProblem<>::with_autodiff(test::bratu(s), n, n)), y);
+    ASSERT_EQ(u.status, Status::kConverged) << spec << ": " << u.message;
+    EXPECT_EQ(u.linear_solver, "umfpack") << spec;
+  }
+  EXPECT_NE(test::message_of([&] {
+              registry.create("newton:linear=klu,ordering=metis", test::residual_stop(1e-9, 9));
+            }).find("ordering=metis needs linear=umfpack"),
+            std::string::npos);
+  EXPECT_THROW(registry.create("newton:linear=umfpack,ordering=rcm", test::residual_stop(1e-9, 9)),
+               InvalidInput);
 }
 
 TEST(SparseAuto, RunsOnlyTheStagesWithASparsePathOnALargeSparseProblem) {

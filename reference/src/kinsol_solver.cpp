@@ -88,6 +88,33 @@ struct KinsolSolver::Impl {
     }
     return 0;
   }
+  static int preconditioner_setup(N_Vector u_vec, N_Vector u_scale_vec, N_Vector f_vec,
+                                  N_Vector f_scale_vec, void* data) {
+    auto* self = static_cast<Impl*>(data);
+    const auto map = [n = self->n](N_Vector v) {
+      return KinsolPreconditioner::ConstVector(N_VGetArrayPointer(v), n);
+    };
+    try {
+      return self->options.preconditioner.setup(map(u_vec), map(u_scale_vec), map(f_vec),
+                                                map(f_scale_vec));
+    } catch (...) {
+      return -1;
+    }
+  }
+  static int preconditioner_solve(N_Vector u_vec, N_Vector u_scale_vec, N_Vector f_vec,
+                                  N_Vector f_scale_vec, N_Vector v_vec, void* data) {
+    auto* self = static_cast<Impl*>(data);
+    const auto map = [n = self->n](N_Vector v) {
+      return KinsolPreconditioner::ConstVector(N_VGetArrayPointer(v), n);
+    };
+    try {
+      return self->options.preconditioner.solve(
+          map(u_vec), map(u_scale_vec), map(f_vec), map(f_scale_vec),
+          Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(v_vec), self->n));
+    } catch (...) {
+      return -1;
+    }
+  }
   static void silent(int, const char*, const char*, char*, void*) {}
 
   // Frees what the constructor made, also when it threw half-way (a failed allocation).
@@ -133,7 +160,8 @@ struct KinsolSolver::Impl {
         linear_solver = SUNLinSol_KLU(u, matrix, context);
         break;
       case KinsolLinearSolver::kSpgmr:
-        linear_solver = SUNLinSol_SPGMR(u, SUN_PREC_NONE, 15, context);
+        linear_solver = SUNLinSol_SPGMR(
+            u, options.preconditioner.solve ? SUN_PREC_RIGHT : SUN_PREC_NONE, 15, context);
         if (linear_solver) check(SUNLinSol_SPGMRSetMaxRestarts(linear_solver, 2), "restarts");
         break;
     }
@@ -147,6 +175,10 @@ struct KinsolSolver::Impl {
     }
     if (options.linear_solver == KinsolLinearSolver::kKlu) {
       check(KINSetJacFn(kinsol, &Impl::sparse_jacobian), "KINSetJacFn");
+    }
+    if (options.linear_solver == KinsolLinearSolver::kSpgmr && options.preconditioner.solve) {
+      check(KINSetPreconditioner(kinsol, &Impl::preconditioner_setup, &Impl::preconditioner_solve),
+            "KINSetPreconditioner");
     }
     check(KINSetMaxSetupCalls(kinsol, options.max_setup_calls), "KINSetMaxSetupCalls");
     check(KINSetMaxSubSetupCalls(kinsol, options.max_sub_setup_calls), "KINSetMaxSubSetupCalls");
@@ -229,6 +261,30 @@ KinsolSolver::KinsolSolver(int n, KinsolOptions options, Function function, Jaco
   if (options.max_iterations < 1) {
     throw std::invalid_argument("KinsolOptions::max_iterations must be >= 1");
   }
+  if (!(options.step_tolerance >= 0.0 && std::isfinite(options.step_tolerance))) {
+    throw std::invalid_argument("KinsolOptions::step_tolerance must be finite and >= 0");
+  }
+  const bool newton = options.strategy == KinsolStrategy::kNewtonLineSearch;
+  if (options.constraints.size() != 0) {
+    if (!newton || options.constraints.size() != n) {
+      throw std::invalid_argument("KinsolOptions::constraints: for Newton, empty or of size n = " +
+                                  std::to_string(n));
+    }
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double c = options.constraints[i];
+      if (c != 0.0 && c != 1.0 && c != 2.0 && c != -1.0 && c != -2.0) {
+        throw std::invalid_argument("KinsolOptions::constraints[" + std::to_string(i) +
+                                    "] is not one of 0, 1, 2, -1, -2");
+      }
+    }
+  }
+  if (static_cast<bool>(options.preconditioner.setup) !=
+          static_cast<bool>(options.preconditioner.solve) ||
+      (options.preconditioner.solve &&
+       !(newton && options.linear_solver == KinsolLinearSolver::kSpgmr))) {
+    throw std::invalid_argument(
+        "KinsolOptions::preconditioner: both setup and solve, and only with kinsol:newton-spgmr");
+  }
   for (const auto& [scale, name] :
        {std::pair{&options.u_scale, "u_scale"}, std::pair{&options.f_scale, "f_scale"}}) {
     if (scale->size() != 0 && scale->size() != n) {
@@ -277,7 +333,17 @@ KinsolSolver::KinsolSolver(int n, KinsolOptions options, Function function, Jaco
   s.check(KINInit(s.kinsol, &Impl::residual, s.u), "KINInit");
   s.check(KINSetUserData(s.kinsol, &s), "KINSetUserData");
   s.check(KINSetFuncNormTol(s.kinsol, options.tolerance), "KINSetFuncNormTol");
-  s.check(KINSetScaledStepTol(s.kinsol, options.tolerance), "KINSetScaledStepTol");
+  s.check(KINSetScaledStepTol(
+              s.kinsol, options.step_tolerance > 0.0 ? options.step_tolerance : options.tolerance),
+          "KINSetScaledStepTol");
+  if (options.constraints.size() == n) {
+    N_Vector constraints = N_VNew_Serial(n, s.context);
+    if (!constraints) throw std::bad_alloc();
+    Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(constraints), n) = options.constraints;
+    const int flag = KINSetConstraints(s.kinsol, constraints);  // KINSOL keeps a copy
+    N_VDestroy(constraints);
+    s.check(flag, "KINSetConstraints");
+  }
   s.check(KINSetNumMaxIters(s.kinsol, options.max_iterations), "KINSetNumMaxIters");
   if (options.strategy == KinsolStrategy::kNewtonLineSearch) s.attach_linear_solver();
 }
@@ -288,8 +354,9 @@ KinsolResult KinsolSolver::solve(Eigen::VectorXd& x) {
   Impl& s = *impl_;
   if (x.size() != s.n) throw std::invalid_argument("KinsolSolver::solve: wrong size");
   Eigen::Map<Eigen::VectorXd>(N_VGetArrayPointer(s.u), s.n) = x;
-  const int strategy =
-      s.options.strategy == KinsolStrategy::kNewtonLineSearch ? KIN_LINESEARCH : KIN_FP;
+  const int strategy = s.options.strategy != KinsolStrategy::kNewtonLineSearch ? KIN_FP
+                       : s.options.line_search                                 ? KIN_LINESEARCH
+                                                                               : KIN_NONE;
   if (s.options.strategy == KinsolStrategy::kNewtonLineSearch) {
     s.check(KINSetMaxNewtonStep(s.kinsol, s.options.max_newton_step), "KINSetMaxNewtonStep");
   }
@@ -303,6 +370,12 @@ KinsolResult KinsolSolver::solve(Eigen::VectorXd& x) {
   KINGetNumNonlinSolvIters(s.kinsol, &r.iterations);
   if (s.matrix) KINGetNumJacEvals(s.kinsol, &r.jacobian_evaluations);
   if (s.linear_solver) KINGetNumLinIters(s.kinsol, &r.linear_iterations);
+  if (s.linear_solver && s.options.linear_solver == KinsolLinearSolver::kSpgmr) {
+    KINGetNumLinFuncEvals(s.kinsol, &r.product_evaluations);
+    KINGetNumPrecEvals(s.kinsol, &r.preconditioner_setups);
+    KINGetNumPrecSolves(s.kinsol, &r.preconditioner_solves);
+    KINGetNumLinConvFails(s.kinsol, &r.linear_convergence_failures);
+  }
   x = Eigen::Map<const Eigen::VectorXd>(N_VGetArrayPointer(s.u), s.n);
   // Judge the returned point ourselves (one more evaluation, counted).
   r.residual = std::numeric_limits<double>::infinity();

@@ -11,6 +11,7 @@
 #include "nlobs/solvers/linear/klu.hpp"
 #include "nlobs/solvers/linear/preconditioners.hpp"
 #include "nlobs/solvers/linear/sparse_lu.hpp"
+#include "nlobs/solvers/linear/umfpack.hpp"
 #include "nlobs/solvers/sparse/pattern_bandwidths.hpp"
 #include "nlobs/solvers/sparse/sparsity_pattern.hpp"
 
@@ -62,6 +63,7 @@ std::vector<std::pair<std::string, std::string>> linear_solver_names() {
       {"band-lu", "band LU with partial pivoting (LAPACK dgbtf2): widths from J or lower=,upper="},
       {"sparse-lu", "Eigen's supernodal SparseLU, COLAMD ordering"},
       {"klu", "SuiteSparse KLU (BTF + AMD), refactoring with the last pivot order"},
+      {"umfpack", "SuiteSparse UMFPACK, multifrontal (BLAS 3); ordering=amd (default) or metis"},
       {"gmres", "restarted GMRES(m), right-preconditioned"},
       {"bicgstab", "BiCGSTAB, right-preconditioned"}};
 }
@@ -74,6 +76,17 @@ std::unique_ptr<LinearSolver> make_linear_solver(std::string_view text) {
     if (spec.name == "dense-lu") return std::make_unique<DenseLuSolver>();
     if (spec.name == "sparse-lu") return std::make_unique<SparseLuSolver>();
     return std::make_unique<KluSolver>();
+  }
+  if (spec.name == "umfpack") {
+    EngineSpecReader reader(spec, {{"ordering", "amd (default) or metis (nested dissection)"}});
+    const std::string ordering = reader.text("ordering").value_or("amd");
+    reader.finish();
+    if (ordering != "amd" && ordering != "metis") {
+      throw InvalidInput("linear solver umfpack: ordering '" + ordering +
+                         "' is unknown; valid: amd, metis");
+    }
+    return std::make_unique<UmfpackSolver>(ordering == "metis" ? UmfpackOrdering::kMetis
+                                                               : UmfpackOrdering::kAmd);
   }
   if (spec.name == "band-lu") {
     EngineSpecReader reader(spec, {{"lower", "lower bandwidth, >= 0 (with upper; default: J's)"},
@@ -123,7 +136,8 @@ std::string choose_linear_solver(const std::string& requested, const SparsityPat
   }
   if (requested != "auto") return requested;
   const PatternBandwidths band = pattern_bandwidths(pattern);
-  return std::max(band.lower, band.upper) <= kAutoBandWidth ? "band-lu" : "klu";
+  if (std::max(band.lower, band.upper) <= kAutoBandWidth) return "band-lu";
+  return n >= kAutoMultifrontalSize ? "umfpack" : "klu";
 }
 
 }  // namespace nlobs

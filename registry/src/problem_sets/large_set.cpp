@@ -114,12 +114,79 @@ TestProblem laplace2d(Index wanted) {
   return p;
 }
 
+// kinFoodWeb_kry's constants (SUNDIALS examples/kinsol/serial/kinFoodWeb_kry.c): AA, EE, GG, BB,
+// DPREY, DPRED, ALPHA; 6 species, 3 prey and 3 predators.
+constexpr Index kSpecies = 6, kPrey = 3;
+constexpr double kFoodWebAA = 1.0, kFoodWebEE = 1e4, kFoodWebGG = 0.5e-6, kFoodWebBB = 1.0;
+constexpr double kFoodWebDPrey = 1.0, kFoodWebDPred = 0.5, kFoodWebAlpha = 1.0;
+
+// kinFoodWeb_kry: 0 = d_i Δc_i + c_i (b_i (1 + α x y) + Σ_j a_ij c_j) on an m × m mesh of the
+// unit square, zero normal derivative (a mirrored neighbour outside), species interleaved at
+// each point as the example stores them: c[s + 6 (jx + m jy)]. Every operation in the example's
+// order (its WebRate's dot product over all six species, its one-sided differences), so that
+// KINSOL reproduces the example's published counts on it to the iteration.
+TestProblem food_web(Index wanted) {
+  const Index m = std::max<Index>(
+      2, static_cast<Index>(std::llround(std::sqrt(static_cast<double>(wanted) / kSpecies))));
+  const double d = 1.0 / static_cast<double>(m - 1);
+  auto f = [m, d](const auto& c, auto& out) {
+    using T = typename std::decay_t<decltype(c)>::Scalar;
+    for (Index jy = 0; jy < m; ++jy) {
+      const double y = d * static_cast<double>(jy);
+      const Index down = jy > 0 ? -m : m, up = jy + 1 < m ? m : -m;  // in points
+      for (Index jx = 0; jx < m; ++jx) {
+        const double x = d * static_cast<double>(jx);
+        const Index left = jx > 0 ? -1 : 1, right = jx + 1 < m ? 1 : -1;
+        const Index base = kSpecies * (jx + m * jy);
+        const double growth = 1.0 + kFoodWebAlpha * x * y;
+        for (Index s = 0; s < kSpecies; ++s) {
+          const Index k = base + s;
+          const bool prey = s < kPrey;
+          // Σ_j a_sj c_j, j = 0 … 5: a_ss = −AA; −GG on the predators (prey s), EE on the prey
+          // (predator s); 0 elsewhere (its terms add nothing, and are left out).
+          T dot = T(0.0);
+          for (Index j = 0; j < kSpecies; ++j) {
+            if (j == s) {
+              dot = dot + c[base + j] * -kFoodWebAA;
+            } else if (prey && j >= kPrey) {
+              dot = dot + c[base + j] * -kFoodWebGG;
+            } else if (!prey && j < kPrey) {
+              dot = dot + c[base + j] * kFoodWebEE;
+            }
+          }
+          const T rate = c[k] * ((prey ? kFoodWebBB : -kFoodWebBB) * growth + dot);
+          const double diffusion = (prey ? kFoodWebDPrey : kFoodWebDPred) / (d * d);
+          const T below = c[k] - c[k + kSpecies * down], above = c[k + kSpecies * up] - c[k];
+          const T west = c[k] - c[k + kSpecies * left], east = c[k + kSpecies * right] - c[k];
+          out[k] = diffusion * (above - below) + diffusion * (east - west) + rate;
+        }
+      }
+    }
+  };
+  const Index n = kSpecies * m * m;
+  Eigen::VectorXd start(n), scale(n);
+  for (Index k = 0; k < n; ++k) {
+    const bool prey = k % kSpecies < kPrey;
+    start[k] = prey ? 1.0 : 30000.0;
+    scale[k] = prey ? 1.0 : 1e-5;
+  }
+  TestProblem p = root_test_problem("food-web", n, f, {{"x0", start}});
+  p.u_scale = scale;  // as the example: sc for both u_scale and f_scale
+  p.f_scale = scale;
+  p.lower = Eigen::VectorXd::Zero(n);  // KINSetConstraints(2): every concentration > 0
+  p.strict_lower = StrictBounds::Constant(n, true);
+  p.description = "predator-prey food web, 6 species on a " + std::to_string(m) + "x" +
+                  std::to_string(m) + " mesh (SUNDIALS kinFoodWeb_kry)";
+  return p;
+}
+
 std::vector<TestProblem> problems_of_size(Index n) {
   std::vector<TestProblem> out;
   out.push_back(broyden_tridiagonal(n));
   out.push_back(bratu2d(n));
   out.push_back(reaction_diffusion1d(n));
   out.push_back(laplace2d(n));
+  out.push_back(food_web(n));
   return out;
 }
 
@@ -129,14 +196,15 @@ ProblemSetEntry large_problem_set() {
   return {.name = "large",
           .description =
               "sparse systems of run-time size (large:n=K): Broyden tridiagonal, 2-D Bratu "
-              "(PETSc ex5), 1-D reaction-diffusion, kinLaplace_bnd (SUNDIALS)",
+              "(PETSc ex5), 1-D reaction-diffusion, kinLaplace_bnd and kinFoodWeb_kry (SUNDIALS)",
           .problems =
               [] {
                 std::vector<TestProblem> out;
                 out.push_back(broyden_tridiagonal(10'000));
                 out.push_back(bratu2d(10'000));
                 out.push_back(reaction_diffusion1d(10'000));
-                out.push_back(laplace2d(31 * 31));  // the example's own grid
+                out.push_back(laplace2d(31 * 31));   // the example's own grid
+                out.push_back(food_web(6 * 8 * 8));  // the example's own 8 x 8 mesh
                 return out;
               },
           .solved_threshold = 1e-8,

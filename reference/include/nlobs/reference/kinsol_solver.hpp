@@ -40,6 +40,19 @@ struct KinsolSparseJacobian {
   std::function<void(const Eigen::VectorXd& x, const Eigen::VectorXd& f, double* values)> values{};
 };
 
+// A preconditioner for kSpgmr, applied on the right (KINSetPreconditioner; SUN_PREC_RIGHT), as
+// KINSOL's Krylov examples give one. `setup` prepares P ≈ J at u (f = F(u), and the scales);
+// `solve` overwrites v with P⁻¹ v. Each returns 0 on success, > 0 for a recoverable failure
+// (KINSOL retries with a fresh setup), < 0 to stop. Neither may throw (a throw is a failure < 0).
+struct KinsolPreconditioner {
+  using ConstVector = Eigen::Map<const Eigen::VectorXd>;
+  std::function<int(ConstVector u, ConstVector u_scale, ConstVector f, ConstVector f_scale)>
+      setup{};
+  std::function<int(ConstVector u, ConstVector u_scale, ConstVector f, ConstVector f_scale,
+                    Eigen::Map<Eigen::VectorXd> v)>
+      solve{};
+};
+
 struct KinsolOptions {
   KinsolStrategy strategy = KinsolStrategy::kFixedPoint;
   KinsolLinearSolver linear_solver = KinsolLinearSolver::kDense;  // Newton only
@@ -55,6 +68,16 @@ struct KinsolOptions {
   // Jacobian early; 0: KINSOL's default, 5.
   long max_sub_setup_calls = 0;
   double tolerance = 1e-8;  // KINSOL's fnormtol (‖F‖∞, or ‖G(u)−u‖∞ for FP) and scsteptol
+  // KINSetScaledStepTol when > 0 (else `tolerance`): the scaled step ‖D_u Δu‖∞ that ends a run.
+  double step_tolerance = 0.0;
+  // Newton only: KIN_LINESEARCH (true), or KIN_NONE (false: full Newton steps, which KINSOL
+  // shortens only to keep the constraints, as kinFoodWeb_kry runs).
+  bool line_search = true;
+  // KINSetConstraints (Newton only): per unknown 0 (none), 1 (u ≥ 0), 2 (u > 0), −1 (u ≤ 0) or
+  // −2 (u < 0). Empty: none; otherwise of size n, each of those values.
+  Eigen::VectorXd constraints{};
+  // kSpgmr only: a preconditioner (both functions, or neither: none).
+  KinsolPreconditioner preconditioner{};
   int anderson_depth = 2;
   long max_iterations = 10000;  // KINSetNumMaxIters: KINSOL counts iterations, not evaluations
   // Every evaluation of F (or G) counts, the final check's included (KinsolResult::evaluations):
@@ -92,7 +115,13 @@ struct KinsolResult {
   long evaluations = 0;
   long jacobian_evaluations = 0;  // KINGetNumJacEvals (Newton on a matrix)
   long linear_iterations = 0;     // KINGetNumLinIters (Newton; SPGMR's Krylov iterations)
-  bool budget_spent = false;      // an evaluation beyond max_evaluations was refused
+  // kSpgmr: KINGetNumLinFuncEvals (evaluations of F for difference-quotient J·v, KINSOL's
+  // nfeSG, among `evaluations`), KINGetNumPrecEvals and KINGetNumPrecSolves (npe, nps),
+  // KINGetNumLinConvFails (ncfl).
+  long product_evaluations = 0;
+  long preconditioner_setups = 0, preconditioner_solves = 0;
+  long linear_convergence_failures = 0;
+  bool budget_spent = false;  // an evaluation beyond max_evaluations was refused
   // "converged", "non_finite" or "residual_above_tolerance" (flag >= 0 that does not stand);
   // "max_evaluations" (budget_spent), "max_iterations" (KIN_MAXITER_REACHED), "non_finite"
   // (KIN_FIRST_SYSFUNC_ERR, KIN_REPTD_SYSFUNC_ERR: F not finite where KINSOL could not avoid

@@ -35,13 +35,15 @@ inline FiniteDifference parse_finite_difference(const char* engine, const std::s
   throw InvalidInput(std::string(engine) + ": fd=" + v + " is not forward or central");
 }
 
-// The keys linear=… and preconditioner=… of the engines with a sparse path, and their reading:
-// the linear-solver spec, or nullopt when neither is given.
+// The keys linear=…, preconditioner=… and ordering=… of the engines with a sparse path, and
+// their reading: the linear-solver spec, or nullopt when none is given.
 inline constexpr const char* kLinearKeyHelp =
-    "auto|dense|band-lu|sparse-lu|klu|gmres|bicgstab: the linear solver of a problem with a "
-    "sparse Jacobian; default auto (band-lu or klu)";
+    "auto|dense|band-lu|sparse-lu|klu|umfpack|gmres|bicgstab: the linear solver of a problem with "
+    "a sparse Jacobian; default auto (band-lu, klu, or umfpack from 20000 unknowns)";
 inline constexpr const char* kPreconditionerKeyHelp =
     "none|jacobi|ilu0|ilut, with linear=gmres|bicgstab; default none";
+inline constexpr const char* kOrderingKeyHelp =
+    "amd|metis (nested dissection), with linear=umfpack; default amd";
 inline std::optional<std::string> parse_linear_solver(const char* engine, EngineSpecReader& s,
                                                       std::string linear) {
   const std::optional<std::string> given = s.text("linear");
@@ -54,7 +56,14 @@ inline std::optional<std::string> parse_linear_solver(const char* engine, Engine
     }
     linear += ":preconditioner=" + *preconditioner;
   }
-  if (!given && !preconditioner) return std::nullopt;
+  const std::optional<std::string> ordering = s.text("ordering");
+  if (ordering) {
+    if (linear != "umfpack") {
+      throw InvalidInput(std::string(engine) + ": ordering=" + *ordering + " needs linear=umfpack");
+    }
+    linear += ":ordering=" + *ordering;
+  }
+  if (!given && !preconditioner && !ordering) return std::nullopt;
   return linear;
 }
 }  // namespace detail
@@ -103,6 +112,7 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
         {"fd", "forward|central differences when no Jacobian; default central"},
         {"linear", detail::kLinearKeyHelp},
         {"preconditioner", detail::kPreconditionerKeyHelp},
+        {"ordering", detail::kOrderingKeyHelp},
         {"reuse",
          "1..1000 iterations one Jacobian (and its factorisation) serves: modified Newton "
          "(KINSOL: 10); default 1"}},
@@ -199,7 +209,8 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
         {"growth", "factor gamma >= 1 on the SER step update (PETSc: 1.1), <= 10; default 1"},
         {"fd", "forward|central differences when no Jacobian; default central"},
         {"linear", detail::kLinearKeyHelp},
-        {"preconditioner", detail::kPreconditionerKeyHelp}},
+        {"preconditioner", detail::kPreconditionerKeyHelp},
+        {"ordering", detail::kOrderingKeyHelp}},
        {"pseudo-transient:flow=fixed-point", "pseudo-transient:flow=fixed-point,delta0=1e-4",
         "pseudo-transient:flow=fixed-point,linear=gmres,preconditioner=ilu0"},
        [](EngineSpecReader& s, SolverOptions o) {

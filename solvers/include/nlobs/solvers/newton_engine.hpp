@@ -52,8 +52,9 @@ struct NewtonOptions {
   // Used only when the problem carries no Jacobian.
   FiniteDifference finite_difference = FiniteDifference::kCentral;
   // The sparse path's linear solver, a make_linear_solver spec ("klu", "gmres:preconditioner=
-  // ilu0", …), or "auto" (band-lu when J's bandwidth is at most 16, kAutoBandWidth, else klu), or
-  // "dense" (the dense path even for a problem with a sparse Jacobian; no detection is run).
+  // ilu0", …), or "auto" (band-lu when J's bandwidth is at most 16, kAutoBandWidth, else klu,
+  // umfpack from 20 000 unknowns: choose_linear_solver), or "dense" (the dense path even for a
+  // problem with a sparse Jacobian; no detection is run).
   // Read only for problems with a sparse Jacobian; the trust region is dense whatever this says.
   std::string linear_solver = "auto";
   // η_k of the Krylov solvers (ignored by the direct ones).
