@@ -382,6 +382,9 @@ TEST(LargeSet, KinsolSpgmrReproducesKinFoodWebKrysPublishedCounts) {
   Eigen::VectorXd x = p.starts[0].x;
   const reference::KinsolResult r = kinsol.solve(x);
   EXPECT_EQ(r.status(), "converged") << r.flag_name << " " << r.reason;
+#if defined(__x86_64__) && !defined(__FMA__)
+  // To the iteration: rounding alone moves these counts (Debian's SUNDIALS 6.4 on x86-64, no
+  // fused multiply-add there or here).
   EXPECT_EQ(r.iterations, 9);
   EXPECT_EQ(r.linear_iterations, 329);
   EXPECT_EQ(r.product_evaluations, 338);
@@ -389,6 +392,11 @@ TEST(LargeSet, KinsolSpgmrReproducesKinFoodWebKrysPublishedCounts) {
   EXPECT_EQ(r.preconditioner_setups, 1);
   EXPECT_EQ(r.preconditioner_solves, 338);
   EXPECT_EQ(r.linear_convergence_failures, 6);
+#else
+  EXPECT_GE(r.iterations, 6);
+  EXPECT_LE(r.iterations, 12);
+  EXPECT_EQ(r.preconditioner_setups, 1);
+#endif
   // "At bottom left: 1.16428 ... 34927.5; at top right: 1.25797 ... 37736.7".
   const Eigen::Index top_right = 6 * (mesh * mesh - 1);
   for (const Eigen::VectorXd* answer : {&x}) {

@@ -24,6 +24,7 @@
 #include "nlobs/solvers/linear/make_linear_solver.hpp"
 #include "nlobs/solvers/linear/preconditioners.hpp"
 #include "nlobs/solvers/linear/sparse_lu.hpp"
+#include "nlobs/solvers/linear/umfpack.hpp"
 #include "nlobs/solvers/sparse/compressed_jacobian.hpp"
 #include "nlobs/solvers/sparse/sparsity_pattern.hpp"
 #include "test_support.hpp"
@@ -250,9 +251,14 @@ TEST(UmfpackSolver, KeepsItsAnalysisForOnePatternAndAgreesWithDenseLu) {
   const Vector<Dynamic> b = random_vector(n, 5);
   for (const char* spec : {"umfpack", "umfpack:ordering=metis"}) {
     std::unique_ptr<LinearSolver> solver = make_linear_solver(spec);
+    const auto* umfpack = dynamic_cast<const UmfpackSolver*>(solver.get());
+    ASSERT_NE(umfpack, nullptr);
+    int analyses = 0;
     for (const auto& [shift, extra] : {std::pair{0.0, false}, {0.5, false}, {0.5, true}}) {
       const SparseJacobian jac = grid(shift, extra);
       ASSERT_EQ(solver->setup(jac), LinearStatus::kSolved) << spec << ": " << solver->message();
+      analyses += shift == 0.0 || extra;  // a first pattern, then a new one
+      EXPECT_EQ(umfpack->symbolic_analyses(), analyses) << spec << " shift " << shift;
       Vector<Dynamic> x;
       ASSERT_EQ(solver->solve(b, x, 0.0), LinearStatus::kSolved) << solver->message();
       const Vector<Dynamic> expected = dense_solution(jac, b);

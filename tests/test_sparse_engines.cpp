@@ -8,6 +8,7 @@
 
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include "large_test_problems.hpp"
 #include "nlobs/solvers/builtin_engines.hpp"
@@ -138,12 +139,22 @@ TEST(SparsePseudoTransient, HalvesDeltaPastASingularShiftedMatrixAndConverges) {
 TEST(SparsePseudoTransient, RefusesWhatTheSparsePathCannotTake) {
   const Index n = 120;
   const Vector<Dynamic> x0 = Vector<Dynamic>::Zero(n);
-  // A scaling on a declared sparse Jacobian.
+  // A scaling on a declared sparse Jacobian keeps the sparse path (D_f J D_u⁻¹), on the dense
+  // path's flow: the same steps (the scaled flow ẋ = −D_u⁻¹ D_f F is slower here: 149 against 78).
   const auto declared = sparse_autodiff_problem(test::broyden_tridiagonal(), x0);
-  PseudoTransientEngine<> scaled({}, test::residual_stop(1e-9, 200));
-  scaled.set_scaling({.u_scale = Vector<Dynamic>::Constant(n, 2.0)});
   Vector<Dynamic> x = x0;
-  EXPECT_THROW(scaled.solve(to_fixed_point(declared), x), InvalidInput);
+  std::vector<Summary> runs;
+  for (const bool sparse : {false, true}) {
+    PseudoTransientEngine<> scaled({}, test::residual_stop(1e-9, 400));
+    scaled.set_scaling({.u_scale = Vector<Dynamic>::Constant(n, 2.0)});
+    x = x0;
+    runs.push_back(
+        scaled.solve(to_fixed_point(sparse ? declared : declared.with_dense_jacobian()), x));
+    EXPECT_EQ(runs.back().status, Status::kConverged) << sparse << ": " << runs.back().message;
+    EXPECT_EQ(runs.back().linear_solver.empty(), !sparse);
+  }
+  EXPECT_EQ(runs[1].iterations, runs[0].iterations);
+  x = x0;
   // A user's sparse Jacobian whose pattern lacks a diagonal entry, where δ⁻¹ is added.
   std::vector<std::pair<Index, Index>> off_diagonal;
   for (Index i = 0; i + 1 < n; ++i) off_diagonal.push_back({i, i + 1});

@@ -154,12 +154,42 @@ TEST(SparseNewton, RefusesWhatWouldTakeTheDensePathAtLargeSize) {
   Vector<Dynamic> x = x0;
   NewtonEngine<> trust(NewtonOptions{.trust_region = true});
   EXPECT_THROW(trust.solve(problem, x), InvalidInput);
-  NewtonEngine<> scaled(NewtonOptions{.line_search = true});
-  scaled.set_scaling({.u_scale = Vector<Dynamic>::Constant(50, 2.0)});
-  EXPECT_THROW(scaled.solve(problem, x), InvalidInput);
   NewtonEngine<> dense(NewtonOptions{.trust_region = true, .linear_solver = "dense"},
                        test::residual_stop());
   EXPECT_EQ(dense.solve(problem, x).status, Status::kConverged);
+}
+
+// A scaling keeps the sparse path: the scaled problem's Jacobian is D_f J D_u⁻¹ on J's pattern,
+// and the iterates are the dense path's (the same scaled Newton steps), whether the pattern is
+// declared or detected; unequal scales, a box, and the scaled norms in the Summary.
+TEST(SparseNewton, AScalingKeepsTheSparsePathAndTheDensePathsIterates) {
+  const Index n = 300;
+  const Vector<Dynamic> x0 = Vector<Dynamic>::Constant(n, -1.0);
+  Scaling scaling;
+  scaling.u_scale = Vector<Dynamic>::LinSpaced(n, 0.5, 4.0);
+  scaling.f_scale = Vector<Dynamic>::LinSpaced(n, 3.0, 0.25);
+  const RootProblem<> declared = sparse_autodiff_problem(broyden_tridiagonal(), x0);
+  const RootProblem<> detected = RootProblem<>::with_autodiff(broyden_tridiagonal(), n, n);
+  for (const RootProblem<>* problem : {&declared, &detected}) {
+    std::vector<Summary> runs;
+    std::vector<Vector<Dynamic>> answers;
+    for (const bool sparse : {false, true}) {
+      NewtonEngine<> newton(NewtonOptions{.line_search = true}, test::residual_stop(1e-10, 100));
+      newton.set_scaling(scaling);
+      newton.set_bounds({Vector<Dynamic>::Constant(n, -5.0), Vector<Dynamic>::Constant(n, 5.0)});
+      Vector<Dynamic> x = x0;
+      runs.push_back(
+          newton.solve(to_fixed_point(sparse ? *problem : problem->with_dense_jacobian()), x));
+      answers.push_back(x);
+      ASSERT_EQ(runs.back().status, Status::kConverged) << sparse << ": " << runs.back().message;
+      EXPECT_EQ(runs.back().linear_solver.empty(), !sparse) << runs.back().linear_solver;
+    }
+    EXPECT_EQ(runs[1].iterations, runs[0].iterations);
+    EXPECT_LE((answers[1] - answers[0]).lpNorm<Eigen::Infinity>(), 1e-10);
+    Vector<Dynamic> f(n);
+    problem->evaluate(answers[1], f);
+    EXPECT_NEAR(runs[1].residual_norm, f.cwiseProduct(scaling.f_scale).norm(), 1e-12);
+  }
 }
 
 TEST(SparseNewton, UsesColouredDifferences) {

@@ -265,6 +265,9 @@ KinsolSolver::KinsolSolver(int n, KinsolOptions options, Function function, Jaco
     throw std::invalid_argument("KinsolOptions::step_tolerance must be finite and >= 0");
   }
   const bool newton = options.strategy == KinsolStrategy::kNewtonLineSearch;
+  if (!newton && !options.line_search) {
+    throw std::invalid_argument("KinsolOptions::line_search = false is for Newton only");
+  }
   if (options.constraints.size() != 0) {
     if (!newton || options.constraints.size() != n) {
       throw std::invalid_argument("KinsolOptions::constraints: for Newton, empty or of size n = " +

@@ -68,10 +68,12 @@ struct KinsolOptions {
   // Jacobian early; 0: KINSOL's default, 5.
   long max_sub_setup_calls = 0;
   double tolerance = 1e-8;  // KINSOL's fnormtol (‖F‖∞, or ‖G(u)−u‖∞ for FP) and scsteptol
-  // KINSetScaledStepTol when > 0 (else `tolerance`): the scaled step ‖D_u Δu‖∞ that ends a run.
+  // KINSetScaledStepTol when > 0 (else `tolerance`): a run ends when max_i |Δu_i| / (|u_i| +
+  // 1/D_u,i) falls to it (KINSOL's scaled step, KINScSNorm); also the line search's smallest λ.
   double step_tolerance = 0.0;
-  // Newton only: KIN_LINESEARCH (true), or KIN_NONE (false: full Newton steps, which KINSOL
-  // shortens only to keep the constraints, as kinFoodWeb_kry runs).
+  // Newton only (false is refused for the fixed-point strategies): KIN_LINESEARCH (true), or
+  // KIN_NONE (false: full Newton steps, which KINSOL shortens only to keep the constraints and to
+  // max_newton_step, as kinFoodWeb_kry runs).
   bool line_search = true;
   // KINSetConstraints (Newton only): per unknown 0 (none), 1 (u ≥ 0), 2 (u > 0), −1 (u ≤ 0) or
   // −2 (u < 0). Empty: none; otherwise of size n, each of those values.

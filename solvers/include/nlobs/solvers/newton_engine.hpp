@@ -121,7 +121,6 @@ class NewtonEngine : public Engine<N> {
   // What sends a solve to the dense path whatever the problem carries; nullptr for nothing.
   const char* dense_reason() const {
     if (trust_region_) return "the trust region";
-    if (!this->scaling_.empty()) return "a scaling (set_scaling)";
     return nullptr;
   }
   // dx_ = −J_F⁻¹ f_ (dense: jac_, LU; sparse: sparse_jac_, linear_), J_F evaluated at x_ when

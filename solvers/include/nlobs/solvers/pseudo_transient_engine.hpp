@@ -131,10 +131,9 @@ class PseudoTransientEngine : public Engine<N> {
   SparseJacobian sparse_jac_, sparse_shifted_;
   std::vector<Index> diagonal_;
   detail::SparseLinearStep linear_;
-  // What sends a solve to the dense path whatever the problem carries; nullptr for nothing.
-  const char* dense_reason() const {
-    return this->scaling_.empty() ? nullptr : "a scaling (set_scaling)";
-  }
+  // What sends a solve to the dense path whatever the problem carries: nothing (a scaling keeps
+  // the sparse path: the scaled problem carries D_f J D_u⁻¹, scaling.hpp).
+  const char* dense_reason() const { return nullptr; }
   // J_F at x_ into sparse_jac_ (sparse path); nullopt or the status.
   std::optional<Status> sparse_jacobian(std::string& message);
   // p_ = (δ⁻¹I − σJ)⁻¹ F (then negated for σ = −1) by LU of shifted_ or by linear_: nullopt, or

@@ -7,6 +7,8 @@
 // an engine makes of ‖F‖ and ‖Δx‖ — residual and step tolerances, the line search's and the trust
 // region's merit ½‖F‖₂², the trust region ‖Δx‖₂ ≤ Δ, stagnation, the rounding floor,
 // acceptance — is then made of ‖D_f F‖ and ‖D_u Δx‖ ([SUNDIALS05], KINSOL; [DS96] §7.1).
+// A problem's sparse Jacobian is scaled alike (D_f J D_u⁻¹, the same pattern): newton and
+// pseudo-transient keep their sparse path under a scaling.
 // Summary::residual_norm and step_norm are those scaled norms; x and the trace's points are
 // returned in the problem's own variables. Pseudo-transient continuation, not affine invariant,
 // follows the scaled flow ẋ = −D_u⁻¹ D_f F (a mass matrix D_f⁻¹ D_u in [KK98]'s form).
@@ -14,6 +16,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -31,6 +34,14 @@ struct Scaling {
 };
 
 namespace detail {
+
+// The sparse Jacobian of the scaled problem below, ∂F̃(x̃) = D_f ∂F(x) D_u⁻¹ at x = D_u⁻¹ x̃ held
+// inside `box`, on `original`'s pattern: the scaled problem keeps the sparse path
+// (src/scaled_sparse_jacobian.cpp). Resolved (detected, if the original is still to be) at the
+// first point an engine asks with.
+std::shared_ptr<SparseJacobianState> scaled_sparse_jacobian_state(
+    std::shared_ptr<SparseJacobianState> original, const Vector<Dynamic>& du,
+    const Vector<Dynamic>& df, const BoxBounds& box);
 
 // Entries finite and > 0, the two of one size where both are given. Throws InvalidInput naming
 // `owner`.
@@ -106,8 +117,19 @@ FixedPointProblem<N> scaled_problem(const FixedPointProblem<N>& problem, const V
     scaled_f(xs, out);
     out += xs;
   };
+  // The problem's sparse Jacobian, scaled alike: the sparse path stays open under a scaling.
+  const auto with_sparse = [&problem, &du, &df, &box](FixedPointProblem<N> out) {
+    if constexpr (N == Dynamic) {
+      if (problem.sparse_jacobian_state()) {
+        return out.with_sparse_jacobian_state(
+            scaled_sparse_jacobian_state(problem.sparse_jacobian_state(), du, df, box));
+      }
+    }
+    return out;
+  };
   if (!problem.has_jacobian()) {
-    return FixedPointProblem<N>::from_map(std::move(map), n).with_residual(std::move(scaled_f));
+    return with_sparse(
+        FixedPointProblem<N>::from_map(std::move(map), n).with_residual(std::move(scaled_f)));
   }
   auto scaled_df = [p, inverse_du, df, limits, x = Vector<N>(inverse_du)](
                        const Vector<N>& xs, Matrix<N, N>& jac) mutable {
@@ -131,9 +153,9 @@ FixedPointProblem<N> scaled_problem(const FixedPointProblem<N>& problem, const V
     scaled_df(xs, jac);
     jac.diagonal().array() += 1.0;
   };
-  return FixedPointProblem<N>::with_jacobian(std::move(map), std::move(dmap), n,
-                                             problem.jacobian_source())
-      .with_residual(std::move(scaled_f), std::move(scaled_df));
+  return with_sparse(FixedPointProblem<N>::with_jacobian(std::move(map), std::move(dmap), n,
+                                                         problem.jacobian_source())
+                         .with_residual(std::move(scaled_f), std::move(scaled_df)));
 }
 
 // lower and upper times D_u (±inf and empty sides stay as they are).

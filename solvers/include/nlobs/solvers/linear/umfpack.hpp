@@ -43,6 +43,8 @@ class UmfpackSolver final : public LinearSolver {
 
   std::string_view name() const override { return "umfpack"; }
   bool iterative() const override { return false; }
+  // Setups that analysed a new pattern (the rest reused the last analysis).
+  int symbolic_analyses() const { return symbolic_analyses_; }
 
   LinearStatus setup(const SparseJacobian& jac) override {
     ++stats_.setups;
@@ -77,10 +79,15 @@ class UmfpackSolver final : public LinearSolver {
       const int status = umfpack_di_symbolic(n, n, start_.data(), index_.data(), values_.data(),
                                              &symbolic_, control_.data(), info_.data());
       if (status < 0) return umfpack_failure("umfpack_di_symbolic", status);
+      ++symbolic_analyses_;
+      // The solve's workspace (umfpack_di_wsolve; 5n doubles with iterative refinement), here
+      // rather than allocated by each solve as umfpack_di_solve would.
+      int_workspace_.resize(static_cast<std::size_t>(n));
+      workspace_.resize(5 * static_cast<std::size_t>(n));
     }
     const int status = umfpack_di_numeric(start_.data(), index_.data(), values_.data(), symbolic_,
                                           &numeric_, control_.data(), info_.data());
-    // Other warnings (the determinant's under- or overflow) leave a usable factorisation.
+    // umfpack_di_numeric returns OK, the singular warning, or an error (< 0).
     const double rcond = info_[UMFPACK_RCOND];
     if (status == UMFPACK_WARNING_singular_matrix || (status >= 0 && !(rcond > kSingularPivot))) {
       std::ostringstream os;
@@ -98,10 +105,10 @@ class UmfpackSolver final : public LinearSolver {
     if (const LinearStatus s = check_right_hand_side(b); s != LinearStatus::kSolved) return s;
     scaled_b_ = row_scale_.cwiseProduct(b);
     x.resize(b.size());
-    const int status =
-        umfpack_di_solve(UMFPACK_At, start_.data(), index_.data(), values_.data(), x.data(),
-                         scaled_b_.data(), numeric_, control_.data(), info_.data());
-    if (status < 0) return umfpack_failure("umfpack_di_solve", status);
+    const int status = umfpack_di_wsolve(UMFPACK_At, start_.data(), index_.data(), values_.data(),
+                                         x.data(), scaled_b_.data(), numeric_, control_.data(),
+                                         info_.data(), int_workspace_.data(), workspace_.data());
+    if (status < 0) return umfpack_failure("umfpack_di_wsolve", status);
     if (!x.allFinite()) {
       return fail(LinearStatus::kSingular, "the solution is not finite (J numerically singular)");
     }
@@ -125,10 +132,12 @@ class UmfpackSolver final : public LinearSolver {
   std::array<double, UMFPACK_INFO> info_{};
   void* symbolic_ = nullptr;
   void* numeric_ = nullptr;
-  int n_ = 0;
+  int n_ = 0, symbolic_analyses_ = 0;
   std::vector<int> start_, index_;  // Jᵀ's compressed columns, kept for the solve's refinement
-  SparseJacobian compressed_;       // a copy only of an uncompressed J
-  std::vector<double> values_;      // J's values, rows equilibrated
+  std::vector<int> int_workspace_;
+  std::vector<double> workspace_;
+  SparseJacobian compressed_;   // a copy only of an uncompressed J
+  std::vector<double> values_;  // J's values, rows equilibrated
   Vector<Dynamic> scaled_b_;
 };
 
