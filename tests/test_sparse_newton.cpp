@@ -192,6 +192,42 @@ TEST(SparseNewton, AScalingKeepsTheSparsePathAndTheDensePathsIterates) {
   }
 }
 
+// Coloured differences under a scaling: unknowns of order 1e-12 (x_i = c·y_i), brought to order
+// 1 by u_scale = 1/c. The differences must step in the scaled variables, as the dense path's
+// differences of the scaled problem do; steps √ε·max(1, |x_j|) in x would be 1e4 times the
+// unknowns (stagnated before the scaled source differenced F̃ itself).
+TEST(SparseNewton, ColouredDifferencesUnderAScalingStepInTheScaledVariables) {
+  const Index n = 60;
+  const double c = 1e-12;
+  // F_i = log(y_i) − 1 + 0.1 (y_{i−1} + y_{i+1} − 2e): the root y = e.
+  auto on_doubles = [c](const Vector<Dynamic>& x, Vector<Dynamic>& f) {
+    const Index m = x.size();
+    f.resize(m);
+    const double e = std::exp(1.0);
+    for (Index i = 0; i < m; ++i) {
+      const double left = i > 0 ? x[i - 1] / c : e, right = i + 1 < m ? x[i + 1] / c : e;
+      f[i] = std::log(x[i] / c) - 1.0 + 0.1 * (left + right - 2.0 * e);
+    }
+  };
+  const RootProblem<> problem =
+      sparse_difference_problem(on_doubles, SparsityPattern::band(n, 1, 1));
+  std::vector<Summary> runs;
+  for (const bool sparse : {false, true}) {
+    NewtonEngine<> newton(NewtonOptions{.line_search = true}, test::residual_stop(1e-10, 100));
+    newton.set_scaling({.u_scale = Vector<Dynamic>::Constant(n, 1.0 / c)});
+    newton.set_bounds({.lower = Vector<Dynamic>::Zero(n),
+                       .upper = {},
+                       .strict_lower = StrictBounds::Constant(n, true)});
+    Vector<Dynamic> x = Vector<Dynamic>::Constant(n, c);
+    runs.push_back(
+        newton.solve(to_fixed_point(sparse ? problem : problem.with_dense_jacobian()), x));
+    ASSERT_EQ(runs.back().status, Status::kConverged) << sparse << ": " << runs.back().message;
+    EXPECT_EQ(runs.back().linear_solver.empty(), !sparse);
+    EXPECT_LE(((x / c).array().log() - 1.0).abs().maxCoeff(), 1e-8);
+  }
+  EXPECT_EQ(runs[1].iterations, runs[0].iterations);
+}
+
 TEST(SparseNewton, UsesColouredDifferences) {
   const Index n = 100;
   const Vector<Dynamic> x0 = Vector<Dynamic>::Constant(n, -1.0);

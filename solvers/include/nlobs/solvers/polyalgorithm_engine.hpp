@@ -42,8 +42,8 @@ struct PolyalgorithmOptions {
   // unknowns, the stages without a sparse path (Engine::has_sparse_path: dogleg,
   // levenberg-marquardt, broyden, …) are not run: each would build and factor a dense n×n J —
   // at n = 10⁴ 800 MB and minutes per factorisation, where newton and pseudo-transient take
-  // milliseconds on the sparse path — unless no stage has a sparse path (auto:order=dogleg, or
-  // every stage under a scaling): then all run, densely. 0: run them at any n. ≥ 0.
+  // milliseconds on the sparse path — unless no stage has a sparse path (auto:order=dogleg):
+  // then all run, densely. 0: run them at any n. ≥ 0.
   Index dense_stage_limit = 1000;
 };
 

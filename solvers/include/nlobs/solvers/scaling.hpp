@@ -15,6 +15,7 @@
 // Choose D_u so that D_u x is of order 1 and D_f so that D_f F is, as KINSOL asks.
 #include <Eigen/Core>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -37,11 +38,15 @@ namespace detail {
 
 // The sparse Jacobian of the scaled problem below, ∂F̃(x̃) = D_f ∂F(x) D_u⁻¹ at x = D_u⁻¹ x̃ held
 // inside `box`, on `original`'s pattern: the scaled problem keeps the sparse path
-// (src/scaled_sparse_jacobian.cpp). Resolved (detected, if the original is still to be) at the
-// first point an engine asks with.
+// (src/scaled_sparse_jacobian.cpp). An exact source (AD) is scaled entry by entry; a
+// difference source differences `scaled_f` (F̃) in x̃ instead, with steps in the scaled
+// variables, as the dense path's differences of the scaled problem take them. Resolved
+// (detected, if the original is still to be) at the first point an engine asks with; declared
+// when the original is.
+using ScaledResidual = std::function<void(const Vector<Dynamic>&, Vector<Dynamic>&)>;
 std::shared_ptr<SparseJacobianState> scaled_sparse_jacobian_state(
     std::shared_ptr<SparseJacobianState> original, const Vector<Dynamic>& du,
-    const Vector<Dynamic>& df, const BoxBounds& box);
+    const Vector<Dynamic>& df, const BoxBounds& box, ScaledResidual scaled_f);
 
 // Entries finite and > 0, the two of one size where both are given. Throws InvalidInput naming
 // `owner`.
@@ -118,11 +123,11 @@ FixedPointProblem<N> scaled_problem(const FixedPointProblem<N>& problem, const V
     out += xs;
   };
   // The problem's sparse Jacobian, scaled alike: the sparse path stays open under a scaling.
-  const auto with_sparse = [&problem, &du, &df, &box](FixedPointProblem<N> out) {
+  const auto with_sparse = [&problem, &du, &df, &box, scaled_f](FixedPointProblem<N> out) {
     if constexpr (N == Dynamic) {
       if (problem.sparse_jacobian_state()) {
-        return out.with_sparse_jacobian_state(
-            scaled_sparse_jacobian_state(problem.sparse_jacobian_state(), du, df, box));
+        return out.with_sparse_jacobian_state(scaled_sparse_jacobian_state(
+            problem.sparse_jacobian_state(), du, df, box, ScaledResidual(scaled_f)));
       }
     }
     return out;

@@ -30,8 +30,8 @@ inline void check_linear_solver_option(const char* option, const std::string& sp
 }
 
 // An engine whose linear solver is `spec` takes the sparse path unless spec is "dense" or
-// something else sends it to the dense one (`dense_reason`: "the trust region", "a scaling
-// (set_scaling)"; nullptr for nothing).
+// something else sends it to the dense one (`dense_reason`: "the trust region"; nullptr for
+// nothing).
 inline bool takes_sparse_path(const std::string& spec, const char* dense_reason) {
   return spec != "dense" && dense_reason == nullptr;
 }

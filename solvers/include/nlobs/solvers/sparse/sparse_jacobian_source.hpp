@@ -61,11 +61,14 @@ class SparseJacobianState {
     state->note_ = "declared";
     return state;
   }
-  static std::shared_ptr<SparseJacobianState> detected_later(Detector detect) {
+  // `declared`: a state that wraps a declared one (a scaled problem's) says so, whatever it
+  // resolves by (declared() below).
+  static std::shared_ptr<SparseJacobianState> detected_later(Detector detect,
+                                                             bool declared = false) {
     auto state = std::make_shared<SparseJacobianState>();
     state->detect_ = std::move(detect);
     state->note_ = "not detected yet (an engine with a sparse path detects at its start)";
-    state->by_detection_ = true;
+    state->by_detection_ = !declared;
     return state;
   }
 
