@@ -18,6 +18,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "nlobs/solvers/linear/equilibrated_rows.hpp"
 #include "nlobs/solvers/linear/linear_solver.hpp"
 
 namespace nlobs {
@@ -39,34 +40,18 @@ class KluSolver final : public LinearSolver {
   LinearStatus setup(const SparseJacobian& jac) override {
     ++stats_.setups;
     if (const LinearStatus s = check_matrix(jac); s != LinearStatus::kSolved) return s;
-    const SparseJacobian* source = &jac;
-    if (!jac.isCompressed()) {  // KLU reads the arrays as they are: no gaps
-      compressed_ = jac;
-      compressed_.makeCompressed();
-      source = &compressed_;
-    }
-    int* start = const_cast<int*>(source->outerIndexPtr());  // KLU reads, never writes, them
-    int* index = const_cast<int*>(source->innerIndexPtr());
-    const int n = static_cast<int>(source->rows());
-    const Index nonzeros = source->nonZeros();
+    const SparseJacobian& source = rows_.compressed(jac);
+    const int n = static_cast<int>(source.rows());
     // Rows of J equilibrated here; KLU's own scaling of Jᵀ's rows then scales J's columns.
-    if (const LinearStatus s = equilibrate_rows(*source); s != LinearStatus::kSolved) return s;
-    values_.resize(static_cast<std::size_t>(nonzeros));
-    for (Index i = 0; i < n; ++i) {
-      for (Index k = start[i]; k < start[i + 1]; ++k) {
-        values_[static_cast<std::size_t>(k)] = row_scale_[i] * source->valuePtr()[k];
-      }
-    }
-    double* values = values_.data();
-    const bool same_pattern = symbolic_ != nullptr && n_ == n &&
-                              index_.size() == static_cast<std::size_t>(nonzeros) &&
-                              std::equal(start, start + n + 1, start_.begin()) &&
-                              std::equal(index, index + nonzeros, index_.begin());
+    if (const LinearStatus s = equilibrate_rows(source); s != LinearStatus::kSolved) return s;
+    rows_.scale(source, row_scale_);
+    double* values = rows_.values();
+    const bool same_pattern = rows_.same_pattern_else_keep(source) && symbolic_ != nullptr;
+    int* start = rows_.starts();
+    int* index = rows_.indices();
     if (!same_pattern) {
       release();
       n_ = n;
-      start_.assign(start, start + n + 1);
-      index_.assign(index, index + nonzeros);
       symbolic_ = klu_analyze(n, start, index, &common_);
       if (symbolic_ == nullptr) return klu_failure("klu_analyze");
     }
@@ -129,9 +114,7 @@ class KluSolver final : public LinearSolver {
   klu_symbolic* symbolic_ = nullptr;
   klu_numeric* numeric_ = nullptr;
   int n_ = 0, refactorizations_ = 0;
-  std::vector<int> start_, index_;
-  SparseJacobian compressed_;   // a copy only of an uncompressed J
-  std::vector<double> values_;  // J's values, rows equilibrated
+  detail::EquilibratedRows rows_;  // J's pattern and its values, rows equilibrated
 };
 
 }  // namespace nlobs

@@ -19,6 +19,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "nlobs/solvers/linear/equilibrated_rows.hpp"
 #include "nlobs/solvers/linear/linear_solver.hpp"
 
 namespace nlobs {
@@ -49,34 +50,15 @@ class UmfpackSolver final : public LinearSolver {
   LinearStatus setup(const SparseJacobian& jac) override {
     ++stats_.setups;
     if (const LinearStatus s = check_matrix(jac); s != LinearStatus::kSolved) return s;
-    const SparseJacobian* source = &jac;
-    if (!jac.isCompressed()) {
-      compressed_ = jac;
-      compressed_.makeCompressed();
-      source = &compressed_;
-    }
-    const int* start = source->outerIndexPtr();
-    const int* index = source->innerIndexPtr();
-    const int n = static_cast<int>(source->rows());
-    const Index nonzeros = source->nonZeros();
-    if (const LinearStatus s = equilibrate_rows(*source); s != LinearStatus::kSolved) return s;
-    values_.resize(static_cast<std::size_t>(nonzeros));
-    for (Index i = 0; i < n; ++i) {
-      for (Index k = start[i]; k < start[i + 1]; ++k) {
-        values_[static_cast<std::size_t>(k)] = row_scale_[i] * source->valuePtr()[k];
-      }
-    }
-    const bool same_pattern = symbolic_ != nullptr && n_ == n &&
-                              index_.size() == static_cast<std::size_t>(nonzeros) &&
-                              std::equal(start, start + n + 1, start_.begin()) &&
-                              std::equal(index, index + nonzeros, index_.begin());
+    const SparseJacobian& source = rows_.compressed(jac);
+    const int n = static_cast<int>(source.rows());
+    if (const LinearStatus s = equilibrate_rows(source); s != LinearStatus::kSolved) return s;
+    rows_.scale(source, row_scale_);
+    const bool same_pattern = rows_.same_pattern_else_keep(source) && symbolic_ != nullptr;
     if (numeric_ != nullptr) umfpack_di_free_numeric(&numeric_);
     if (!same_pattern) {
       release();
-      n_ = n;
-      start_.assign(start, start + n + 1);
-      index_.assign(index, index + nonzeros);
-      const int status = umfpack_di_symbolic(n, n, start_.data(), index_.data(), values_.data(),
+      const int status = umfpack_di_symbolic(n, n, rows_.starts(), rows_.indices(), rows_.values(),
                                              &symbolic_, control_.data(), info_.data());
       if (status < 0) return umfpack_failure("umfpack_di_symbolic", status);
       ++symbolic_analyses_;
@@ -85,8 +67,8 @@ class UmfpackSolver final : public LinearSolver {
       int_workspace_.resize(static_cast<std::size_t>(n));
       workspace_.resize(5 * static_cast<std::size_t>(n));
     }
-    const int status = umfpack_di_numeric(start_.data(), index_.data(), values_.data(), symbolic_,
-                                          &numeric_, control_.data(), info_.data());
+    const int status = umfpack_di_numeric(rows_.starts(), rows_.indices(), rows_.values(),
+                                          symbolic_, &numeric_, control_.data(), info_.data());
     // umfpack_di_numeric returns OK, the singular warning, or an error (< 0).
     const double rcond = info_[UMFPACK_RCOND];
     if (status == UMFPACK_WARNING_singular_matrix || (status >= 0 && !(rcond > kSingularPivot))) {
@@ -105,9 +87,9 @@ class UmfpackSolver final : public LinearSolver {
     if (const LinearStatus s = check_right_hand_side(b); s != LinearStatus::kSolved) return s;
     scaled_b_ = row_scale_.cwiseProduct(b);
     x.resize(b.size());
-    const int status = umfpack_di_wsolve(UMFPACK_At, start_.data(), index_.data(), values_.data(),
-                                         x.data(), scaled_b_.data(), numeric_, control_.data(),
-                                         info_.data(), int_workspace_.data(), workspace_.data());
+    const int status = umfpack_di_wsolve(
+        UMFPACK_At, rows_.starts(), rows_.indices(), rows_.values(), x.data(), scaled_b_.data(),
+        numeric_, control_.data(), info_.data(), int_workspace_.data(), workspace_.data());
     if (status < 0) return umfpack_failure("umfpack_di_wsolve", status);
     if (!x.allFinite()) {
       return fail(LinearStatus::kSingular, "the solution is not finite (J numerically singular)");
@@ -132,12 +114,10 @@ class UmfpackSolver final : public LinearSolver {
   std::array<double, UMFPACK_INFO> info_{};
   void* symbolic_ = nullptr;
   void* numeric_ = nullptr;
-  int n_ = 0, symbolic_analyses_ = 0;
-  std::vector<int> start_, index_;  // Jᵀ's compressed columns, kept for the solve's refinement
+  int symbolic_analyses_ = 0;
   std::vector<int> int_workspace_;
   std::vector<double> workspace_;
-  SparseJacobian compressed_;   // a copy only of an uncompressed J
-  std::vector<double> values_;  // J's values, rows equilibrated
+  detail::EquilibratedRows rows_;  // J's pattern and values (the solve's refinement reads them)
   Vector<Dynamic> scaled_b_;
 };
 
