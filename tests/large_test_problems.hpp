@@ -6,8 +6,10 @@
 //                                   x_0 = x_{n+1} = 0 (the returning call shape)
 //   2-D Bratu (PETSc's SNES ex5)    (4u − Σ neighbours)/h² − λ e^u on an s×s interior grid,
 //                                   h = 1/(s+1), u = 0 on the boundary (the out-parameter shape)
+// and a least-squares one, a smoothed exponential fit (smoothed_fit below).
 #include <cmath>
 #include <type_traits>
+#include <utility>
 
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/types.hpp"
@@ -44,6 +46,34 @@ inline auto bratu(Index s, double lambda = 6.0) {
         if (c + 1 < s) sum -= u[p + 1];
         f[p] = sum / h2 - lambda * exp(u[p]);
       }
+    }
+  };
+}
+
+// A nonlinear least-squares problem with no zero residual, m = 2n − 1:
+//   r_i = exp(x_i) + 0.1 x_i x_{i+1} − d_i (i < n, x_n = 0),  r_{n+i} = α (x_{i+1} − x_i),
+// data d from x*_i = sin(i/7) perturbed by 0.05 cos(2.9 i), which the smoothing term cannot
+// follow: the minimum leaves residuals of order 1e-2. J has 2 entries a row.
+inline Vector<Dynamic> smoothed_fit_data(Index n) {
+  Vector<Dynamic> data(n);
+  for (Index i = 0; i < n; ++i) {
+    const double xi = std::sin(static_cast<double>(i) / 7.0);
+    const double next = i + 1 < n ? std::sin(static_cast<double>(i + 1) / 7.0) : 0.0;
+    data[i] = std::exp(xi) + 0.1 * xi * next + 0.05 * std::cos(2.9 * static_cast<double>(i));
+  }
+  return data;
+}
+
+inline auto smoothed_fit(Vector<Dynamic> data, double alpha = 0.5) {
+  return [d = std::move(data), alpha](const auto& x, auto& r) {
+    using T = typename std::decay_t<decltype(x)>::Scalar;
+    using std::exp;
+    const Index size = x.size();
+    r.resize(2 * size - 1);
+    for (Index i = 0; i < size; ++i) {
+      const T next = i + 1 < size ? T(x[i + 1]) : T(0.0);
+      r[i] = exp(x[i]) + 0.1 * x[i] * next - d[i];
+      if (i + 1 < size) r[size + i] = alpha * (x[i + 1] - x[i]);
     }
   };
 }

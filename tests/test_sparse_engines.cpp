@@ -237,15 +237,30 @@ TEST(SparseAuto, RunsOnlyTheStagesWithASparsePathOnALargeSparseProblem) {
   EXPECT_EQ(a.linear_solver, "band-lu");
   EXPECT_EQ(a.message, "");
 
-  // dogleg first: not run (a dense 3000×3000 J), said so; pseudo-transient solves it.
+  // dogleg and newton's trust region first: not run (a dense 3000×3000 J), said so;
+  // pseudo-transient solves it.
   x = x0;
-  const Summary b = by_spec("auto:order=dogleg/levenberg-marquardt/pseudo-transient", problem, x);
+  const Summary b = by_spec("auto:order=dogleg/newton:trustregion=1/pseudo-transient", problem, x);
   ASSERT_EQ(b.status, Status::kConverged) << b.message;
   EXPECT_EQ(b.stage, "pseudo-transient");
   EXPECT_EQ(b.linear_solver, "band-lu");
   EXPECT_EQ(b.message,
-            "after dogleg, levenberg-marquardt not run (no sparse path, and n = 3000 > "
+            "after dogleg, newton:trustregion=1 not run (no sparse path, and n = 3000 > "
             "dense_stage_limit 1000)");
+  // levenberg-marquardt has one (the normal equations by CHOLMOD), and so has broyden
+  // (limited memory).
+  x = x0;
+  const Summary c = by_spec("auto:order=dogleg/levenberg-marquardt", problem, x);
+  ASSERT_EQ(c.status, Status::kConverged) << c.message;
+  EXPECT_EQ(c.stage, "levenberg-marquardt");
+  EXPECT_EQ(c.linear_solver, "cholmod");
+  EXPECT_EQ(c.message,
+            "after dogleg not run (no sparse path, and n = 3000 > dense_stage_limit 1000)");
+  x = x0;
+  const Summary d = by_spec("auto:order=dogleg/broyden", problem, x);
+  ASSERT_EQ(d.status, Status::kConverged) << d.message;
+  EXPECT_EQ(d.stage, "broyden");
+  EXPECT_EQ(d.linear_solver, "band-lu");
   EXPECT_THROW(registry.create("auto:dense_limit=-1", test::residual_stop(1e-9, 200)),
                InvalidInput);
 }

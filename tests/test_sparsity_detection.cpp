@@ -186,19 +186,35 @@ TEST(SparsityDetection, LeavesTheTrustRegionOnTheDensePathButRefusesItForADeclar
   EXPECT_THROW(newton(sparse_autodiff_problem(broyden_tridiagonal(), x0), x, trust), InvalidInput);
 }
 
-TEST(SparsityDetection, DeclinesANonSquareF) {
+TEST(SparsityDetection, DetectsATallFAndDeclinesAWideOne) {
+  // m > n (least squares: levenberg-marquardt's sparse path) is detected; m < n has no engine.
   const Index n = 150;
-  auto f = [](const auto& x) {
+  auto tall = [](const auto& x) {
     using T = typename std::decay_t<decltype(x)>::Scalar;
     Vector<Dynamic, T> r(x.size() + 1);
     r.head(x.size()) = x;
-    r[x.size()] = x.sum();
+    r[x.size()] = x[0] + x[x.size() - 1];
     return r;
   };
-  const auto problem = RootProblem<>::with_autodiff(f, n, n + 1);
-  EXPECT_EQ(problem.sparse_jacobian(Vector<Dynamic>::Zero(n)), nullptr);
-  EXPECT_NE(problem.sparse_jacobian_note().find("only square systems"), std::string::npos)
-      << problem.sparse_jacobian_note();
+  const auto problem = RootProblem<>::with_autodiff(tall, n, n + 1);
+  const SparseJacobianSource* source = problem.sparse_jacobian(Vector<Dynamic>::Zero(n));
+  ASSERT_NE(source, nullptr) << problem.sparse_jacobian_note();
+  EXPECT_EQ(source->pattern->rows, n + 1);
+  EXPECT_EQ(source->pattern->cols, n);
+  EXPECT_TRUE(source->pattern->contains(n, 0) && source->pattern->contains(n, n - 1));
+  EXPECT_EQ(problem.sparse_jacobian_note(), "detected: " + std::to_string(n + 2) + " entries");
+
+  auto wide = [](const auto& x) {
+    using T = typename std::decay_t<decltype(x)>::Scalar;
+    Vector<Dynamic, T> r(x.size() - 1);
+    for (Index i = 0; i + 1 < x.size(); ++i) r[i] = x[i] - x[i + 1];
+    return r;
+  };
+  const auto underdetermined = RootProblem<>::with_autodiff(wide, n, n - 1);
+  EXPECT_EQ(underdetermined.sparse_jacobian(Vector<Dynamic>::Zero(n)), nullptr);
+  EXPECT_NE(underdetermined.sparse_jacobian_note().find("fewer residuals than unknowns"),
+            std::string::npos)
+      << underdetermined.sparse_jacobian_note();
 }
 
 TEST(SparsityDetection, DeclinesWhereFThrowsWhileTracedAndLeavesNoCountBehind) {

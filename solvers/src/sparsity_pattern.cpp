@@ -23,13 +23,16 @@ PatternBandwidths pattern_bandwidths(const SparsityPattern& pattern) {
 namespace nlobs::detail {
 
 SparsityPattern with_diagonal(const SparsityPattern& pattern) {
+  // A least-squares J (m > n) goes to the normal equations, where a structural zero on its
+  // diagonal only adds fill to JᵀJ and colours: left as it is.
+  if (pattern.rows != pattern.cols) return pattern;
   SparsityPattern out;
   out.rows = pattern.rows;
   out.cols = pattern.cols;
   out.row_start.assign(static_cast<std::size_t>(pattern.rows) + 1, 0);
   out.columns.reserve(pattern.columns.size() + static_cast<std::size_t>(pattern.rows));
   for (Index i = 0; i < pattern.rows; ++i) {
-    bool placed = i >= pattern.cols;  // no diagonal entry in a row below the square part
+    bool placed = false;
     for (Index k = pattern.row_start[i]; k < pattern.row_start[i + 1]; ++k) {
       const Index j = pattern.columns[k];
       if (!placed && j >= i) {

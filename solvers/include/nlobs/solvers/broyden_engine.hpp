@@ -18,7 +18,17 @@
 // point where neither decreases ‖F‖ while a bound holds x against −∇φ is blocked_by_bound.
 //
 // Stop rules: StopCriteria's, the step criterion on full steps t = 1 that no bound cut short.
+//
+// Limited memory (run-time size, a problem with a sparse Jacobian: the sparse path). H is never
+// formed: H_0 = J_F(x_0)⁻¹ is applied by a sparse direct solver's factors, and the updates are
+// kept in product form ([Kel95] §7.3, [DS96] §8.3),
+//   H_{k+1} = (I + u_k s_kᵀ) H_k,   u_k = (s_k − H_k y_k) / (s_kᵀ H_k y_k),
+// which is the update above (u_k s_kᵀ H_k is its rank-one term), so H_k v costs one solve with
+// J_F(x_0) and k dot products and axpys, O(k n). After `memory` updates (two n-vectors each) the
+// next step takes a fresh Jacobian: the iterates are the dense path's with max_updates = memory
+// (the dense path's default never restarts). Singular J: each linear solver's own pivot rule.
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -29,6 +39,7 @@
 
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
+#include "nlobs/solvers/sparse_path.hpp"
 #include "nlobs/solvers/square_system.hpp"
 #include "nlobs/solvers/stop_monitor.hpp"
 
@@ -40,6 +51,13 @@ struct BroydenOptions {
   int max_updates = 0;                // updates before a fresh Jacobian regardless; ≥ 0, 0 = off
   // Used only when the problem carries no Jacobian.
   FiniteDifference finite_difference = FiniteDifference::kCentral;
+  // The limited-memory form on a problem with a sparse Jacobian (run-time size): H_0 applied by
+  // this direct solver — "auto" (band-lu, klu or umfpack by the pattern, as newton chooses),
+  // "band-lu", "sparse-lu", "klu", "umfpack[:ordering=…]" — or "dense": the dense path, H n×n.
+  // A Krylov solver is refused (H_0 must be applied exactly for the updates to hold).
+  std::string linear_solver = "auto";
+  // Updates the limited-memory form keeps (2 n doubles each) before a fresh Jacobian; 1..1000.
+  int memory = 20;
 
   // Throws InvalidInput naming the field and its value.
   void validate() const;
@@ -58,6 +76,14 @@ inline void BroydenOptions::validate() const {
     fail("sufficient_decrease", sufficient_decrease, "must lie in (0, 0.5)");
   }
   if (max_updates < 0) fail("max_updates", max_updates, "must be >= 0");
+  if (memory < 1 || memory > 1000) fail("memory", memory, "must lie in 1..1000");
+  detail::check_linear_solver_option("BroydenOptions::linear_solver", linear_solver);
+  if (linear_solver != "auto" && linear_solver != "dense" &&
+      make_linear_solver(linear_solver)->iterative()) {
+    throw InvalidInput("BroydenOptions::linear_solver = \"" + linear_solver +
+                       "\" is invalid: H_0 = J^-1 must be applied exactly, by a direct solver "
+                       "(auto, band-lu, sparse-lu, klu, umfpack) or dense");
+  }
 }
 
 template <int N = Dynamic>
@@ -74,12 +100,21 @@ class BroydenEngine : public Engine<N> {
   bool accepts_bounds() const override { return true; }
   bool accepts_strict_bounds() const override { return true; }
   bool accepts_scaling() const override { return true; }
+  bool has_sparse_path() const override { return broyden_.linear_solver != "dense"; }
 
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
 
  private:
-  // H = J_F(x_)⁻¹ from a fresh Jacobian (kept in jac_); nullopt or the status to stop with.
+  // H = J_F(x_)⁻¹ from a fresh Jacobian (kept in jac_, or factored from sparse_jac_ on the
+  // sparse path); nullopt or the status to stop with.
   std::optional<Status> renew(std::string& message);
+  // out = H v; nullopt or the status to stop with (the sparse path's solve failed).
+  std::optional<Status> apply_inverse(const Vector<N>& v, Vector<N>& out, std::string& message);
+  // H ← (I + u sᵀ) H with s = d_, H y = hy_, denominator sᵀ H y; false when the limited-memory
+  // store is full (then a fresh Jacobian).
+  bool update(double denominator);
+  // J_Fᵀ f_ into gradient_ and ‖J_F gradient_‖², at the last fresh Jacobian.
+  double gradient_at_jacobian();
   // Backtracking from t0 along P(x_ + t d): the sufficient-decrease test above (armijo = false),
   // or Armijo's on ∇φ = gradient_ (armijo = true). Trial in xt_, ft_; false when none.
   bool search(const Vector<N>& d, double t0, bool armijo);
@@ -93,10 +128,24 @@ class BroydenEngine : public Engine<N> {
   Eigen::PartialPivLU<Matrix<N, N>> lu_;
   bool projected_ = false;  // the last trial point was projected onto the box
   double t_ = 1.0;          // the last trial's t
+  // The sparse path (run-time size only): J_F(x_0), its factors, and the updates' u_k, s_k as
+  // columns, `stored_` of them; the columns grow (doubling) up to `memory` as updates arrive.
+  bool sparse_ = false;
+  SparseJacobian sparse_jac_;
+  detail::SparseLinearStep linear_;
+  Matrix<Dynamic, Dynamic> updates_u_, updates_s_;
+  Index stored_ = 0;
 };
 
 template <int N>
 std::optional<Status> BroydenEngine<N>::renew(std::string& message) {
+  if constexpr (N == Dynamic) {
+    if (sparse_) {
+      if (auto s = system_.sparse_jacobian(x_, f_, sparse_jac_, message)) return s;
+      stored_ = 0;
+      return linear_.failure(linear_.setup(sparse_jac_), message);
+    }
+  }
   if (auto s = system_.jacobian(x_, f_, jac_, message)) return s;
   lu_.compute(jac_);
   // A pivot below this fraction of the largest |J_ij|: singular, as NewtonEngine judges.
@@ -109,6 +158,57 @@ std::optional<Status> BroydenEngine<N>::renew(std::string& message) {
   os << "Jacobian of F is singular (smallest LU pivot " << smallest_pivot << ")";
   message = os.str();
   return Status::kSingularJacobian;
+}
+
+template <int N>
+std::optional<Status> BroydenEngine<N>::apply_inverse(const Vector<N>& v, Vector<N>& out,
+                                                      std::string& message) {
+  if constexpr (N == Dynamic) {
+    if (sparse_) {
+      // (A direct solver: the tolerances do not apply.)
+      if (auto s = linear_.failure(linear_.resolve(v, out, 0.5, 1.0), message)) return s;
+      for (Index k = 0; k < stored_; ++k) {
+        out.noalias() += updates_u_.col(k) * updates_s_.col(k).dot(out);
+      }
+      return std::nullopt;
+    }
+  }
+  out.noalias() = h_ * v;
+  static_cast<void>(message);
+  return std::nullopt;
+}
+
+template <int N>
+bool BroydenEngine<N>::update(double denominator) {
+  if constexpr (N == Dynamic) {
+    if (sparse_) {
+      if (stored_ == broyden_.memory) return false;
+      if (stored_ == updates_u_.cols()) {
+        const Index columns = std::min<Index>(broyden_.memory, std::max<Index>(4, 2 * stored_));
+        updates_u_.conservativeResize(Eigen::NoChange, columns);
+        updates_s_.conservativeResize(Eigen::NoChange, columns);
+      }
+      updates_u_.col(stored_) = (d_ - hy_) / denominator;
+      updates_s_.col(stored_) = d_;
+      ++stored_;
+      return true;
+    }
+  }
+  gradient_.noalias() = h_.transpose() * d_;  // Hᵀ s, so that the update is O(n²)
+  h_.noalias() += ((d_ - hy_) / denominator) * gradient_.transpose();
+  return true;
+}
+
+template <int N>
+double BroydenEngine<N>::gradient_at_jacobian() {
+  if constexpr (N == Dynamic) {
+    if (sparse_) {
+      gradient_.noalias() = sparse_jac_.transpose() * f_;
+      return (sparse_jac_ * gradient_).squaredNorm();
+    }
+  }
+  gradient_.noalias() = jac_.transpose() * f_;
+  return (jac_ * gradient_).squaredNorm();
 }
 
 template <int N>
@@ -143,10 +243,20 @@ Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& 
   system_.start(name(), problem, x, this->bounds_, broyden_.finite_difference, stop);
   const detail::Box<N>& box = system_.box();
   const Index n = x.size();
+  sparse_ = false;
   if constexpr (N == Dynamic) {
     for (Vector<N>* v : {&x_, &f_, &d_, &xt_, &ft_, &hy_, &gradient_}) v->resize(n);
-    h_.resize(n, n), jac_.resize(n, n);
-    if (lu_.rows() != n) lu_ = Eigen::PartialPivLU<Matrix<N, N>>(n);
+    const SparseJacobianSource* source =
+        detail::sparse_path_source(problem, x, broyden_.linear_solver, nullptr);
+    sparse_ = source != nullptr;
+    if (sparse_) {
+      linear_.choose(broyden_.linear_solver, *source->pattern, n);
+      updates_u_.resize(n, 0), updates_s_.resize(n, 0);
+      stored_ = 0;
+    } else {
+      h_.resize(n, n), jac_.resize(n, n);
+      if (lu_.rows() != n) lu_ = Eigen::PartialPivLU<Matrix<N, N>>(n);
+    }
   }
   Summary summary;
   summary.engine = name();
@@ -169,7 +279,10 @@ Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& 
   // The budget or the progress window is spent: why (blocked where a bound holds x against
   // −Jᵀ F, J the last Jacobian computed).
   auto spent_status = [&] {
-    if (box.active()) gradient_.noalias() = -(jac_.transpose() * f_);
+    if (box.active()) {
+      gradient_at_jacobian();
+      gradient_ = -gradient_;
+    }
     return system_.spent_status(summary.message, x_, gradient_, fnorm);
   };
   while (!status) {
@@ -177,11 +290,11 @@ Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& 
       status = spent_status();
       break;
     }
-    d_.noalias() = -(h_ * f_);
+    if ((status = apply_inverse(f_, d_, summary.message))) break;
+    d_ = -d_;
     bool accepted = search(d_, 1.0, false), descent_step = false;
     if (!accepted && fresh && box.active() && !system_.budget_spent()) {
-      gradient_.noalias() = jac_.transpose() * f_;
-      const double curvature = (jac_ * gradient_).squaredNorm();
+      const double curvature = gradient_at_jacobian();
       if (curvature > 0.0) {
         d_ = -gradient_;
         accepted = search(d_, gradient_.squaredNorm() / curvature, true);
@@ -197,7 +310,8 @@ Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& 
         updates = 0;
         if (fresh) continue;
       } else {
-        gradient_.noalias() = -(jac_.transpose() * f_);
+        gradient_at_jacobian();
+        gradient_ = -gradient_;
         if (const std::optional<Index> i =
                 box.blocking(x_, gradient_, detail::BoxMove::kDirection)) {
           summary.message = box.blocked_message(*i, x_, fnorm, "the descent direction");
@@ -209,10 +323,11 @@ Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& 
       }
       break;
     }
-    d_ = xt_ - x_;  // s, the step taken
-    f_ = ft_ - f_;  // y = F(x + s) − F(x), until f_ takes F(x + s)
-    hy_.noalias() = h_ * f_;
-    const double denominator = d_.dot(hy_);
+    d_ = xt_ - x_;           // s, the step taken
+    f_ = ft_ - f_;           // y = F(x + s) − F(x), until f_ takes F(x + s)
+    std::string hy_failure;  // (a failed H y only restarts: its message is not the run's)
+    const std::optional<Status> failed = apply_inverse(f_, hy_, hy_failure);
+    const double denominator = failed ? std::numeric_limits<double>::quiet_NaN() : d_.dot(hy_);
     const double step = d_.template lpNorm<Eigen::Infinity>();
     const bool full_step = t_ == 1.0 && !projected_ && !descent_step;
     x_ = xt_;
@@ -225,9 +340,7 @@ Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& 
     if (status) break;
     const bool restart = broyden_.max_updates > 0 && updates >= broyden_.max_updates;
     if (!restart && std::isfinite(denominator) &&
-        std::abs(denominator) > 1e-14 * d_.norm() * hy_.norm()) {
-      gradient_.noalias() = h_.transpose() * d_;  // Hᵀ s, so that the update is O(n²)
-      h_.noalias() += ((d_ - hy_) / denominator) * gradient_.transpose();
+        std::abs(denominator) > 1e-14 * d_.norm() * hy_.norm() && update(denominator)) {
       fresh = false;
       ++updates;
     } else {
@@ -239,6 +352,9 @@ Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& 
 
   x = x_;
   system_.finish(summary, *status, monitor, x, f_, stop);
+  if constexpr (N == Dynamic) {
+    if (sparse_) linear_.report(summary);
+  }
   return summary;
 }
 

@@ -156,15 +156,33 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
          return std::make_unique<DoglegEngine<N>>(d, std::move(o));
        }});
   add({"broyden",
-       "Broyden's good method: line search, Jacobian restarts, O(n^2) inverse updates",
+       "Broyden's good method: line search, Jacobian restarts, O(n^2) inverse updates (limited "
+       "memory, O(k n), on a sparse Jacobian)",
        {{"backtracks", "step halvings before the Jacobian is renewed, 0..60; default 10"},
         {"updates", "updates before a fresh Jacobian regardless, 0 = off; default 0"},
-        {"fd", "forward|central differences when no Jacobian; default central"}},
-       {"broyden", "broyden:fd=forward,updates=20"},
+        {"fd", "forward|central differences when no Jacobian; default central"},
+        {"linear",
+         "auto|dense|band-lu|sparse-lu|klu|umfpack: H0 = J^-1 of a problem with a sparse "
+         "Jacobian by this direct solver, the updates kept as vectors (limited memory), or "
+         "dense H; default auto"},
+        {"ordering", detail::kOrderingKeyHelp},
+        {"memory",
+         "updates the limited-memory form keeps before a fresh Jacobian, 1..1000; "
+         "default 20"}},
+       {"broyden", "broyden:fd=forward,updates=20", "broyden:memory=50"},
        [](EngineSpecReader& s, SolverOptions o) {
          BroydenOptions b;
          if (auto v = s.integer("backtracks", 0, 60)) b.max_backtracks = *v;
          if (auto v = s.integer("updates", 0, 1 << 30)) b.max_updates = *v;
+         if (auto v = s.integer("memory", 1, 1000)) b.memory = *v;
+         if (auto v = s.text("preconditioner")) {
+           throw InvalidInput("broyden: preconditioner=" + *v +
+                              " does not apply: H0 is applied by a direct solver "
+                              "(linear=auto|band-lu|sparse-lu|klu|umfpack)");
+         }
+         if (auto v = detail::parse_linear_solver("broyden", s, b.linear_solver)) {
+           b.linear_solver = *v;
+         }
          if (auto v = s.text("fd"))
            b.finite_difference = detail::parse_finite_difference("broyden", *v);
          return std::make_unique<BroydenEngine<N>>(b, std::move(o));
@@ -177,9 +195,12 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
         {"geodesic", "0/1 geodesic acceleration (Transtrum-Sethna); default 0"},
         {"ftol", "relative reduction of |F|^2 (least squares); default 1e-10"},
         {"gtol", "cosine of F and the columns of J; default 1e-12"},
-        {"fd", "forward|central differences when no Jacobian; default central"}},
+        {"fd", "forward|central differences when no Jacobian; default central"},
+        {"linear",
+         "auto|cholmod|dense: the step of a problem with a sparse Jacobian by CHOLMOD's sparse "
+         "Cholesky of the normal equations, or dense QR; default auto (cholmod)"}},
        {"levenberg-marquardt", "levenberg-marquardt:geodesic=1",
-        "levenberg-marquardt:scale=jacobian"},
+        "levenberg-marquardt:scale=jacobian", "levenberg-marquardt:linear=dense"},
        [](EngineSpecReader& s, SolverOptions o) {
          LevenbergMarquardtOptions l;
          if (auto v = s.text("scale")) {
@@ -197,6 +218,7 @@ void add_builtin_engines(EngineRegistry<N>& registry) {
          if (auto v = s.text("fd")) {
            l.finite_difference = detail::parse_finite_difference("levenberg-marquardt", *v);
          }
+         if (auto v = s.text("linear")) l.linear_solver = *v;
          return std::make_unique<LevenbergMarquardtEngine<N>>(l, std::move(o));
        }});
   add({"pseudo-transient",

@@ -105,8 +105,9 @@ class Engine {
   virtual bool accepts_scaling() const { return false; }
   // Whether solve() takes the sparse path (J assembled sparse, steps by the linear-solver layer)
   // for a problem that carries a sparse Jacobian, declared or detected: newton with a line search
-  // or full steps, pseudo-transient (under a scaling too) — not with linear_solver = "dense". The
-  // others build and factor a dense n×n J (auto skips them on a large sparse problem).
+  // or full steps, pseudo-transient, levenberg-marquardt (the normal equations by CHOLMOD) and
+  // broyden (limited memory), under a scaling too — not with linear_solver = "dense". The others
+  // build and factor a dense n×n J (auto skips them on a large sparse problem).
   virtual bool has_sparse_path() const { return false; }
   void set_scaling(Scaling scaling) {
     if (scaled_solve_running_) {

@@ -26,14 +26,23 @@
 // minimum on the box) and a square one is blocked_by_bound, as is a stagnation where a bound
 // holds x.
 // Geodesic acceleration is refused with bounds (its second-difference point may leave the box).
-#include <Eigen/Householder>
-#include <Eigen/QR>
+//
+// The step's linear algebra is a model: LmQrModel (dense J, QR with column pivoting, as MINPACK)
+// or, at run-time size on a problem with a sparse Jacobian (declared, or detected by
+// RootProblem::with_autodiff), LmNormalEquationsModel (the damped normal equations by CHOLMOD's
+// sparse Cholesky; the same λ iteration, one factorisation per λ tried). Both give the loop below
+// the same calls: jacobian() to fill, gradient, freeze, column_norms, factor (returning gtol's
+// cosine), find_lambda (the step p(λ) in x's order), multiply (J p), damped_solve (the
+// acceleration), report.
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <sstream>
+#include <string>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 
 #include "nlobs/solvers/engine.hpp"
@@ -41,6 +50,8 @@
 #include "nlobs/solvers/library_sizes.hpp"
 #include "nlobs/solvers/square_system.hpp"
 #include "nlobs/solvers/stop_monitor.hpp"
+#include "nlobs/solvers/trust_region/lm_normal_equations_model.hpp"
+#include "nlobs/solvers/trust_region/lm_qr_model.hpp"
 
 namespace nlobs {
 
@@ -62,6 +73,11 @@ struct LevenbergMarquardtOptions {
   double second_derivative_step = 0.1;  // h of the directional second difference; > 0
   // Used only when the problem carries no Jacobian.
   FiniteDifference finite_difference = FiniteDifference::kCentral;
+  // The step's linear algebra on a problem with a sparse Jacobian (run-time size): "auto" or
+  // "cholmod" — the damped normal equations by CHOLMOD's sparse Cholesky — or "dense" (J dense,
+  // QR with column pivoting, as on every other problem). A problem without a sparse Jacobian
+  // takes the dense path whatever this says.
+  std::string linear_solver = "auto";
 };
 
 template <int N = Dynamic>
@@ -75,6 +91,7 @@ class LevenbergMarquardtEngine : public Engine<N> {
   bool accepts_bounds() const override { return true; }
   bool accepts_strict_bounds() const override { return true; }
   bool accepts_scaling() const override { return true; }
+  bool has_sparse_path() const override { return lm_.linear_solver != "dense"; }
 
   // Square: F = G − x, J = ∂G − I.
   Summary solve(const FixedPointProblem<N>& problem, Vector<N>& x) override;
@@ -83,18 +100,17 @@ class LevenbergMarquardtEngine : public Engine<N> {
 
  private:
   using ResidualVector = Vector<Dynamic>;
-  using JacobianMatrix = Matrix<Dynamic, N>;
 
-  // The iteration on F given as residual(x, f) → finite? and jacobian(x, J) (evaluations it
-  // spent); m = rows of F.
+  // The iteration on F given as residual(x, f) → finite? and jacobian(x, f, J) (evaluations it
+  // spent, J the model's), with the step's linear algebra by `model`; m = rows of F.
   // jacobian_cost: the evaluations of F one Jacobian spends (0 when the problem carries one).
-  template <typename Residual, typename Jacobian>
-  Summary run(Residual&& residual, Jacobian&& jacobian, int jacobian_cost, Index m, Vector<N>& x);
-  // min ‖[R; √λ D_P] z − [b; 0]‖ (MINPACK's qrsolv) into z; leaves S (the triangular factor of
-  // the augmented matrix) in s_ and its diagonal in sdiag_.
-  void solve_damped(double lambda, const Vector<N>& b, Vector<N>& z);
-  // Moré's λ for radius delta (MINPACK's lmpar); leaves the permuted step in z_ and returns λ.
-  double find_lambda(double delta, double lambda);
+  template <typename Model, typename Residual, typename Jacobian>
+  Summary run(Model& model, Residual&& residual, Jacobian&& jacobian, int jacobian_cost, Index m,
+              Vector<N>& x);
+  // The sparse model for a solve from x, or nullptr for the dense path.
+  template <typename Problem>
+  std::shared_ptr<detail::LmNormalEquationsModel> sparse_model(const Problem& problem,
+                                                               const Vector<N>& x) const;
 
   void resize(Index n, Index m);
   void on_set_bounds() override {
@@ -107,16 +123,12 @@ class LevenbergMarquardtEngine : public Engine<N> {
 
   LevenbergMarquardtOptions lm_;
   Vector<N> x_ = zero_vector<N>(), xt_ = zero_vector<N>(), p_ = zero_vector<N>(),
-            diag_ = zero_vector<N>(), diag_p_ = zero_vector<N>(), qtf_ = zero_vector<N>(),
-            z_ = zero_vector<N>(), w_ = zero_vector<N>(), sdiag_ = zero_vector<N>(),
-            b_ = zero_vector<N>(), v_ = zero_vector<N>(), a_ = zero_vector<N>(),
-            qtr_ = zero_vector<N>(), g_ = zero_vector<N>(), column_norms_ = zero_vector<N>(),
-            gradient_ = zero_vector<N>();
+            diag_ = zero_vector<N>(), v_ = zero_vector<N>(), a_ = zero_vector<N>(),
+            g_ = zero_vector<N>(), column_norms_ = zero_vector<N>(), gradient_ = zero_vector<N>();
+  Eigen::Array<bool, N, 1> frozen_;
   ResidualVector f_, ft_, fh_, fp_, fm_, work_m_;
-  JacobianMatrix jac_;
-  Matrix<N, N> r_, s_;
-  Eigen::ColPivHouseholderQR<JacobianMatrix> qr_;
-  Eigen::Matrix<Index, N, 1> perm_;
+  detail::LmQrModel<N> dense_;
+  Matrix<N, N> square_jacobian_;  // ∂G or ∂F of a fixed-size square problem, before J
   FiniteDifferenceWorkspace<N> fd_;
   detail::Box<N> box_;
   ProgressWindow progress_;
@@ -143,148 +155,57 @@ LevenbergMarquardtEngine<N>::LevenbergMarquardtEngine(LevenbergMarquardtOptions 
           "acceleration_ratio", lm_.acceleration_ratio, "must be finite and > 0");
   require(lm_.second_derivative_step > 0.0 && std::isfinite(lm_.second_derivative_step),
           "second_derivative_step", lm_.second_derivative_step, "must be finite and > 0");
+  if (lm_.linear_solver != "auto" && lm_.linear_solver != "dense" &&
+      lm_.linear_solver != "cholmod") {
+    throw InvalidInput("LevenbergMarquardtOptions::linear_solver = \"" + lm_.linear_solver +
+                       "\" is invalid: must be auto, dense or cholmod");
+  }
   detail::require_lipschitz_for_error_bound(name(), this->options_.stop);
 }
 
 template <int N>
 void LevenbergMarquardtEngine<N>::resize(Index n, Index m) {
   if constexpr (N == Dynamic) {
-    for (Vector<N>* v : {&x_, &xt_, &p_, &diag_, &diag_p_, &qtf_, &z_, &w_, &sdiag_, &b_, &v_, &a_,
-                         &qtr_, &g_, &column_norms_, &gradient_}) {
+    for (Vector<N>* v : {&x_, &xt_, &p_, &diag_, &v_, &a_, &g_, &column_norms_, &gradient_}) {
       v->resize(n);
     }
-    perm_.resize(n), r_.resize(n, n), s_.resize(n, n), fd_.resize(n);
+    frozen_.resize(n);
+    fd_.resize(n);
   }
   for (ResidualVector* v : {&f_, &ft_, &fh_, &fp_, &fm_, &work_m_}) {
     if (v->size() != m) v->resize(m);
   }
-  if (jac_.rows() != m || jac_.cols() != n) jac_.resize(m, n);
-  // qr_ sizes itself in compute(): allocates when m changes, never after.
 }
 
 template <int N>
-void LevenbergMarquardtEngine<N>::solve_damped(double lambda, const Vector<N>& b, Vector<N>& z) {
-  const Index n = r_.rows();
-  s_ = r_.template triangularView<Eigen::Upper>();
-  b_ = b;
-  const double root = std::sqrt(lambda);
-  for (Index j = 0; j < n; ++j) {
-    const double dj = root * diag_p_[j];
-    if (dj == 0.0) continue;
-    // The row [0 … √λ D_j … 0 | 0] of the augmented system, eliminated against S by rotations.
-    w_.setZero();
-    w_[j] = dj;
-    double extra = 0.0;  // its right-hand side
-    for (Index k = j; k < n; ++k) {
-      if (w_[k] == 0.0) continue;
-      const double radius = std::hypot(s_(k, k), w_[k]);
-      const double c = s_(k, k) / radius, s = w_[k] / radius;  // [c s; −s c] zeroes w_k
-      for (Index i = k; i < n; ++i) {
-        const double top = s_(k, i), bottom = w_[i];
-        s_(k, i) = c * top + s * bottom;
-        w_[i] = -s * top + c * bottom;
-      }
-      const double top = b_[k];
-      b_[k] = c * top + s * extra;
-      extra = -s * top + c * extra;
+template <typename Problem>
+std::shared_ptr<detail::LmNormalEquationsModel> LevenbergMarquardtEngine<N>::sparse_model(
+    const Problem& problem, const Vector<N>& x) const {
+  if constexpr (N == Dynamic) {
+    if (lm_.linear_solver == "dense") return nullptr;
+    bool sparse = false;
+    if constexpr (std::is_same_v<Problem, FixedPointProblem<N>>) {
+      sparse = problem.has_residual() && problem.sparse_residual_jacobian(x) != nullptr;
+    } else {
+      sparse = problem.sparse_jacobian(x) != nullptr;
     }
+    // Made afresh for each solve: copies of an engine never share one.
+    if (sparse) return std::make_shared<detail::LmNormalEquationsModel>();
   }
-  sdiag_ = s_.diagonal();
-  // Back substitution; a zero diagonal ends the non-singular part (the rest of z is 0).
-  Index rank = n;
-  for (Index j = 0; j < n; ++j) {
-    if (s_(j, j) == 0.0) {
-      rank = j;
-      break;
-    }
-  }
-  z.setZero();
-  for (Index j = rank - 1; j >= 0; --j) {
-    double sum = b_[j];
-    for (Index i = j + 1; i < rank; ++i) sum -= s_(j, i) * z[i];
-    z[j] = sum / s_(j, j);
-  }
+  static_cast<void>(problem), static_cast<void>(x);
+  return nullptr;
 }
 
 template <int N>
-double LevenbergMarquardtEngine<N>::find_lambda(double delta, double lambda) {
-  const Index n = r_.rows();
-  const double dwarf = std::numeric_limits<double>::min();
-  // Gauss–Newton direction R z = Qᵀ F; rank-deficient R: components past the first zero
-  // diagonal are 0.
-  Index rank = n;
-  for (Index j = 0; j < n; ++j) {
-    if (r_(j, j) == 0.0) {
-      rank = j;
-      break;
-    }
-  }
-  z_.setZero();
-  for (Index j = rank - 1; j >= 0; --j) {
-    double sum = qtf_[j];
-    for (Index i = j + 1; i < rank; ++i) sum -= r_(j, i) * z_[i];
-    z_[j] = sum / r_(j, j);
-  }
-  double dxnorm = diag_p_.cwiseProduct(z_).norm();
-  double fp = dxnorm - delta;
-  if (fp <= 0.1 * delta) return 0.0;
-
-  // Bounds on λ: parl from the Newton step of the secular equation at λ = 0 (full rank only),
-  // paru = ‖D⁻¹ Jᵀ F‖ / Δ.
-  double parl = 0.0;
-  if (rank == n) {
-    w_ = diag_p_.cwiseProduct(diag_p_.cwiseProduct(z_)) / dxnorm;
-    for (Index j = 0; j < n; ++j) {
-      double sum = w_[j];
-      for (Index i = 0; i < j; ++i) sum -= r_(i, j) * w_[i];
-      w_[j] = sum / r_(j, j);
-    }
-    const double t = w_.norm();
-    parl = ((fp / delta) / t) / t;
-  }
-  for (Index j = 0; j < n; ++j) {
-    w_[j] = r_.col(j).head(j + 1).dot(qtf_.head(j + 1)) / diag_p_[j];
-  }
-  const double gnorm = w_.norm();
-  double paru = gnorm / delta;
-  if (paru == 0.0) paru = dwarf / std::min(delta, 0.1);
-
-  lambda = std::min(std::max(lambda, parl), paru);  // MINPACK's order (parl > paru by rounding)
-  if (lambda == 0.0) lambda = gnorm / dxnorm;
-  for (int iteration = 1;; ++iteration) {
-    if (lambda == 0.0) lambda = std::max(dwarf, 0.001 * paru);
-    solve_damped(lambda, qtf_, z_);
-    dxnorm = diag_p_.cwiseProduct(z_).norm();
-    const double previous = fp;
-    fp = dxnorm - delta;
-    // |‖Dp‖ − Δ| ≤ 0.1 Δ, or λ at its lower bound 0 with ‖Dp‖ < Δ still, or ten iterations.
-    if (std::abs(fp) <= 0.1 * delta || (parl == 0.0 && fp <= previous && previous < 0.0) ||
-        iteration == 10) {
-      return lambda;
-    }
-    // Newton correction of λ on φ(λ) = ‖D p(λ)‖ − Δ, through S from solve_damped.
-    w_ = diag_p_.cwiseProduct(diag_p_.cwiseProduct(z_)) / dxnorm;
-    for (Index j = 0; j < n; ++j) {
-      w_[j] /= sdiag_[j];
-      for (Index i = j + 1; i < n; ++i) w_[i] -= s_(j, i) * w_[j];
-    }
-    const double t = w_.norm();
-    const double correction = ((fp / delta) / t) / t;
-    if (fp > 0.0) parl = std::max(parl, lambda);
-    if (fp < 0.0) paru = std::min(paru, lambda);
-    lambda = std::max(parl, lambda + correction);
-  }
-}
-
-template <int N>
-template <typename Residual, typename Jacobian>
-Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobian,
+template <typename Model, typename Residual, typename Jacobian>
+Summary LevenbergMarquardtEngine<N>::run(Model& model, Residual&& residual, Jacobian&& jacobian,
                                          int jacobian_cost, Index m, Vector<N>& x) {
   const Index n = x.size();
   const bool least_squares = m > n;
   StopCriteria stop = this->options_.stop;
   stop.stagnation_patience = 0;  // a trust region grows and shrinks its steps by design
   resize(n, m);
+  model.resize(n, m);
   Summary summary;
   summary.engine = name();
   StopMonitor monitor(stop, x.template lpNorm<Eigen::Infinity>(), /*estimate_lipschitz=*/false);
@@ -346,9 +267,9 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
       status = Status::kMaxEvaluations;  // the differences would overrun the budget
       break;
     }
-    evaluations += jacobian(x_, f_, jac_);
+    evaluations += jacobian(x_, f_, model.jacobian());
     ++jacobians;
-    if (!jac_.allFinite()) {
+    if (!model.finite()) {
       summary.message = "the Jacobian of F is not finite";
       status = Status::kNonFinite;
       break;
@@ -356,17 +277,21 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
     // −∇(½‖F‖²) = −Jᵀ F; in a box, the active set: the variables on a closed bound it points out
     // of are frozen for this Jacobian (their columns zeroed, so the step leaves them where they
     // are). A strict bound is never reached: its steps are cut short by the projection instead.
-    gradient_.noalias() = -(jac_.transpose() * f_);
-    bool bound_held = false;
+    model.gradient(f_, gradient_);
+    frozen_.setConstant(false);
     if (box_.active()) {
-      for (Index k = 0; k < n; ++k) {
-        if (box_.on_closed_bound_against(k, x_[k], gradient_[k])) {
-          jac_.col(k).setZero();
-          bound_held = true;
-        }
-      }
+      for (Index k = 0; k < n; ++k)
+        frozen_[k] = box_.on_closed_bound_against(k, x_[k], gradient_[k]);
     }
-    column_norms_ = jac_.colwise().norm().transpose();
+    const bool bound_held = frozen_.any();
+    model.freeze(frozen_);
+    model.column_norms(column_norms_);
+    if (!column_norms_.allFinite()) {
+      // (Entries near 1e154: every cosine would read 0 and gtol stop a run far from a minimum.)
+      summary.message = "the column norms of the Jacobian of F overflow";
+      status = Status::kNonFinite;
+      break;
+    }
     if (jacobians == 1) {
       if (lm_.scale_by_jacobian_columns) {
         for (Index j = 0; j < n; ++j) diag_[j] = column_norms_[j] == 0.0 ? 1.0 : column_norms_[j];
@@ -378,27 +303,9 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
     } else if (lm_.scale_by_jacobian_columns) {
       diag_ = diag_.cwiseMax(column_norms_);
     }
-    qr_.compute(jac_);
-    r_ = qr_.matrixR().topRows(n).template triangularView<Eigen::Upper>();
-    for (Index j = 0; j < n; ++j) {
-      perm_[j] = qr_.colsPermutation().indices()[j];
-      diag_p_[j] = diag_[perm_[j]];
-    }
-    work_m_ = f_;
-    work_m_.applyOnTheLeft(qr_.householderQ().adjoint());
-    qtf_ = work_m_.head(n);
-
     // MINPACK's gtol: the largest cosine between F and a column of J (in a box, of the free
     // variables' columns: the frozen ones are zero).
-    double cosine = 0.0;
-    if (fnorm > 0.0) {
-      for (Index j = 0; j < n; ++j) {
-        const double norm = column_norms_[perm_[j]];
-        if (norm == 0.0) continue;
-        cosine =
-            std::max(cosine, std::abs(r_.col(j).head(j + 1).dot(qtf_.head(j + 1)) / fnorm) / norm);
-      }
-    }
+    const double cosine = model.factor(f_, fnorm, diag_, column_norms_);
     if (cosine <= lm_.gradient_tolerance) {
       if (least_squares) {
         summary.message = bound_held ? "the projected gradient vanishes: a minimum on the box"
@@ -412,8 +319,7 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
 
     // Inner loop: trial steps with this Jacobian until one is accepted.
     while (!status) {
-      lambda = find_lambda(delta, lambda);
-      for (Index j = 0; j < n; ++j) v_[perm_[j]] = -z_[j];  // the step in x's order
+      lambda = model.find_lambda(delta, lambda, v_);
       const double vnorm = diag_.cwiseProduct(v_).norm();
       if (!std::isfinite(lambda) || !v_.allFinite()) {
         stagnate("the Levenberg-Marquardt step is not finite (J or F near overflow)");
@@ -432,12 +338,9 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
         ++evaluations;
         progress_.saw(std::numeric_limits<double>::infinity());
         if (residual(xt_, fh_)) {
-          work_m_.noalias() = jac_ * v_;
+          model.multiply(v_, work_m_);
           work_m_ = (2.0 / h) * ((fh_ - f_) / h - work_m_);
-          work_m_.applyOnTheLeft(qr_.householderQ().adjoint());
-          qtr_ = work_m_.head(n);
-          solve_damped(lambda, qtr_, z_);
-          for (Index j = 0; j < n; ++j) a_[perm_[j]] = -z_[j];
+          model.damped_solve(lambda, work_m_, a_);
           if (2.0 * diag_.cwiseProduct(a_).norm() <= lm_.acceleration_ratio * vnorm) {
             p_ = v_ + 0.5 * a_;
             accelerated = true;
@@ -469,11 +372,11 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
       // projected step p', 1 − ‖F + J p'‖²/‖F‖² directly. directional = Fᵀ J p / ‖F‖².
       double predicted = 0.0, directional = 0.0;
       if (projected) {
-        work_m_.noalias() = jac_ * p_;
+        model.multiply(p_, work_m_);
         directional = f_.dot(work_m_) / (fnorm * fnorm);
         predicted = -2.0 * directional - work_m_.squaredNorm() / (fnorm * fnorm);
       } else {
-        work_m_.noalias() = jac_ * v_;
+        model.multiply(v_, work_m_);
         const double t1 = work_m_.norm() / fnorm;
         const double t2 = std::sqrt(lambda) * vnorm / fnorm;
         predicted = t1 * t1 + 2.0 * t2 * t2;
@@ -539,6 +442,7 @@ Summary LevenbergMarquardtEngine<N>::run(Residual&& residual, Jacobian&& jacobia
   summary.status = *status;
   summary.function_evaluations = evaluations;
   summary.jacobian_evaluations = jacobians;
+  model.report(summary);
   monitor.fill(summary, f_.allFinite() ? f_.template lpNorm<Eigen::Infinity>()
                                        : std::numeric_limits<double>::infinity());
   summary.record_answer(x, this->options_.stop, least_squares);
@@ -568,25 +472,44 @@ Summary LevenbergMarquardtEngine<N>::solve(const FixedPointProblem<N>& problem, 
     }
     return f.allFinite();
   };
-  auto jacobian = [&](const Vector<N>& at, const ResidualVector& f, JacobianMatrix& jac) {
+  if constexpr (N == Dynamic) {
+    if (const std::shared_ptr<detail::LmNormalEquationsModel> sparse = sparse_model(problem, x)) {
+      detail::SparseJacobianState& state = *problem.sparse_jacobian_state();
+      auto jacobian = [&state](const Vector<N>& at, const ResidualVector& f, SparseJacobian& jac) {
+        return detail::evaluate_sparse_jacobian(state, at, f, jac);
+      };
+      return run(*sparse, residual, jacobian, state.get()->evaluations_per_jacobian, n, x);
+    }
+  }
+  // ∂G or ∂F straight into J at run-time size; through square_jacobian_ at a fixed one (J is
+  // m×n there, Matrix<Dynamic, N>).
+  auto jacobian = [&](const Vector<N>& at, const ResidualVector& f,
+                      typename detail::LmQrModel<N>::JacobianMatrix& jac) {
+    Matrix<N, N>& square = [&]() -> Matrix<N, N>& {
+      if constexpr (N == Dynamic) {
+        return jac;
+      } else {
+        return square_jacobian_;
+      }
+    }();
     int spent = 0;
     if (problem.has_jacobian() && problem.has_residual()) {
-      problem.residual_jacobian(at, r_);  // ∂F itself
-      jac = r_;
-      return spent;
-    }
-    if (problem.has_jacobian()) {
-      problem.jacobian(at, r_);
+      problem.residual_jacobian(at, square);  // ∂F itself
     } else {
-      xt_ = f + at;  // G(x)
-      spent = finite_difference_jacobian(problem, at, xt_, r_, lm_.finite_difference, fd_, &box_);
+      if (problem.has_jacobian()) {
+        problem.jacobian(at, square);
+      } else {
+        xt_ = f + at;  // G(x)
+        spent =
+            finite_difference_jacobian(problem, at, xt_, square, lm_.finite_difference, fd_, &box_);
+      }
+      square.diagonal().array() -= 1.0;
     }
-    jac = r_;
-    jac.diagonal().array() -= 1.0;
+    if constexpr (N != Dynamic) jac = square;
     return spent;
   };
   const int cost = problem.has_jacobian() ? 0 : finite_difference_cost(lm_.finite_difference, n);
-  return run(residual, jacobian, cost, n, x);
+  return run(dense_, residual, jacobian, cost, n, x);
 }
 
 template <int N>
@@ -621,7 +544,17 @@ Summary LevenbergMarquardtEngine<N>::solve_least_squares(const RootProblem<N, Dy
     }
     return f.allFinite();
   };
-  auto jacobian = [&](const Vector<N>& at, const ResidualVector& f, JacobianMatrix& jac) {
+  if constexpr (N == Dynamic) {
+    if (const std::shared_ptr<detail::LmNormalEquationsModel> sparse = sparse_model(problem, x)) {
+      detail::SparseJacobianState& state = *problem.sparse_jacobian_state();
+      auto jacobian = [&state](const Vector<N>& at, const ResidualVector& f, SparseJacobian& jac) {
+        return detail::evaluate_sparse_jacobian(state, at, f, jac);
+      };
+      return run(*sparse, residual, jacobian, state.get()->evaluations_per_jacobian, m, x);
+    }
+  }
+  auto jacobian = [&](const Vector<N>& at, const ResidualVector& f,
+                      typename detail::LmQrModel<N>::JacobianMatrix& jac) {
     if (problem.has_jacobian()) {
       problem.jacobian(at, jac);
       return 0;
@@ -632,7 +565,7 @@ Summary LevenbergMarquardtEngine<N>::solve_least_squares(const RootProblem<N, Dy
   };
   const int cost =
       problem.has_jacobian() ? 0 : finite_difference_cost(lm_.finite_difference, problem.size());
-  return run(residual, jacobian, cost, m, x);
+  return run(dense_, residual, jacobian, cost, m, x);
 }
 
 // Compiled once in the library for its sizes (nlobs/solvers/library_sizes.hpp).

@@ -39,10 +39,10 @@ struct PolyalgorithmOptions {
   int shared_minimum = 2;
   static constexpr double kSameMinimum = 1e-3;
   // On a problem with a sparse Jacobian (declared, or detected at x0) of more than this many
-  // unknowns, the stages without a sparse path (Engine::has_sparse_path: dogleg,
-  // levenberg-marquardt, broyden, …) are not run: each would build and factor a dense n×n J —
-  // at n = 10⁴ 800 MB and minutes per factorisation, where newton and pseudo-transient take
-  // milliseconds on the sparse path — unless no stage has a sparse path (auto:order=dogleg):
+  // unknowns, the stages without a sparse path (Engine::has_sparse_path: dogleg, newton's trust
+  // region, …) are not run: each would build and factor a dense n×n J — at n = 10⁴ 800 MB and
+  // minutes per factorisation, where newton and pseudo-transient take milliseconds on the
+  // sparse path — unless no stage has a sparse path (auto:order=dogleg):
   // then all run, densely. 0: run them at any n. ≥ 0.
   Index dense_stage_limit = 1000;
 };

@@ -68,6 +68,8 @@ class SparseLinearStep {
     solver_ = make_linear_solver(choose_linear_solver(spec, pattern, n));
   }
   const LinearSolver& solver() const { return *solver_; }
+  // Sets up A (factor, or build the preconditioner) for resolve().
+  LinearStatus setup(const SparseJacobian& a) { return solver_->setup(a); }
   bool iterative() const { return solver_->iterative(); }
 
   // A x = b, x to a relative residual `tolerance` for a Krylov solver (a direct one solves

@@ -17,6 +17,25 @@
 
 namespace nlobs::detail {
 
+// jac = J_F(x) by the state's source (resolved), f = F(x); returns the evaluations of F it made.
+// A J of another structure than the source's pattern (a user's evaluate) is refused: the engines
+// address its entries through the pattern.
+inline int evaluate_sparse_jacobian(SparseJacobianState& state, const Vector<Dynamic>& x,
+                                    const Vector<Dynamic>& f, SparseJacobian& jac) {
+  const int spent = state.evaluate(x, f, jac);
+  const SparsityPattern& pattern = *state.get()->pattern;
+  if (jac.rows() != pattern.rows || jac.cols() != pattern.cols || !jac.isCompressed() ||
+      jac.nonZeros() != pattern.nonzeros()) {
+    throw InvalidInput(
+        "the sparse Jacobian's evaluate returned a " + std::to_string(jac.rows()) + "x" +
+        std::to_string(jac.cols()) + " matrix with " + std::to_string(jac.nonZeros()) +
+        " stored entries" + (jac.isCompressed() ? "" : " (not compressed)") +
+        ", not the structure of its pattern (" + std::to_string(pattern.rows) + "x" +
+        std::to_string(pattern.cols) + ", " + std::to_string(pattern.nonzeros()) + " entries)");
+  }
+  return spent;
+}
+
 template <int N>
 class SquareSystem {
  public:
@@ -91,18 +110,8 @@ class SquareSystem {
     if (evaluations_ + sparse.evaluations_per_jacobian > max_evaluations_) {
       return Status::kMaxEvaluations;
     }
-    evaluations_ += state.evaluate(x, f, jac);
+    evaluations_ += evaluate_sparse_jacobian(state, x, f, jac);
     ++jacobians_;
-    const SparsityPattern& pattern = *sparse.pattern;
-    if (jac.rows() != pattern.rows || jac.cols() != pattern.cols || !jac.isCompressed() ||
-        jac.nonZeros() != pattern.nonzeros()) {
-      throw InvalidInput(
-          "the sparse Jacobian's evaluate returned a " + std::to_string(jac.rows()) + "x" +
-          std::to_string(jac.cols()) + " matrix with " + std::to_string(jac.nonZeros()) +
-          " stored entries" + (jac.isCompressed() ? "" : " (not compressed)") +
-          ", not the structure of its pattern (" + std::to_string(pattern.rows) + "x" +
-          std::to_string(pattern.cols) + ", " + std::to_string(pattern.nonzeros()) + " entries)");
-    }
     if (detail::first_non_finite_row(jac) >= 0) {
       message = "the Jacobian of F is not finite";
       return Status::kNonFinite;

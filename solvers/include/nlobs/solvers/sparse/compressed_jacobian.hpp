@@ -123,8 +123,9 @@ class CompressedJacobian {
 
 namespace detail {
 // The sparse Jacobian of f by compressed AD (f generic in its scalar type) or coloured forward
-// differences (f on doubles), on `pattern` with its whole diagonal: a structural entry, zero
-// where F_i does not depend on x_i (ILU(0) and Jacobi then still fail on the zero, named).
+// differences (f on doubles), on `pattern` with its whole diagonal when square: a structural
+// entry, zero where F_i does not depend on x_i (ILU(0) and Jacobi then still fail on the zero,
+// named).
 template <typename F>
 SparseJacobianSource autodiff_jacobian_source(F f, const SparsityPattern& pattern) {
   CompressedJacobian compressed(with_diagonal(pattern));

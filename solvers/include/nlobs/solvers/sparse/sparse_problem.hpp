@@ -7,8 +7,8 @@
 //   sparse_autodiff_problem(f, pattern)  the same with a declared pattern
 //   sparse_difference_problem(f, pattern) f on doubles; J by coloured forward differences
 // J is compressed by a column colouring: one AD pass of 8 directions (or one evaluation of f) per
-// 8 colours (per colour), [CPR74]. The pattern gets the whole diagonal (a structural entry, zero
-// where F_i does not depend on x_i: ILU(0) and Jacobi then still fail on the zero, named). The
+// 8 colours (per colour), [CPR74]. A square pattern gets the whole diagonal (a structural entry,
+// zero where F_i does not depend on x_i: ILU(0) and Jacobi then still fail on the zero, named). The
 // problem keeps the dense Jacobian of the AD path too, for the engines that have no sparse path
 // yet. Coloured differences step forward (+h) whatever a box says: near a bound where F is not
 // defined outside, use the AD form.

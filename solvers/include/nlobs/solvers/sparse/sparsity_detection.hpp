@@ -3,8 +3,10 @@
 // itself, and how (docs/solvers.md, "Sparse Jacobians"). At the first point x an engine with a
 // sparse path asks with, F is evaluated once on SparsityTracer scalars; the pattern found is
 // used, compressed by a column colouring, when
-//   n = m ≥ kSmallestSize                       (below, the dense Jacobian costs next to nothing
-//                                               and small problems keep their exact behaviour),
+//   m ≥ n ≥ kSmallestSize                       (below, the dense Jacobian costs next to nothing
+//                                               and small problems keep their exact behaviour;
+//                                               m > n: least squares, levenberg-marquardt's
+//                                               sparse path),
 //   F compares no value that depends on x       (a branch: the pattern may change with x),
 //   no row of J has more than max(kRowFloor, n / kRowFraction) entries, and the trace copies at
 //   most kBudgetPerUnknown · n indices in all   (dense rows: the dense path is cheaper, and the
@@ -39,9 +41,9 @@ std::optional<SparseJacobianSource> detect_sparse_jacobian(F& f, const Vector<Dy
                                                            std::string& note) {
   using Rule = SparsityDetectionRule;
   const Index n = x.size();
-  if (m != n) {
+  if (m < n) {
     note = "not detected: F is " + std::to_string(m) + "x" + std::to_string(n) +
-           ", and only square systems have a sparse path yet";
+           ", fewer residuals than unknowns: no engine has a sparse path for it";
     return std::nullopt;
   }
   if (n < Rule::kSmallestSize) {

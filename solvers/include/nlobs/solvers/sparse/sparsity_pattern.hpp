@@ -86,7 +86,7 @@ struct SparsityPattern {
 };
 
 namespace detail {
-// `pattern` with every diagonal entry of its square part (src/sparsity_pattern.cpp).
+// A square `pattern` with every diagonal entry; any other unchanged (src/sparsity_pattern.cpp).
 SparsityPattern with_diagonal(const SparsityPattern& pattern);
 
 // What one evaluation of f on SparsityTracer inputs found: the pattern, the comparisons of values
