@@ -37,7 +37,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -107,10 +106,12 @@ class LevenbergMarquardtEngine : public Engine<N> {
   template <typename Model, typename Residual, typename Jacobian>
   Summary run(Model& model, Residual&& residual, Jacobian&& jacobian, int jacobian_cost, Index m,
               Vector<N>& x);
-  // The sparse model for a solve from x, or nullptr for the dense path.
-  template <typename Problem>
-  std::shared_ptr<detail::LmNormalEquationsModel> sparse_model(const Problem& problem,
-                                                               const Vector<N>& x) const;
+  // The run on the sparse path (LmNormalEquationsModel, made afresh for each solve: copies of
+  // an engine never share one) when the problem has a sparse Jacobian at x and linear_solver is
+  // not "dense"; nullopt for the dense path.
+  template <typename Problem, typename Residual>
+  std::optional<Summary> run_sparse(const Problem& problem, Residual& residual, Index m,
+                                    Vector<N>& x);
 
   void resize(Index n, Index m);
   void on_set_bounds() override {
@@ -178,22 +179,30 @@ void LevenbergMarquardtEngine<N>::resize(Index n, Index m) {
 }
 
 template <int N>
-template <typename Problem>
-std::shared_ptr<detail::LmNormalEquationsModel> LevenbergMarquardtEngine<N>::sparse_model(
-    const Problem& problem, const Vector<N>& x) const {
+template <typename Problem, typename Residual>
+std::optional<Summary> LevenbergMarquardtEngine<N>::run_sparse(const Problem& problem,
+                                                               Residual& residual, Index m,
+                                                               Vector<N>& x) {
   if constexpr (N == Dynamic) {
-    if (lm_.linear_solver == "dense") return nullptr;
-    bool sparse = false;
+    if (lm_.linear_solver == "dense") return std::nullopt;
     if constexpr (std::is_same_v<Problem, FixedPointProblem<N>>) {
-      sparse = problem.has_residual() && problem.sparse_residual_jacobian(x) != nullptr;
-    } else {
-      sparse = problem.sparse_jacobian(x) != nullptr;
+      if (!problem.has_residual() || problem.sparse_residual_jacobian(x) == nullptr) {
+        return std::nullopt;
+      }
+    } else if (problem.sparse_jacobian(x) == nullptr) {
+      return std::nullopt;
     }
-    // Made afresh for each solve: copies of an engine never share one.
-    if (sparse) return std::make_shared<detail::LmNormalEquationsModel>();
+    detail::SparseJacobianState& state = *problem.sparse_jacobian_state();
+    auto jacobian = [&state](const Vector<N>& at, const ResidualVector& f, SparseJacobian& jac) {
+      return detail::evaluate_sparse_jacobian(state, at, f, jac);
+    };
+    detail::LmNormalEquationsModel model;
+    return run(model, residual, jacobian, state.get()->evaluations_per_jacobian, m, x);
+  } else {
+    static_cast<void>(problem), static_cast<void>(residual), static_cast<void>(m),
+        static_cast<void>(x);
+    return std::nullopt;
   }
-  static_cast<void>(problem), static_cast<void>(x);
-  return nullptr;
 }
 
 template <int N>
@@ -472,14 +481,8 @@ Summary LevenbergMarquardtEngine<N>::solve(const FixedPointProblem<N>& problem, 
     }
     return f.allFinite();
   };
-  if constexpr (N == Dynamic) {
-    if (const std::shared_ptr<detail::LmNormalEquationsModel> sparse = sparse_model(problem, x)) {
-      detail::SparseJacobianState& state = *problem.sparse_jacobian_state();
-      auto jacobian = [&state](const Vector<N>& at, const ResidualVector& f, SparseJacobian& jac) {
-        return detail::evaluate_sparse_jacobian(state, at, f, jac);
-      };
-      return run(*sparse, residual, jacobian, state.get()->evaluations_per_jacobian, n, x);
-    }
+  if (std::optional<Summary> sparse = run_sparse(problem, residual, n, x)) {
+    return std::move(*sparse);
   }
   // ∂G or ∂F straight into J at run-time size; through square_jacobian_ at a fixed one (J is
   // m×n there, Matrix<Dynamic, N>).
@@ -544,14 +547,8 @@ Summary LevenbergMarquardtEngine<N>::solve_least_squares(const RootProblem<N, Dy
     }
     return f.allFinite();
   };
-  if constexpr (N == Dynamic) {
-    if (const std::shared_ptr<detail::LmNormalEquationsModel> sparse = sparse_model(problem, x)) {
-      detail::SparseJacobianState& state = *problem.sparse_jacobian_state();
-      auto jacobian = [&state](const Vector<N>& at, const ResidualVector& f, SparseJacobian& jac) {
-        return detail::evaluate_sparse_jacobian(state, at, f, jac);
-      };
-      return run(*sparse, residual, jacobian, state.get()->evaluations_per_jacobian, m, x);
-    }
+  if (std::optional<Summary> sparse = run_sparse(problem, residual, m, x)) {
+    return std::move(*sparse);
   }
   auto jacobian = [&](const Vector<N>& at, const ResidualVector& f,
                       typename detail::LmQrModel<N>::JacobianMatrix& jac) {
