@@ -47,6 +47,33 @@ SolverOptions least_squares_stop() {
   return o;
 }
 
+// One least-squares problem solved from x0 on the dense path (QR, `dense`) and on the sparse one
+// (CHOLMOD, `sparse`), by engines alike but for the problem; check() asserts both converged and
+// the sparse one on CHOLMOD.
+struct BothPaths {
+  Summary dense, sparse;
+  Vector<Dynamic> dense_x, x;
+
+  BothPaths(const RootProblem<>& dense_problem, const RootProblem<>& sparse_problem,
+            const Vector<Dynamic>& x0, const LevenbergMarquardtOptions& lm = {},
+            const SolverOptions& options = least_squares_stop(), const BoxBounds& box = {})
+      : dense_x(x0), x(x0) {
+    Lm dense_lm(lm, options), sparse_lm(lm, options);
+    if (box.lower.size() != 0 || box.upper.size() != 0) {
+      dense_lm.set_bounds(box);
+      sparse_lm.set_bounds(box);
+    }
+    dense = dense_lm.solve_least_squares(dense_problem, dense_x);
+    sparse = sparse_lm.solve_least_squares(sparse_problem, x);
+  }
+  void check() const {
+    ASSERT_EQ(dense.status, Status::kConverged) << dense.full_report();
+    ASSERT_EQ(sparse.status, Status::kConverged) << sparse.full_report();
+    EXPECT_TRUE(dense.linear_solver.empty());
+    EXPECT_EQ(sparse.linear_solver, "cholmod");
+  }
+};
+
 TEST(SparseLeastSquares, AnInconsistentFitMatchesTheDensePath) {
   const SmoothedFit fit(300);
   const Vector<Dynamic> x0 = Vector<Dynamic>::Zero(fit.n);
@@ -81,16 +108,11 @@ TEST(SparseLeastSquares, ScalingAndGeodesicAccelerationMatchTheDensePath) {
   for (const LevenbergMarquardtOptions& options :
        {LevenbergMarquardtOptions{.scale_by_jacobian_columns = true},
         LevenbergMarquardtOptions{.geodesic_acceleration = true}}) {
-    Lm dense_lm(options, least_squares_stop()), sparse_lm(options, least_squares_stop());
-    Vector<Dynamic> dense_x = x0, x = x0;
-    const Summary dense = dense_lm.solve_least_squares(fit.dense(), dense_x);
-    const Summary s = sparse_lm.solve_least_squares(fit.declared(), x);
-    ASSERT_EQ(dense.status, Status::kConverged) << dense.full_report();
-    ASSERT_EQ(s.status, Status::kConverged) << s.full_report();
-    EXPECT_EQ(s.linear_solver, "cholmod");
-    EXPECT_LE((x - dense_x).lpNorm<Eigen::Infinity>(), 1e-7);
-    EXPECT_NEAR(s.iterations, dense.iterations, 1);
-    EXPECT_NEAR(s.function_evaluations, dense.function_evaluations, 2);
+    const BothPaths run(fit.dense(), fit.declared(), x0, options);
+    ASSERT_NO_FATAL_FAILURE(run.check());
+    EXPECT_LE((run.x - run.dense_x).lpNorm<Eigen::Infinity>(), 1e-7);
+    EXPECT_NEAR(run.sparse.iterations, run.dense.iterations, 1);
+    EXPECT_NEAR(run.sparse.function_evaluations, run.dense.function_evaluations, 2);
   }
 }
 
@@ -101,13 +123,9 @@ TEST(SparseLeastSquares, MoresLambdaIterationTakesTheDensePathsIterates) {
   const Vector<Dynamic> x0 = Vector<Dynamic>::Constant(fit.n, 3.0);
   SolverOptions options = least_squares_stop();
   options.record_trace = true;
-  const LevenbergMarquardtOptions lm{.initial_radius_factor = 1e-3};
-  Lm dense_lm(lm, options), sparse_lm(lm, options);
-  Vector<Dynamic> dense_x = x0, x = x0;
-  const Summary dense = dense_lm.solve_least_squares(fit.dense(), dense_x);
-  const Summary s = sparse_lm.solve_least_squares(fit.declared(), x);
-  ASSERT_EQ(dense.status, Status::kConverged) << dense.full_report();
-  ASSERT_EQ(s.status, Status::kConverged) << s.full_report();
+  const BothPaths run(fit.dense(), fit.declared(), x0, {.initial_radius_factor = 1e-3}, options);
+  ASSERT_NO_FATAL_FAILURE(run.check());
+  const Summary &dense = run.dense, &s = run.sparse;
   ASSERT_EQ(s.iterations, dense.iterations);
   EXPECT_EQ(s.function_evaluations, dense.function_evaluations);
   EXPECT_GT(s.linear_setups, s.jacobian_evaluations) << "several lambdas per Jacobian";
@@ -123,16 +141,10 @@ TEST(SparseLeastSquares, ABoxThatHoldsVariablesGivesTheDenseMinimumOnTheBox) {
   // x* = sin(i/7) reaches ±1: a box of ±0.5 holds about a third of the variables.
   const BoxBounds box{Vector<Dynamic>::Constant(fit.n, -0.5),
                       Vector<Dynamic>::Constant(fit.n, 0.5)};
-  Lm dense_lm({}, least_squares_stop()), sparse_lm({}, least_squares_stop());
-  dense_lm.set_bounds(box);
-  sparse_lm.set_bounds(box);
-  Vector<Dynamic> dense_x = x0, x = x0;
-  const Summary dense = dense_lm.solve_least_squares(fit.dense(), dense_x);
-  const Summary s = sparse_lm.solve_least_squares(fit.declared(), x);
-  ASSERT_EQ(dense.status, Status::kConverged) << dense.full_report();
-  ASSERT_EQ(s.status, Status::kConverged) << s.full_report();
-  EXPECT_EQ(s.linear_solver, "cholmod");
-  EXPECT_LE((x - dense_x).lpNorm<Eigen::Infinity>(), 1e-7);
+  const BothPaths run(fit.dense(), fit.declared(), x0, {}, least_squares_stop(), box);
+  ASSERT_NO_FATAL_FAILURE(run.check());
+  const Vector<Dynamic>& x = run.x;
+  EXPECT_LE((x - run.dense_x).lpNorm<Eigen::Infinity>(), 1e-7);
   const Index held = (x.array().abs() == 0.5).count();
   EXPECT_GT(held, fit.n / 5) << "the box binds";
   EXPECT_LE(x.cwiseAbs().maxCoeff(), 0.5);
@@ -149,18 +161,13 @@ TEST(SparseLeastSquares, AVariableNoResidualDependsOnStaysWhereItIs) {
   const Index n = fit.n + 1, m = fit.residuals();
   Vector<Dynamic> x0 = Vector<Dynamic>::Zero(n);
   x0[n - 1] = 3.0;
-  Lm dense_lm({}, least_squares_stop()), sparse_lm({}, least_squares_stop());
-  Vector<Dynamic> dense_x = x0, x = x0;
-  const Summary dense =
-      dense_lm.solve_least_squares(RootProblem<>::with_dense_autodiff(f, n, m), dense_x);
-  const Summary s = sparse_lm.solve_least_squares(sparse_autodiff_problem(f, x0, m), x);
-  ASSERT_EQ(dense.status, Status::kConverged) << dense.full_report();
-  ASSERT_EQ(s.status, Status::kConverged) << s.full_report();
-  EXPECT_EQ(s.linear_solver, "cholmod");
+  const BothPaths run(RootProblem<>::with_dense_autodiff(f, n, m),
+                      sparse_autodiff_problem(f, x0, m), x0);
+  ASSERT_NO_FATAL_FAILURE(run.check());
   // λ = 0 does not factor; the smallest λ that does stands in, found once per Jacobian.
-  EXPECT_LE(s.linear_setups, 3 * s.jacobian_evaluations);
-  EXPECT_EQ(x[n - 1], 3.0);
-  EXPECT_LE((x - dense_x).lpNorm<Eigen::Infinity>(), 1e-6);
+  EXPECT_LE(run.sparse.linear_setups, 3 * run.sparse.jacobian_evaluations);
+  EXPECT_EQ(run.x[n - 1], 3.0);
+  EXPECT_LE((run.x - run.dense_x).lpNorm<Eigen::Infinity>(), 1e-6);
 }
 
 TEST(SparseLeastSquares, SolvesASquareSystemThroughItsResidualForm) {

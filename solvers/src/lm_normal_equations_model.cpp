@@ -8,6 +8,13 @@
 #include <limits>
 
 namespace nlobs::detail {
+namespace {
+// ε·max(max_j ‖J̃ e_j‖², 1): the smallest λ tried where λ = 0 does not factor; A + λI is positive
+// definite in floating point well before λ reaches ‖A‖ (tenfold steps from here).
+double regularising_lambda(double largest_diagonal) {
+  return std::numeric_limits<double>::epsilon() * std::max(largest_diagonal, 1.0);
+}
+}  // namespace
 
 void LmNormalEquationsModel::resize(Index n, Index m) {
   static_cast<void>(m);  // J comes sized from the problem's sparse Jacobian
@@ -79,7 +86,6 @@ bool LmNormalEquationsModel::base_step() {
   // λ = 0 when J̃ᵀJ̃ + E is positive definite; else the smallest of ε·max(max_j ‖J̃ e_j‖², 1)·10^k
   // that factors, whose step stands in for the Gauss–Newton step QR would take (the largest λ
   // that failed is the floor below which no λ is tried again).
-  const double regular = std::numeric_limits<double>::epsilon() * std::max(largest_diagonal_, 1.0);
   floor_ = -1.0;  // none failed yet
   base_lambda_ = 0.0;
   for (int tries = 0; tries <= 40; ++tries) {
@@ -96,7 +102,8 @@ bool LmNormalEquationsModel::base_step() {
       }
     }
     floor_ = base_lambda_;
-    base_lambda_ = base_lambda_ == 0.0 ? regular : 10.0 * base_lambda_;
+    base_lambda_ =
+        base_lambda_ == 0.0 ? regularising_lambda(largest_diagonal_) : 10.0 * base_lambda_;
     if (!std::isfinite(base_lambda_)) break;
   }
   return false;
@@ -127,7 +134,6 @@ double LmNormalEquationsModel::find_lambda(double delta, double lambda, Vector<D
   if (!std::isfinite(paru) || !std::isfinite(parl)) return nan;
   lambda = std::min(std::max(lambda, parl), paru);
   if (lambda == 0.0 && dxnorm > 0.0) lambda = gnorm / dxnorm;
-  const double regular = std::numeric_limits<double>::epsilon() * std::max(largest_diagonal_, 1.0);
   int failures = 0;
   for (int iteration = 1;; ++iteration) {
     if (lambda == 0.0) lambda = std::max(dwarf, 0.001 * paru);
@@ -137,7 +143,7 @@ double LmNormalEquationsModel::find_lambda(double delta, double lambda, Vector<D
       // (Rounding of a numerically singular J̃ᵀJ̃ above the base's floor: rare.)
       if (++failures > 40) return nan;
       floor_ = std::max(floor_, lambda);
-      lambda = std::max(10.0 * lambda, regular);
+      lambda = std::max(10.0 * lambda, regularising_lambda(largest_diagonal_));
       --iteration;
       continue;
     }

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <new>
 #include <stdexcept>
@@ -56,6 +57,27 @@ struct NormalEquationsCholesky::Cholmod {
     d.xtype = CHOLMOD_REAL;
     d.dtype = CHOLMOD_DOUBLE;
     return d;
+  }
+  // out = the systems applied to b in turn (CHOLMOD_A; or CHOLMOD_P then CHOLMOD_L) with the
+  // factor (`factored`: the last factorisation succeeded); a first system's output goes to
+  // `permuted` when a second follows.
+  void apply(const char* caller, bool factored, std::initializer_list<int> systems,
+             const Vector<Dynamic>& b, Vector<Dynamic>& out) {
+    if (!factored || b.size() != n) {
+      throw InvalidInput(std::string("NormalEquationsCholesky::") + caller +
+                         " without a factor of size " + std::to_string(b.size()));
+    }
+    cholmod_dense rhs = dense_view(b);
+    cholmod_dense* in = &rhs;
+    for (auto system = systems.begin(); system != systems.end(); ++system) {
+      cholmod_dense** result = system + 1 == systems.end() ? &x : &permuted;
+      if (!cholmod_solve2(*system, factor, in, nullptr, result, nullptr, &y, &e, &common)) {
+        check("cholmod_solve2");
+        throw std::runtime_error("CHOLMOD: cholmod_solve2 failed");
+      }
+      in = *result;
+    }
+    out = Eigen::Map<const Vector<Dynamic>>(static_cast<const double*>(x->x), n);
   }
   void check(const char* call) const {
     if (common.status == CHOLMOD_OUT_OF_MEMORY) throw std::bad_alloc();
@@ -173,34 +195,11 @@ bool NormalEquationsCholesky::factor(double lambda) {
 }
 
 void NormalEquationsCholesky::solve(const Vector<Dynamic>& b, Vector<Dynamic>& q) {
-  Cholmod& c = *cholmod_;
-  if (!factored_ || b.size() != c.n) {
-    throw InvalidInput("NormalEquationsCholesky::solve without a factor of size " +
-                       std::to_string(b.size()));
-  }
-  cholmod_dense rhs = Cholmod::dense_view(b);
-  if (!cholmod_solve2(CHOLMOD_A, c.factor, &rhs, nullptr, &c.x, nullptr, &c.y, &c.e, &c.common)) {
-    c.check("cholmod_solve2");
-    throw std::runtime_error("CHOLMOD: cholmod_solve2 failed");
-  }
-  q = Eigen::Map<const Vector<Dynamic>>(static_cast<const double*>(c.x->x), c.n);
+  cholmod_->apply("solve", factored_, {CHOLMOD_A}, b, q);
 }
 
 void NormalEquationsCholesky::solve_lower(const Vector<Dynamic>& b, Vector<Dynamic>& y) {
-  Cholmod& c = *cholmod_;
-  if (!factored_ || b.size() != c.n) {
-    throw InvalidInput("NormalEquationsCholesky::solve_lower without a factor of size " +
-                       std::to_string(b.size()));
-  }
-  cholmod_dense rhs = Cholmod::dense_view(b);
-  if (!cholmod_solve2(CHOLMOD_P, c.factor, &rhs, nullptr, &c.permuted, nullptr, &c.y, &c.e,
-                      &c.common) ||
-      !cholmod_solve2(CHOLMOD_L, c.factor, c.permuted, nullptr, &c.x, nullptr, &c.y, &c.e,
-                      &c.common)) {
-    c.check("cholmod_solve2");
-    throw std::runtime_error("CHOLMOD: cholmod_solve2 failed");
-  }
-  y = Eigen::Map<const Vector<Dynamic>>(static_cast<const double*>(c.x->x), c.n);
+  cholmod_->apply("solve_lower", factored_, {CHOLMOD_P, CHOLMOD_L}, b, y);
 }
 
 }  // namespace nlobs
