@@ -8,8 +8,10 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <random>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "invalid_argument_message.hpp"
@@ -268,6 +270,36 @@ TEST(SparseLeastSquares, AJacobianWhoseColumnNormsOverflowStopsBothPaths) {
     EXPECT_EQ(s.status, Status::kNonFinite) << linear << ": " << s.full_report();
     EXPECT_NE(s.message.find("overflow"), std::string::npos) << s.message;
   }
+}
+
+TEST(SparseLeastSquares, ATrialPointOutsideFsDomainIsARejectedStepOnBothPaths) {
+  // r_i = log(x_i) − 1 (i < n), r_{n+i} = 0.3 (x_{i+1} − x_i): from x = 50 the first
+  // Gauss–Newton steps overshoot below 0, where log is NaN; the step is refused and the radius
+  // shrinks, on both paths alike.
+  const Index n = 150;
+  auto nan_steps = std::make_shared<int>(0);
+  auto f = [nan_steps](const auto& x, auto& r) {
+    using std::log;
+    const Index size = x.size();
+    r.resize(2 * size - 1);
+    for (Index i = 0; i < size; ++i) {
+      if constexpr (std::is_same_v<std::decay_t<decltype(x[i])>, double>) {
+        if (x[i] <= 0.0) ++*nan_steps;
+      }
+      r[i] = log(x[i]) - 1.0 - 0.01 * static_cast<double>(i % 5);
+      if (i + 1 < size) r[size + i] = 0.3 * (x[i + 1] - x[i]);
+    }
+  };
+  const Vector<Dynamic> x0 = Vector<Dynamic>::Constant(n, 50.0);
+  const BothPaths run(RootProblem<>::with_dense_autodiff(f, n, 2 * n - 1),
+                      sparse_autodiff_problem(f, x0, 2 * n - 1), x0,
+                      {.initial_radius_factor = 1e4});
+  ASSERT_NO_FATAL_FAILURE(run.check());
+  EXPECT_GT(*nan_steps, 0) << "some trial point left the domain";
+  EXPECT_TRUE(run.x.allFinite());
+  EXPECT_GT(run.x.minCoeff(), 0.0);
+  EXPECT_LE((run.x - run.dense_x).lpNorm<Eigen::Infinity>(), 1e-7);
+  EXPECT_EQ(run.sparse.iterations, run.dense.iterations);
 }
 
 TEST(SparseLeastSquares, TheEvaluationBudgetHoldsOnTheSparsePath) {
