@@ -363,6 +363,11 @@ TEST(ObserverOptions, ValidateNamesTheField) {
   ekf.measurement_covariance = Eigen::Matrix2d{{1.0, 2.0}, {2.0, 1.0}};  // eigenvalues 3, −1
   EXPECT_NE(refusal([&] { ekf.validate(); }).find("must be positive semi-definite"),
             std::string::npos);
+  ekf.measurement_covariance = Eigen::Matrix2d{{1.0, 1.0}, {1.0, 1.0}};  // eigenvalues 2, 0
+  EXPECT_EQ(refusal([&] { ekf.validate(); }), "(accepted)");  // Cholesky fails; LDLT accepts
+  ekf.measurement_covariance = Eigen::Vector3d(1.0, -1e-9, 2.0).asDiagonal();
+  EXPECT_NE(refusal([&] { ekf.validate(); }).find("must be positive semi-definite"),
+            std::string::npos);
   ekf.measurement_covariance = Eigen::Matrix2d{{1.0, 0.5}, {0.0, 1.0}};
   EXPECT_NE(refusal([&] { ekf.validate(); }).find("must be symmetric"), std::string::npos);
   ekf.measurement_covariance = Eigen::MatrixXd::Constant(1, 1, 1e-4);

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -388,6 +389,64 @@ TEST(RunSafety, AFailingGnuplotLeavesTheDataAndAWarning) {
 TEST(Run, WindowLongerThanDataIsAnError) {
   EXPECT_NE(error_of("chua-fp", {.steps = 4}).find("window of 6 samples is longer than the data"),
             std::string::npos);
+}
+
+// A model of run-time size by name: the reaction–diffusion chain with 120 cells, its x0 and
+// covariances written out as a script would; the EKF's sparse covariance propagation (through
+// AnyModel: the dense Jacobian's nonzeros) gives the dense one's numbers, and both track.
+// 40 samples of T = 0.25 (no measurement noise, the CLI's default).
+TEST(Run, AReactionDiffusionChainOfRunTimeSize) {
+  const int n = 120;
+  nlohmann::json x0 = nlohmann::json::array(), guess = nlohmann::json::array();
+  for (int i = 0; i < n; ++i) {
+    x0.push_back(1.0 / (1.0 + std::exp((i - 30.0) / 3.0)));
+    guess.push_back(1.0 / (1.0 + std::exp((i - 40.0) / 3.0)));
+  }
+  const auto diagonal = [n](double v) {
+    nlohmann::json m = nlohmann::json::array();
+    for (int i = 0; i < n; ++i) {
+      nlohmann::json row = nlohmann::json::array();
+      for (int j = 0; j < n; ++j) row.push_back(i == j ? v : 0.0);
+      m.push_back(row);
+    }
+    return m;
+  };
+  nlohmann::json ekf = {{"type", "ekf"},
+                        {"initial_covariance", diagonal(0.25)},
+                        {"process_covariance", diagonal(1e-6)}};
+  nlohmann::json dense = ekf;
+  dense["sparse_jacobian"] = false;
+  const nlohmann::json scenario = {{"name", "chain"},
+                                   {"model",
+                                    {{"name", "reaction-diffusion"},
+                                     {"step", 0.25},
+                                     {"parameters", {{"cells", n}, {"sensors", 24}}}}},
+                                   {"x0", x0},
+                                   {"initial_guess", guess},
+                                   {"steps", 40},
+                                   {"observers", {ekf, dense}}};
+  const fs::path f = scratch("chain.json"), dir = scratch("chain-out");
+  write(f, scenario.dump());
+  std::ostringstream out, err;
+  run_scenario(f.string(), {.out_dir = dir.string()}, out, err);
+  std::ifstream in(dir / "summary.json");
+  const auto summary = nlohmann::json::parse(in);
+  const auto& a = summary["observers"][0];
+  const auto& b = summary["observers"][1];
+  EXPECT_TRUE(a["failures"].empty()) << a.dump();
+  ASSERT_TRUE(a["mse"].is_array()) << a.dump();
+  ASSERT_EQ(a["mse"].size(), static_cast<std::size_t>(n));
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a["mse"].size(); ++i) {
+    const double mse = a["mse"][i].get<double>();
+    EXPECT_NEAR(mse, b["mse"][i].get<double>(), 1e-9 * (1e-6 + mse)) << "state " << i;
+    worst = std::max(worst, mse);
+  }
+  EXPECT_GT(worst, 1e-3);  // the guess starts 10 cells off: errors up to 0.9 in those cells
+  // The error reaches 1e-3 within the first half of the run's 10 time units (4.25 when written).
+  ASSERT_TRUE(a["time_to_1e-3"].is_number()) << a.dump();
+  EXPECT_LT(a["time_to_1e-3"].get<double>(), 5.0);
+  EXPECT_EQ(a["time_to_1e-3"], b["time_to_1e-3"]);
 }
 
 TEST(Run, RecordedDataWithMissingSamplesAndNoTruth) {

@@ -1,14 +1,66 @@
 // The built-in models, registered as a user's are (register_model.hpp): the PI paper's lander
 // and unknown-input integrator, the modulating-function paper's two systems (their canonical
-// forms: nlobs/models/modulating_forms.hpp), and the batch reactor of the MHE literature.
+// forms: nlobs/models/modulating_forms.hpp), the batch reactor of the MHE literature, and the
+// reaction–diffusion chain of run-time size.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
 #include <stdexcept>
+#include <string>
 
 #include "builtin_models.hpp"
 #include "nlobs/models/modulating_forms.hpp"
+#include "nlobs/models/reaction_diffusion_chain.hpp"
 #include "nlobs/models/systems.hpp"
 #include "nlobs/registry/register_model.hpp"
 
 namespace nlobs::detail {
+
+namespace {
+// The chain's sizes arrive as JSON numbers: whole numbers in range, or refused by name. A
+// scenario's observers hold n × n covariances, so a million cells is already far past use;
+// the cap keeps a hostile file from asking for gigabytes.
+struct ChainValues {
+  double cells = 200.0, sensors = 4.0, coupling = 1.0, growth = 1.0, threshold = 0.25;
+};
+constexpr double kMostCells = 1e6, kMostSensors = 1e4;
+long whole_number(const char* key, double value, double lowest, double highest,
+                  const char* why = "") {
+  if (!(value >= lowest && value <= highest) || value != std::floor(value)) {
+    std::ostringstream os;
+    os << "parameter '" << key << "' of model 'reaction-diffusion' = " << value
+       << " must be a whole number in [" << lowest << ", " << highest << "]" << why;
+    throw InvalidInput(os.str());
+  }
+  return static_cast<long>(value);
+}
+
+void add_reaction_diffusion(ModelRegistry& r) {
+  r.add(model_entry(ModelDefinition<ReactionDiffusionChain, ChainValues>{
+      .name = "reaction-diffusion",
+      .description = "Nagumo chain of n cells, x' = D dxx + rho x(1-x)(x-a), p point sensors "
+                     "([Kee87]); n states at run time",
+      .parameters = {{"cells", "n, the states", [](ChainValues& v) -> double& { return v.cells; }},
+                     {"sensors", "p, outputs y_j = x at cell floor((j + 1/2) n / p)",
+                      [](ChainValues& v) -> double& { return v.sensors; }},
+                     {"coupling", "D >= 0", [](ChainValues& v) -> double& { return v.coupling; }},
+                     {"growth", "rho >= 0", [](ChainValues& v) -> double& { return v.growth; }},
+                     {"threshold", "a in (0, 1)",
+                      [](ChainValues& v) -> double& { return v.threshold; }}},
+      .default_step = 0.1,
+      .build = [](const ChainValues& v) {
+        const long cells = whole_number("cells", v.cells, 2.0, kMostCells);
+        const std::string why = " (cells = " + std::to_string(cells) + ")";
+        return ReactionDiffusionChain(
+            {.cells = cells,
+             .sensors = whole_number("sensors", v.sensors, 1.0, std::min(v.cells, kMostSensors),
+                                     why.c_str()),
+             .coupling = v.coupling,
+             .growth = v.growth,
+             .threshold = v.threshold});
+      }}));
+}
+}  // namespace
 
 void add_builtin_models_c(ModelRegistry& r) {
   using Lander = LunarLander;
@@ -78,6 +130,7 @@ void add_builtin_models_c(ModelRegistry& r) {
                      {"rt", "RT, y = RT (cA + cB + cC)",
                       [](BatchReactor& m) -> double& { return m.p.rt; }}},
       .default_step = 0.25}));
+  add_reaction_diffusion(r);
 }
 
 }  // namespace nlobs::detail

@@ -76,14 +76,20 @@ void add_ekf(ObserverTypeRegistry& registry) {
       .name = "ekf",
       .description = "extended Kalman filter, AD Jacobians",
       .condition = "",
-      .keys = kalman_keys({}),
+      .keys = kalman_keys({{"sparse_jacobian",
+                            "n >= 100: F P F' over F's nonzeros (false: dense products)", "true"}}),
       .parse =
           [](JsonReader& o, const ModelInstance&) {
             EkfOptions s;
             read_covariances(o, s);
+            s.sparse_jacobian = o.boolean("sparse_jacobian").value_or(true);
             return s;
           },
-      .write = [](const EkfOptions& s, nlohmann::json& out) { write_covariances(s, out); },
+      .write =
+          [](const EkfOptions& s, nlohmann::json& out) {
+            write_covariances(s, out);
+            if (!s.sparse_jacobian) out["sparse_jacobian"] = false;
+          },
       .build = [](EkfOptions s, const ObserverBuild& b) -> std::unique_ptr<Observer> {
         s.initial_estimate = b.start;
         return std::make_unique<ExtendedKalmanFilter<AnyModel>>(b.design, std::move(s));

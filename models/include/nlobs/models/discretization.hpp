@@ -22,6 +22,7 @@ class SampledModel {
   static constexpr int kStates = Model::kStates;
   static constexpr int kInputs = Model::kInputs;
   static constexpr int kOutputs = Model::kOutputs;
+  static constexpr bool kTracesSparsity = traces_sparsity<Model>();
   template <typename T>
   using State = ModelVector<T, kStates>;
   using Input = ModelVector<double, kInputs>;

@@ -73,6 +73,22 @@ std::string domain_violation_of(const M& model, const ModelVector<double, M::kSt
   }
 }
 
+// Whether observers may evaluate a model on SparsityTracer scalars (solvers/sparse/) to find the
+// pattern of its Jacobians once and keep it. A model opts in with
+// `static constexpr bool kTracesSparsity = true;` when it has a run-time size, its functions
+// compile with that scalar as they do with ceres::Jet, and its coupling between states does not
+// change with k, t or u (comparisons of those are not seen by the tracer, so a pattern that
+// depends on them would be kept stale). Others — the default — keep the dense AD Jacobian, whose
+// exact zeros the EKF still skips (observers/core/move_covariance.hpp).
+template <typename M>
+constexpr bool traces_sparsity() {
+  if constexpr (requires { M::kTracesSparsity; }) {
+    return M::kTracesSparsity && M::kStates == Eigen::Dynamic;
+  } else {
+    return false;
+  }
+}
+
 // A discrete model that integrates over any interval: flow(x, u, t, dt).
 template <typename M>
 concept IntervalModel = DiscreteModel<M> &&

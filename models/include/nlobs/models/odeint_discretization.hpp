@@ -23,6 +23,7 @@ struct OdeintOptions {
 template <ContinuousModel Model>
 class OdeintDiscretized : public SampledModel<Model> {
  public:
+  static constexpr bool kTracesSparsity = false;  // evaluated in double only
   using typename SampledModel<Model>::Input;
   template <typename T>
   using State = typename SampledModel<Model>::template State<T>;

@@ -18,6 +18,7 @@
 
 #include "nlobs/models/model.hpp"
 #include "nlobs/observers/core/discrete_jacobians.hpp"
+#include "nlobs/observers/core/move_covariance.hpp"
 #include "nlobs/observers/core/observer.hpp"
 #include "nlobs/observers/core/option_checks.hpp"
 #include "nlobs/observers/core/predict_update_observer.hpp"
@@ -151,8 +152,13 @@ class SlidingModeObserver final
 // step T each, or the flow over an interval off the grid, Q weighted by its length / T):
 //   x̂ ← f(x̂, u_{k−1}),  P ← F P Fᵀ + w Q;
 // then update with the outputs measured at k (H, R and y restricted to them):
-//   K = P Hᵀ (H P Hᵀ + R)⁻¹, x̂ ← x̂ + K (y − h(x̂)), P ← (I − K H) P (I − K H)ᵀ + K R Kᵀ,
+//   K = P Hᵀ (H P Hᵀ + R)⁻¹, x̂ ← x̂ + K (y − h(x̂)), P ← (I − K H) P (I − K H)ᵀ + K R Kᵀ
+// (Joseph's form [BJ68]: a sum of positive semi-definite terms whatever K's rounding),
 // and report x̂_k. A second sample at the same instant is a second update.
+// Cost per sample with n states and p outputs: the update is O(n² p) (I − K H is never formed);
+// the prediction O(n³) with a dense F, O(nnz(F) n) with the sparse F a model of run-time size
+// n ≥ 100 gets (move_covariance.hpp: a traced pattern and compressed AD, or the dense F's
+// exact nonzeros). P is dense n × n: memory O(n²).
 // An update or prediction that is not finite is not taken (the step says so): the estimate
 // keeps its last finite value, and a non-finite predicted covariance restarts from P0.
 struct EkfOptions {
@@ -161,6 +167,9 @@ struct EkfOptions {
   Eigen::MatrixXd process_covariance;      // Q (n × n); empty: 1e-6 I
   Eigen::MatrixXd measurement_covariance;  // R (p × p); empty: 1e-4 I
   Eigen::MatrixXd initial_covariance;      // P0 (n × n); empty: I
+  // Run-time n ≥ 100: F sparse where the model allows (move_covariance.hpp); false: F dense and
+  // F P Fᵀ by dense products at every size (the same numbers up to rounding).
+  bool sparse_jacobian = true;
   // Throws InvalidInput naming the field: an empty name, an initial estimate that is empty or
   // not finite, a covariance given but not square, finite, symmetric positive semi-definite.
   void validate() const;
@@ -176,7 +185,9 @@ class ExtendedKalmanFilter final
 
  public:
   ExtendedKalmanFilter(Model model, EkfOptions options)
-      : Base(std::move(model), "", true), initial_(options.initial_estimate) {
+      : Base(std::move(model), "", true),
+        initial_(options.initial_estimate),
+        propagation_(options.sparse_jacobian) {
     options.validate();
     this->info_.name = options.name;
     const Eigen::Index n = model_.states(), p = model_.outputs();
@@ -193,21 +204,23 @@ class ExtendedKalmanFilter final
     this->reset_clock();
   }
 
+  // How the last prediction formed F P Fᵀ: "dense", or the sparse path and its pattern (or why
+  // it was declined): move_covariance.hpp.
+  const std::string& jacobian_note() const { return propagation_.note(); }
+
  private:
   using State = ModelVector<double, Model::kStates>;
   using Input = ModelVector<double, Model::kInputs>;
 
   // x̂ ← f(x̂, u_{k−1}), P ← F P Fᵀ + w Q along one move; false when it was not taken.
   bool predict(long k, const ModelStep& move) {
-    Matrix<Model::kStates, Model::kStates> fj;
     const State x(x_);
     const Input u = this->held_input();
-    state_jacobian(model_, x, u, move, fj);
+    propagation_.propagate(model_, x, u, move, p_, q_, covariance_);
     const Eigen::VectorXd predicted = advance(model_, x, u, move);
-    const Eigen::MatrixXd covariance = fj * p_ * fj.transpose() + move.weight * q_;
     if (!accept_finite(predicted, x_, step_, this->name(), k, "the predicted state")) return false;
-    if (covariance.allFinite()) {
-      p_ = covariance;
+    if (covariance_.allFinite()) {
+      p_.swap(covariance_);
       return true;
     }
     predicted_failure(k, "the predicted covariance P", "P restarts from P0");
@@ -218,7 +231,6 @@ class ExtendedKalmanFilter final
   // The update with the outputs measured in y (all of them, or the finite entries).
   void update(long k, const Eigen::VectorXd& y) {
     if (step_.measurement_missing) return;
-    const Eigen::Index n = model_.states();
     Matrix<Model::kOutputs, Model::kStates> jac;
     output_jacobian(model_, State(x_), jac);
     Eigen::MatrixXd hj = jac, r = r_;
@@ -229,15 +241,20 @@ class ExtendedKalmanFilter final
       r = Eigen::MatrixXd(r_(rows, rows));
       innovation = Eigen::VectorXd(innovation(rows));
     }
-    const Eigen::MatrixXd s = hj * p_ * hj.transpose() + r;
-    const Eigen::MatrixXd gain = p_ * hj.transpose() * s.inverse();
+    const Eigen::MatrixXd pht = p_ * hj.transpose();  // P Hᵀ, n × p
+    const Eigen::MatrixXd s = hj * pht + r;
+    const Eigen::MatrixXd gain = pht * s.inverse();
     const Eigen::VectorXd updated = x_ + gain * innovation;
-    const Eigen::MatrixXd ikh = Eigen::MatrixXd::Identity(n, n) - gain * hj;
-    const Eigen::MatrixXd covariance =
-        ikh * p_ * ikh.transpose() + gain * r * gain.transpose();  // Joseph form
-    if (updated.allFinite() && covariance.allFinite()) {
+    // Joseph's form in O(n² p): B = (I − K H) P = P − K (H P), then
+    // P⁺ = B (I − K H)ᵀ + K R Kᵀ = B − (B Hᵀ) Kᵀ + K R Kᵀ.
+    covariance_ = p_;
+    covariance_.noalias() -= gain * (hj * p_);
+    const Eigen::MatrixXd bht = covariance_ * hj.transpose();
+    covariance_.noalias() -= bht * gain.transpose();
+    covariance_.noalias() += gain * r * gain.transpose();
+    if (updated.allFinite() && covariance_.allFinite()) {
       x_ = updated;
-      p_ = covariance;
+      p_.swap(covariance_);
     } else {
       predicted_failure(k, "the measurement update", "kept the last finite estimate");
     }
@@ -252,7 +269,8 @@ class ExtendedKalmanFilter final
   const Eigen::VectorXd& estimate() const { return x_; }
 
   Eigen::VectorXd initial_, x_;
-  Eigen::MatrixXd q_, r_, p0_, p_;
+  Eigen::MatrixXd q_, r_, p0_, p_, covariance_;
+  detail::MoveCovariance<Model> propagation_;
 };
 
 }  // namespace nlobs

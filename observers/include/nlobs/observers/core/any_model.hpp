@@ -17,6 +17,7 @@ class AnyModel {
   static constexpr int kStates = Eigen::Dynamic;
   static constexpr int kInputs = Eigen::Dynamic;
   static constexpr int kOutputs = Eigen::Dynamic;
+  static constexpr bool kTracesSparsity = false;  // double and Jet only (models/model.hpp)
   using Jet = ceres::Jet<double, kJetStride>;
   template <typename T>
   using State = ModelVector<T, Eigen::Dynamic>;
