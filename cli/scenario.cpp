@@ -360,6 +360,12 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
   const AnyModel& model = instance.discrete;
   s.x0 = r.required_vector("x0");
   s.initial_guess = r.required_vector("initial_guess");
+  // Sizes against the model before the observers are read: a covariance given as one number v
+  // becomes v I of the model's size there, which x0's n entries make no larger than the file.
+  if (s.x0.size() != model.states() || s.initial_guess.size() != model.states()) {
+    r.fail("'x0' and 'initial_guess' must have " + std::to_string(model.states()) +
+           " entries (the model's states)");
+  }
   if (auto v = r.integer("steps", 1, kMaxSteps)) s.steps = *v;
   if (auto v = r.number("noise")) {
     if (*v < 0) r.fail("'noise' must be >= 0");
@@ -402,11 +408,6 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
   }
   r.finish({"name", "model", "x0", "initial_guess", "steps", "noise", "process_noise", "seed",
             "input", "observers", "reported", "settle_time"});
-  // Sizes against the model, now that everything parsed.
-  if (s.x0.size() != model.states() || s.initial_guess.size() != model.states()) {
-    r.fail("'x0' and 'initial_guess' must have " + std::to_string(model.states()) +
-           " entries (the model's states)");
-  }
   return s;
 }
 

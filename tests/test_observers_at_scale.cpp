@@ -157,10 +157,20 @@ TEST(ReactionDiffusionChain, IsABuiltInModelOfRunTimeSize) {
     EXPECT_NE(std::string(e.what()).find("'sensors'"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("(cells = 3)"), std::string::npos) << e.what();
   }
-  const nlohmann::json given = {{"type", "ekf"}, {"sparse_jacobian", false}};
+  const nlohmann::json given = {{"type", "ekf"},
+                                {"sparse_jacobian", false},
+                                {"initial_covariance", 0.25},
+                                {"measurement_covariance", 1e-3}};
   JsonReader ekf_reader(given, "observers[0]");
   const nlohmann::json written = observer_spec_json(parse_observer_spec(ekf_reader, model));
   EXPECT_EQ(written["sparse_jacobian"], false);
+  // One number v is v I of the model's size: n × n for P0, p × p for R.
+  ASSERT_EQ(written["initial_covariance"].size(), 150u);
+  EXPECT_EQ(written["initial_covariance"][7].size(), 150u);
+  EXPECT_EQ(written["initial_covariance"][7][7], 0.25);
+  EXPECT_EQ(written["initial_covariance"][7][8], 0.0);
+  ASSERT_EQ(written["measurement_covariance"].size(), 5u);
+  EXPECT_EQ(written["measurement_covariance"][4][4], 1e-3);
   const nlohmann::json wrong = {{"type", "ekf"}, {"sparse_jacobian", "yes"}};
   JsonReader wrong_reader(wrong, "observers[0]");
   EXPECT_THROW(parse_observer_spec(wrong_reader, model), std::invalid_argument);

@@ -391,9 +391,10 @@ TEST(Run, WindowLongerThanDataIsAnError) {
             std::string::npos);
 }
 
-// A model of run-time size by name: the reaction–diffusion chain with 120 cells, its x0 and
-// covariances written out as a script would; the EKF's sparse covariance propagation (through
-// AnyModel: the dense Jacobian's nonzeros) gives the dense one's numbers, and both track.
+// A model of run-time size by name: the reaction–diffusion chain with 120 cells, its x0 written
+// out as a script would, its covariances as one number v for v I; the EKF's sparse covariance
+// propagation (through AnyModel: the dense Jacobian's nonzeros) gives the dense one's numbers,
+// and both track. A negative v is refused by the key's name.
 // 40 samples of T = 0.25 (no measurement noise, the CLI's default).
 TEST(Run, AReactionDiffusionChainOfRunTimeSize) {
   const int n = 120;
@@ -402,18 +403,8 @@ TEST(Run, AReactionDiffusionChainOfRunTimeSize) {
     x0.push_back(1.0 / (1.0 + std::exp((i - 30.0) / 3.0)));
     guess.push_back(1.0 / (1.0 + std::exp((i - 40.0) / 3.0)));
   }
-  const auto diagonal = [n](double v) {
-    nlohmann::json m = nlohmann::json::array();
-    for (int i = 0; i < n; ++i) {
-      nlohmann::json row = nlohmann::json::array();
-      for (int j = 0; j < n; ++j) row.push_back(i == j ? v : 0.0);
-      m.push_back(row);
-    }
-    return m;
-  };
-  nlohmann::json ekf = {{"type", "ekf"},
-                        {"initial_covariance", diagonal(0.25)},
-                        {"process_covariance", diagonal(1e-6)}};
+  nlohmann::json ekf = {
+      {"type", "ekf"}, {"initial_covariance", 0.25}, {"process_covariance", 1e-6}};
   nlohmann::json dense = ekf;
   dense["sparse_jacobian"] = false;
   const nlohmann::json scenario = {{"name", "chain"},
@@ -426,6 +417,12 @@ TEST(Run, AReactionDiffusionChainOfRunTimeSize) {
                                    {"steps", 40},
                                    {"observers", {ekf, dense}}};
   const fs::path f = scratch("chain.json"), dir = scratch("chain-out");
+  nlohmann::json negative = scenario;
+  negative["observers"][0]["initial_covariance"] = -0.25;
+  write(f, negative.dump());
+  EXPECT_NE(error_of(f.string()).find("initial_covariance must be positive semi-definite"),
+            std::string::npos)
+      << error_of(f.string());
   write(f, scenario.dump());
   std::ostringstream out, err;
   run_scenario(f.string(), {.out_dir = dir.string()}, out, err);

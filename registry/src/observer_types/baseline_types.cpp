@@ -79,9 +79,9 @@ void add_ekf(ObserverTypeRegistry& registry) {
       .keys = kalman_keys({{"sparse_jacobian",
                             "n >= 100: F P F' over F's nonzeros (false: dense products)", "true"}}),
       .parse =
-          [](JsonReader& o, const ModelInstance&) {
+          [](JsonReader& o, const ModelInstance& model) {
             EkfOptions s;
-            read_covariances(o, s);
+            read_covariances(o, s, model);
             s.sparse_jacobian = o.boolean("sparse_jacobian").value_or(true);
             return s;
           },
@@ -105,9 +105,9 @@ void add_ukf(ObserverTypeRegistry& registry) {
                            {"beta", "distribution prior, >= 0", "2"},
                            {"kappa", "secondary scaling", "0"}}),
       .parse =
-          [](JsonReader& o, const ModelInstance&) {
+          [](JsonReader& o, const ModelInstance& model) {
             UkfOptions s;
-            read_covariances(o, s);
+            read_covariances(o, s, model);
             s.alpha = o.number("alpha").value_or(s.alpha);
             s.beta = o.number("beta").value_or(s.beta);
             s.kappa = o.number("kappa").value_or(s.kappa);

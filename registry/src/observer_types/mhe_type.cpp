@@ -40,10 +40,10 @@ void add_mhe_type(ObserverTypeRegistry& registry) {
            {"step_tolerance", "converged when |dz| <= tol (1 + |z|), > 0", "1e-10"},
            {"cost_tolerance", "converged when the step's decrease <= tol V, > 0", "1e-12"}}),
       .parse =
-          [](JsonReader& o, const ModelInstance&) {
+          [](JsonReader& o, const ModelInstance& model) {
             MheOptions s;
             s.name = o.name().value_or(s.name);
-            read_covariances(o, s);
+            read_covariances(o, s, model);
             s.horizon = o.integer("horizon", 1, 100000).value_or(s.horizon);
             s.lower_bounds = o.bounds("lower_bounds", -kInf).value_or(Eigen::VectorXd());
             s.upper_bounds = o.bounds("upper_bounds", kInf).value_or(Eigen::VectorXd());
