@@ -186,9 +186,32 @@ std::string observer_style(long o) {
 // convergence), reading plot_data.csv (its columns: plot_table()). Every name from the scenario
 // (observers, signals) goes into the script through gnuplot_quoted(); each PNG is written under
 // its OutputDirectory::external() name, relative to the directory, where gnuplot runs.
+// The states that get a panel in states.png and errors.png: all of them up to kMostPlottedStates,
+// else that many evenly spaced from x1 to xn (a 150-cell chain asked Cairo for a 45 000-pixel
+// image, which it refuses); the multiplot's title says which.
+constexpr Eigen::Index kMostPlottedStates = 12;
+std::vector<Eigen::Index> plotted_states(Eigen::Index n) {
+  std::vector<Eigen::Index> out;
+  const Eigen::Index panels = std::min(n, kMostPlottedStates);
+  for (Eigen::Index j = 0; j < panels; ++j) {
+    out.push_back(panels == 1 ? 0 : j * (n - 1) / (panels - 1));
+  }
+  return out;
+}
+std::string plotted_title(const std::vector<Eigen::Index>& plotted, Eigen::Index n) {
+  if (static_cast<Eigen::Index>(plotted.size()) == n) return "";
+  std::string t = " title 'x" + std::to_string(plotted.front() + 1);
+  for (std::size_t j = 1; j < plotted.size(); ++j) t += ", x" + std::to_string(plotted[j] + 1);
+  return t + " (" + std::to_string(plotted.size()) + " of " + std::to_string(n) +
+         " states; trajectories.csv has all)'";
+}
+
 std::string plot_script(OutputDirectory& dir, const Measurements& data, const RunResult& r,
                         const std::vector<std::string>& traced) {
   const Eigen::Index n = r.estimates.empty() ? 0 : r.estimates.front().rows();
+  const std::vector<Eigen::Index> plotted = plotted_states(n);
+  const Eigen::Index panels = static_cast<Eigen::Index>(plotted.size());
+  const std::string multiplot_title = n > 0 ? plotted_title(plotted, n) : "";
   const long observers = static_cast<long>(r.metrics.size());
   const long offset = data.has_truth() ? n : 0;
   long signal_columns = 0;
@@ -196,11 +219,12 @@ std::string plot_script(OutputDirectory& dir, const Measurements& data, const Ru
   const long first_error = 2 + offset + observers * n + signal_columns;  // |x - xhat| columns
   std::ostringstream g;
   g << "set datafile separator ','\nset key outside right\nset grid\n"
-    << "set terminal pngcairo noenhanced size 1200," << 300 * std::max<Eigen::Index>(n, 1) << "\n";
+    << "set terminal pngcairo noenhanced size 1200," << 300 * std::max<Eigen::Index>(panels, 1)
+    << "\n";
   define_observer_styles(g, observers);
-  g << "set output " << gnuplot_quoted(dir.external("states.png")) << "\nset multiplot layout " << n
-    << ",1\n";
-  for (Eigen::Index i = 0; i < n; ++i) {
+  g << "set output " << gnuplot_quoted(dir.external("states.png")) << "\nset multiplot layout "
+    << panels << ",1" << multiplot_title << "\n";
+  for (const Eigen::Index i : plotted) {
     g << "set ylabel 'x" << i + 1 << "'\n";
     // The truth's range, widened to the finite estimates after the settle index (an estimate
     // that settles on a wrong state must show: the EKF's negative concentrations of
@@ -239,8 +263,8 @@ std::string plot_script(OutputDirectory& dir, const Measurements& data, const Ru
     // constant): one diverging observer must not squeeze the others into a line. An observer
     // whose error leaves the panel is drawn clipped and says so in its key entry.
     g << "set output " << gnuplot_quoted(dir.external("errors.png")) << "\nset logscale y\n"
-      << "set format y '1e%L'\nset multiplot layout " << n << ",1\n";
-    for (Eigen::Index i = 0; i < n; ++i) {
+      << "set format y '1e%L'\nset multiplot layout " << panels << ",1" << multiplot_title << "\n";
+    for (const Eigen::Index i : plotted) {
       const double lo = data.x.row(i).minCoeff(), hi = data.x.row(i).maxCoeff();
       const double size = std::max(std::abs(lo), std::abs(hi));
       const double spread = std::max(hi - lo, 1e-3 * size);

@@ -295,6 +295,12 @@ TEST(ModelRegistry, EntriesDescribeTheirKeysSizesAndObserverFamilies) {
   };
   EXPECT_TRUE(has(r, "high_gain"));
   EXPECT_TRUE(has(r, "mvt"));
+  EXPECT_TRUE(has(r, "ukf"));  // every model: listed since the UKF and MHE took any (they did)
+  EXPECT_TRUE(has(r, "mhe"));
+  // A model of run-time size: the families of AnyModel, none that need fixed sizes.
+  const ModelEntry& chain = model_registry().get("reaction-diffusion");
+  EXPECT_TRUE(has(chain, "ekf") && has(chain, "ukf") && has(chain, "mhe"));
+  EXPECT_FALSE(has(chain, "mvt") || has(chain, "high_gain") || has(chain, "modulating"));
   EXPECT_FALSE(has(r, "modulating"));
   EXPECT_FALSE(has(model_registry().get("two-outputs"), "high_gain"));
   EXPECT_TRUE(has(model_registry().get("pendulum"), "modulating"));

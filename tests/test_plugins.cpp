@@ -732,7 +732,8 @@ TEST(Plugins, TheCliLoadsPluginsFromTheCommandLineAndThePath) {
   const CliRun list = cli("", "--plugin " + kExample + " list");
   EXPECT_EQ(list.status, 0) << list.out;
   EXPECT_TRUE(contains(list.out, "fitzhugh-nagumo — FitzHugh-Nagumo neuron")) << list.out;
-  EXPECT_TRUE(contains(list.out, "observers: window ekf luenberger sliding_mode mvt high_gain"))
+  EXPECT_TRUE(
+      contains(list.out, "observers: window ekf ukf mhe luenberger sliding_mode mvt high_gain"))
       << list.out;
   EXPECT_TRUE(contains(list.out, "; from " + kExample)) << list.out;
   EXPECT_TRUE(contains(list.out, "bad-broyden — Broyden")) << list.out;

@@ -444,6 +444,12 @@ TEST(Run, AReactionDiffusionChainOfRunTimeSize) {
   ASSERT_TRUE(a["time_to_1e-3"].is_number()) << a.dump();
   EXPECT_LT(a["time_to_1e-3"].get<double>(), 5.0);
   EXPECT_EQ(a["time_to_1e-3"], b["time_to_1e-3"]);
+  // 12 of the 120 states get a panel (one each asked Cairo for a 36 000-pixel image).
+  std::ifstream script(dir / "plots.gp");
+  const std::string text((std::istreambuf_iterator<char>(script)),
+                         std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("set multiplot layout 12,1 title 'x1, x11, x22,"), std::string::npos) << text;
+  EXPECT_NE(text.find("x120 (12 of 120 states; trajectories.csv has all)'"), std::string::npos);
 }
 
 TEST(Run, RecordedDataWithMissingSamplesAndNoTruth) {

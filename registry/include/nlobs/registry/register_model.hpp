@@ -11,8 +11,8 @@
 //   }));
 //
 // What the entry offers, by the model's type (one registration serves every size):
-//   window estimators (any engine), EKF, Luenberger, sliding mode: every model (AnyModel, AD
-//     Jacobians through ceres::Jet);
+//   window estimators (any engine), EKF, UKF, MHE, Luenberger, sliding mode: every model
+//     (AnyModel, AD Jacobians through ceres::Jet);
 //   mvt: outputs <= states; the constructor checks y = [I_m 0] x;
 //   high_gain: one output, no input;
 //   modulating: a function modulating_form(const Model&) found by argument-dependent lookup
@@ -173,7 +173,7 @@ ModelEntry model_entry(ModelDefinition<Model, Parameters> definition) {
   entry.states = probe->states();
   entry.inputs = probe->inputs();
   entry.outputs = probe->outputs();
-  entry.families = {"window", "ekf", "luenberger", "sliding_mode"};
+  entry.families = {"window", "ekf", "ukf", "mhe", "luenberger", "sliding_mode"};
   if constexpr (detail::kMvtFits<Model>) entry.families.push_back("mvt");
   if constexpr (detail::kHighGainFits<Model>) entry.families.push_back("high_gain");
   if constexpr (detail::HasModulatingForm<Model>) entry.families.push_back("modulating");
