@@ -182,10 +182,6 @@ std::string observer_style(long o) {
   return " ls " + std::to_string(kFirstObserverStyle + o);
 }
 
-// The gnuplot script of the PNG plots (estimates vs truth, errors, signals, the first window's
-// convergence), reading plot_data.csv (its columns: plot_table()). Every name from the scenario
-// (observers, signals) goes into the script through gnuplot_quoted(); each PNG is written under
-// its OutputDirectory::external() name, relative to the directory, where gnuplot runs.
 // The states that get a panel in states.png and errors.png: all of them up to kMostPlottedStates,
 // else that many evenly spaced from x1 to xn (a 150-cell chain asked Cairo for a 45 000-pixel
 // image, which it refuses); the multiplot's title says which.
@@ -206,6 +202,10 @@ std::string plotted_title(const std::vector<Eigen::Index>& plotted, Eigen::Index
          " states; trajectories.csv has all)'";
 }
 
+// The gnuplot script of the PNG plots (estimates vs truth, errors, signals, the first window's
+// convergence), reading plot_data.csv (its columns: plot_table()). Every name from the scenario
+// (observers, signals) goes into the script through gnuplot_quoted(); each PNG is written under
+// its OutputDirectory::external() name, relative to the directory, where gnuplot runs.
 std::string plot_script(OutputDirectory& dir, const Measurements& data, const RunResult& r,
                         const std::vector<std::string>& traced) {
   const Eigen::Index n = r.estimates.empty() ? 0 : r.estimates.front().rows();
