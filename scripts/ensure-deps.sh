@@ -13,6 +13,7 @@ packages=(
   libeigen3-dev        # linear algebra, fixed-size vectors
   libceres-dev         # ceres::Jet forward-mode AD, least-squares engine (Ceres, TinySolver)
   libsuitesparse-dev   # KLU, UMFPACK: the sparse direct linear solvers (solvers/linear/)
+  libhypre-dev         # BoomerAMG: the algebraic multigrid preconditioner (solvers/linear/)
   libgoogle-glog-dev   # Ceres' logging; the CLI silences it
   libnlopt-cxx-dev     # bounded minimisation engine
   libsundials-dev      # KINSOL: reference solver compared in the same run

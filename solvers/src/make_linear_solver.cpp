@@ -6,6 +6,7 @@
 #include "nlobs/solvers/engine_spec.hpp"
 #include "nlobs/solvers/linear/band_lu.hpp"
 #include "nlobs/solvers/linear/bicgstab.hpp"
+#include "nlobs/solvers/linear/boomeramg.hpp"
 #include "nlobs/solvers/linear/dense_lu.hpp"
 #include "nlobs/solvers/linear/gmres.hpp"
 #include "nlobs/solvers/linear/klu.hpp"
@@ -22,9 +23,13 @@ constexpr int kIntMax = std::numeric_limits<int>::max();
 
 const std::vector<EngineOptionInfo>& preconditioner_options() {
   static const std::vector<EngineOptionInfo> options = {
-      {"preconditioner", "none (default), jacobi, ilu0 or ilut; right preconditioning"},
+      {"preconditioner",
+       "none (default), jacobi, ilu0, ilut or boomeramg (hypre's algebraic multigrid); right "
+       "preconditioning"},
       {"drop_tolerance", "ilut: drop entries below this x the row norm, in (0, 1), default 1e-4"},
-      {"fill_factor", "ilut: at most this x J's entries per row, >= 1, default 10"}};
+      {"fill_factor", "ilut: at most this x J's entries per row, >= 1, default 10"},
+      {"strong_threshold", "boomeramg: strength of connection, in (0, 1), default 0.25"},
+      {"cycles", "boomeramg: V-cycles per application, 1..100, default 1"}};
   return options;
 }
 
@@ -41,12 +46,24 @@ std::unique_ptr<LinearPreconditioner> read_preconditioner(EngineSpecReader& read
   }
   if (drop) ilut.drop_tolerance = *drop;
   if (fill) ilut.fill_factor = *fill;
+  BoomerAmgOptions amg;
+  const auto threshold = reader.number("strong_threshold");
+  const auto cycles = reader.integer("cycles", 1, 100);
+  if ((threshold || cycles) && kind != "boomeramg") {
+    throw InvalidInput(
+        "linear solver options strong_threshold and cycles belong to "
+        "preconditioner=boomeramg, not " +
+        kind);
+  }
+  if (threshold) amg.strong_threshold = *threshold;
+  if (cycles) amg.cycles = *cycles;
   if (kind == "none") return nullptr;
   if (kind == "jacobi") return std::make_unique<JacobiPreconditioner>();
   if (kind == "ilu0") return std::make_unique<Ilu0Preconditioner>();
   if (kind == "ilut") return std::make_unique<IlutPreconditioner>(ilut);
+  if (kind == "boomeramg") return std::make_unique<BoomerAmgPreconditioner>(amg);
   throw InvalidInput("linear solver preconditioner '" + kind +
-                     "' is unknown; valid: none, jacobi, ilu0, ilut");
+                     "' is unknown; valid: none, jacobi, ilu0, ilut, boomeramg");
 }
 
 std::vector<EngineOptionInfo> with_preconditioner(std::vector<EngineOptionInfo> options) {

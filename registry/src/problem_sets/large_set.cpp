@@ -211,11 +211,13 @@ ProblemSetEntry large_problem_set() {
           .problems_of_size = problems_of_size,
           .default_solvers = {"newton", "newton:linesearch=1", "newton:linesearch=1,reuse=10",
                               "newton:linesearch=1,linear=gmres,preconditioner=ilu0",
+                              // hypre's multigrid; invalid_input rows in a build without hypre
+                              "newton:linesearch=1,linear=gmres,preconditioner=boomeramg",
                               "pseudo-transient:growth=1.1", "auto", "anderson",
                               "kinsol:newton-band", "kinsol:newton-klu", "kinsol:newton-spgmr",
-                              // PETSc's SNES ex5 form (-snes_fd_color); invalid_input rows in a
-                              // build without PETSc
-                              "petsc:newtonls"}};
+                              // PETSc's SNES ex5 form (-snes_fd_color), and with the same
+                              // BoomerAMG; invalid_input rows in a build without PETSc
+                              "petsc:newtonls", "petsc:newtonls:-pc_type=hypre"}};
 }
 
 }  // namespace nlobs

@@ -41,7 +41,7 @@ inline constexpr const char* kLinearKeyHelp =
     "auto|dense|band-lu|sparse-lu|klu|umfpack|gmres|bicgstab: the linear solver of a problem with "
     "a sparse Jacobian; default auto (band-lu, klu, or umfpack from 20000 unknowns)";
 inline constexpr const char* kPreconditionerKeyHelp =
-    "none|jacobi|ilu0|ilut, with linear=gmres|bicgstab; default none";
+    "none|jacobi|ilu0|ilut|boomeramg, with linear=gmres|bicgstab; default none";
 inline constexpr const char* kOrderingKeyHelp =
     "amd|metis (nested dissection), with linear=umfpack; default amd";
 inline std::optional<std::string> parse_linear_solver(const char* engine, EngineSpecReader& s,

@@ -1,9 +1,9 @@
 #pragma once
 // A linear solver from a spec string, in the engine spec grammar (engine_spec.hpp):
 //   dense-lu | band-lu[:lower=L,upper=U] | sparse-lu | klu | umfpack[:ordering=amd|metis]
-//   gmres[:restart=30,max_iterations=300,preconditioner=none|jacobi|ilu0|ilut,
-//          drop_tolerance=1e-4,fill_factor=10]
-//   bicgstab[:max_iterations=300,preconditioner=…,drop_tolerance=…,fill_factor=…]
+//   gmres[:restart=30,max_iterations=300,preconditioner=none|jacobi|ilu0|ilut|boomeramg,
+//          drop_tolerance=1e-4,fill_factor=10 (ilut),strong_threshold=0.25,cycles=1 (boomeramg)]
+//   bicgstab[:max_iterations=300,preconditioner=…,drop_tolerance=…,…]
 // Unknown names and options throw InvalidInput listing the valid ones.
 #include <memory>
 #include <string>
