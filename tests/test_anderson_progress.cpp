@@ -37,8 +37,9 @@ FixedPointProblem<Dynamic> bratu_jacobi(int m, double lambda) {
       static_cast<Index>(m) * m);
 }
 
-SolverOptions bratu_options(int residual_window) {
+SolverOptions bratu_options(int residual_window, double per_unknown = 0.1) {
   SolverOptions o;
+  o.stop.residual_window_per_unknown = per_unknown;
   o.stop.step_tolerance.reset();
   o.stop.residual_tolerance = 1e-10;
   o.stop.max_iterations = 20000;
@@ -57,8 +58,9 @@ TEST(AndersonProgress, Bratu2dConvergesWhereTheStepRuleStoppedIt) {
     EXPECT_TRUE(s.converged()) << "n = " << m * m << ": " << s.brief_report();
     EXPECT_LE(s.residual_norm, 1e-10);
   }
-  // The window too short for the run: a named stagnation, not a wrong answer.
-  AndersonEngine<> short_window({.depth = 3}, bratu_options(100));
+  // The window too short for the run: a named stagnation, not a wrong answer (the window alone:
+  // 0.1 n would lengthen it to 303).
+  AndersonEngine<> short_window({.depth = 3}, bratu_options(100, 0.0));
   Eigen::VectorXd u = Eigen::VectorXd::Zero(55 * 55);
   const Summary s = short_window.solve(bratu_jacobi(55, 6.0), u);
   EXPECT_EQ(s.status, Status::kStagnated) << s.brief_report();
@@ -129,6 +131,51 @@ TEST(AndersonProgress, TheWindowRuleOnScriptedResiduals) {
   EXPECT_EQ(*s4, Status::kStagnated);
 }
 
+TEST(AndersonProgress, TheWindowGrowsWithTheUnknownsPastTenThousand) {
+  // The longest stretch without a new best grows with n on 2-D Bratu (604 at 10⁴, 2 000–5 000
+  // at 99 856: a window of 1000 ended that run stagnated at |F| 1e-5; the run itself, 63 046
+  // iterations, is measured in docs/solvers.md, too long for a test).
+  StopCriteria c;
+  EXPECT_EQ(StopMonitor::residual_window_for(c, 100), 1000);
+  EXPECT_EQ(StopMonitor::residual_window_for(c, 10000), 1000);
+  EXPECT_EQ(StopMonitor::residual_window_for(c, 99856), 9986);
+  EXPECT_EQ(StopMonitor::residual_window_for(c, std::numeric_limits<Index>::max()),
+            1000000000000000);
+  c.residual_window_per_unknown = 0.0;
+  EXPECT_EQ(StopMonitor::residual_window_for(c, 99856), 1000);
+  c.residual_window = 0;  // off, whatever n
+  c.residual_window_per_unknown = 0.1;
+  EXPECT_EQ(StopMonitor::residual_window_for(c, 99856), 0);
+
+  // The window in force, on scripted residuals: 1 then 2 forever (no new best), at n = 30 000.
+  c = StopCriteria{};
+  c.step_tolerance.reset();
+  StopMonitor m(c, 1.0, false, StopMonitor::Progress::kBestResidual, 30000);
+  EXPECT_EQ(m.residual_window(), 3000);
+  std::optional<Status> s = m.update(1.0, 1.0, 1.0);
+  int k = 1;
+  while (!s && k < 10000) s = m.update(1.0 / ++k, 2.0, 1.0);
+  ASSERT_TRUE(s.has_value());
+  EXPECT_EQ(*s, Status::kStagnated);
+  EXPECT_EQ(k, 3001);
+
+  // And through the engine: a map with no fixed point of 20 000 unknowns (G(x) = x + 1: the
+  // residual is 1 at every iterate, no new best after the first) runs the 2 000 iterations its
+  // window gives, not the 1000 of residual_window.
+  const auto no_root = FixedPointProblem<Dynamic>::from_map(
+      [](const Eigen::VectorXd& x, Eigen::VectorXd& out) { out = x.array() + 1.0; }, 20000);
+  SolverOptions o;
+  o.stop.max_iterations = 100000;
+  AndersonEngine<> anderson({.depth = 2}, o);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(20000);
+  const Summary summary = anderson.solve(no_root, x);
+  EXPECT_FALSE(summary.usable());
+  EXPECT_TRUE(summary.status == Status::kStagnated || summary.status == Status::kDiverged)
+      << summary.brief_report();
+  EXPECT_GT(summary.iterations, 2000) << summary.brief_report();
+  EXPECT_LT(summary.iterations, 2100) << summary.brief_report();
+}
+
 TEST(AndersonProgress, ANegativeWindowIsRefused) {
   SolverOptions o;
   o.stop.residual_window = -1;
@@ -136,6 +183,16 @@ TEST(AndersonProgress, ANegativeWindowIsRefused) {
               AndersonEngine<1> a({}, o);
             }).find("StopCriteria::residual_window = -1"),
             std::string::npos);
+  for (const double bad :
+       {-0.1, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    o = SolverOptions{};
+    o.stop.residual_window_per_unknown = bad;
+    EXPECT_NE(test::message_of([&] {
+                AndersonEngine<1> a({}, o);
+              }).find("StopCriteria::residual_window_per_unknown"),
+              std::string::npos)
+        << bad;
+  }
 }
 
 }  // namespace

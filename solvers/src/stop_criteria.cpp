@@ -40,6 +40,9 @@ void validate(const StopCriteria& c) {
   if (c.residual_window < 0) {
     fail("residual_window", c.residual_window, "must be >= 0 (0 disables it)");
   }
+  if (!(std::isfinite(c.residual_window_per_unknown) && c.residual_window_per_unknown >= 0.0)) {
+    fail("residual_window_per_unknown", c.residual_window_per_unknown, "must be finite and >= 0");
+  }
   if (!(std::isfinite(c.divergence_growth) && c.divergence_growth > 1.0)) {
     fail("divergence_growth", c.divergence_growth, "must be finite and > 1");
   }

@@ -95,7 +95,8 @@ Summary AcceleratedEngine<N, Accelerator>::solve(const FixedPointProblem<N>& pro
   StopMonitor monitor(opt.stop, x.template lpNorm<Eigen::Infinity>(),
                       has_picard_steps<Accelerator>(),
                       is_non_monotone<Accelerator>() ? StopMonitor::Progress::kBestResidual
-                                                     : StopMonitor::Progress::kSteps);
+                                                     : StopMonitor::Progress::kSteps,
+                      x.size());
   accelerator_.start(x);
   point_ = x;
   last_ = x;

@@ -46,8 +46,14 @@ struct StopCriteria {
   // divergence_growth × that smallest. 0 = off. The default is long because such runs rise for a
   // long while: on the 2-D Bratu problem (λ = 6, nonlinear Jacobi, Anderson(3) from u = 0) the
   // longest stretch without a new best residual is 7, 44, 196 and 604 iterations at n = 100, 1024,
-  // 3025 and 10⁴ (docs/solvers.md).
+  // 3025 and 10⁴, and between 2 000 and 5 000 at 99 856 (docs/solvers.md): it grows with the
+  // problem's slowest mode, so the window does too.
   int residual_window = 1000;
+  // The window in force is max(residual_window, ⌈residual_window_per_unknown · n⌉) for n unknowns:
+  // 1000 up to n = 10⁴, 9 986 at 99 856 (where a window of 1000 or 2000 ended Anderson(3)
+  // `stagnated` at ‖F‖∞ 1e-5 and 5e-7; from 5000 up it converges, 63 046 iterations). ≥ 0, finite;
+  // 0 keeps residual_window alone.
+  double residual_window_per_unknown = 0.1;
   // Progress, counted in evaluations, for the engines that solve a square or least-squares
   // system with a Jacobian (newton, dogleg, levenberg-marquardt, broyden, pseudo-transient):
   // stagnated when progress_window evaluations of F at iterates and trial points (difference

@@ -11,6 +11,7 @@
 
 #include "nlobs/solvers/stop_criteria.hpp"
 #include "nlobs/solvers/summary.hpp"
+#include "nlobs/solvers/types.hpp"
 
 namespace nlobs {
 
@@ -24,13 +25,26 @@ class StopMonitor {
   // over which ‖F‖ fell is no verdict) or the best residual over a window (non-monotone methods
   // such as Anderson: StopCriteria::residual_window). Both end at the rounding floor
   // (Status::kRoundingFloor).
+  // unknowns: n, which sets the residual window in force (StopCriteria::
+  // residual_window_per_unknown); 0 when unknown.
   enum class Progress { kSteps, kBestResidual };
   StopMonitor(const StopCriteria& criteria, double x0_norm, bool estimate_lipschitz,
-              Progress progress = Progress::kSteps)
+              Progress progress = Progress::kSteps, Index unknowns = 0)
       : c_(criteria),
         limit_(criteria.divergence_limit * std::max(1.0, x0_norm)),
         estimate_lipschitz_(estimate_lipschitz),
-        progress_(progress) {}
+        progress_(progress),
+        residual_window_(residual_window_for(criteria, unknowns)) {}
+
+  static long residual_window_for(const StopCriteria& c, Index unknowns) {
+    if (c.residual_window <= 0) return 0;
+    const double scaled = std::ceil(c.residual_window_per_unknown * static_cast<double>(unknowns));
+    // Capped where no run could reach it (and a long cannot overflow).
+    return static_cast<long>(
+        std::max(static_cast<double>(c.residual_window), std::min(scaled, 1e15)));
+  }
+  // The residual window in force (0: off).
+  long residual_window() const { return residual_window_; }
 
   // After each completed iteration: the step ‖x_l − x_{l−1}‖∞, the residual ‖G − x‖∞ at the
   // last evaluated point (NaN when unknown) and ‖x_l‖∞. Returns the final status or nullopt.
@@ -88,16 +102,17 @@ class StopMonitor {
         ++since_best_;
         far_above_ = residual > c_.divergence_growth * best_before ? far_above_ + 1 : 0;
       }
-      if (c_.residual_window > 0) {
-        if (far_above_ >= c_.residual_window) {
+      if (residual_window_ > 0) {
+        if (far_above_ >= residual_window_) {
           return stop(Status::kDiverged,
-                      "every residual of the last residual_window iterations exceeded "
-                      "divergence_growth x the best before them");
+                      "every residual of the last max(residual_window, "
+                      "residual_window_per_unknown x n) iterations exceeded divergence_growth x "
+                      "the best before them");
         }
-        if (since_best_ >= c_.residual_window) {
+        if (since_best_ >= residual_window_) {
           return stop(Status::kStagnated,
-                      "no residual of the last residual_window iterations fell below the best "
-                      "before them");
+                      "no residual of the last max(residual_window, residual_window_per_unknown "
+                      "x n) iterations fell below the best before them");
         }
       }
     } else if (iterations_ > 1 && step >= prev_step_) {
@@ -223,7 +238,8 @@ class StopMonitor {
   double limit_;
   bool estimate_lipschitz_;
   Progress progress_;
-  int since_best_ = 0, far_above_ = 0;  // iterations since the best residual; run above growth×
+  long residual_window_;  // in force: max(residual_window, ⌈residual_window_per_unknown · n⌉)
+  long since_best_ = 0, far_above_ = 0;  // iterations since the best residual; run above growth×
   int iterations_ = 0;
   double prev_step_ = 0.0;
   double last_step_ = 0.0;
