@@ -2,6 +2,7 @@
 
 #include <ostream>
 #include <stdexcept>
+#include <string>
 
 #include "nlobs/common/printable.hpp"
 #include "nlobs/reference/problem_suite.hpp"
@@ -13,6 +14,18 @@
 #include "solve_chua_window.hpp"
 
 namespace nlobs::cli {
+namespace {
+
+// "depth (alias m)": a key and the older names it is also given by.
+std::string with_aliases(const EngineOptionInfo& option) {
+  std::string text = option.key;
+  for (std::size_t i = 0; i < option.aliases.size(); ++i) {
+    text += (i == 0 ? " (alias " : ", ") + option.aliases[i];
+  }
+  return option.aliases.empty() ? text : text + ")";
+}
+
+}  // namespace
 
 void print_list(const std::string& what, std::ostream& out) {
   const bool all = what.empty();
@@ -95,14 +108,15 @@ void print_list(const std::string& what, std::ostream& out) {
     const std::string source = EngineRegistry<Dynamic>::global().source(e.name);
     if (source != "built-in") out << "; from " << source;
     out << '\n';
-    for (const auto& o : e.options) out << "      " << o.key << ": " << o.description << '\n';
+    for (const auto& o : e.options)
+      out << "      " << with_aliases(o) << ": " << o.description << '\n';
     out << "      e.g.";
     for (const auto& x : e.examples) out << ' ' << x;
     out << '\n';
   }
   out << "  options of every engine:";
   for (const auto& o : EngineRegistry<Dynamic>::global().common_options()) {
-    out << "\n      " << o.key << ": " << o.description;
+    out << "\n      " << with_aliases(o) << ": " << o.description;
   }
   out << "\nreference solvers (same run, for comparison):\n  solve chua-window:";
   for (const auto& r : reference_names()) out << ' ' << r;

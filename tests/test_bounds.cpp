@@ -282,6 +282,41 @@ TEST(Bounds, EnginesThatTakeNoBoundsSayWhichDo) {
                            "auto", "ceres", "nlopt"}) {
     EXPECT_TRUE(registry.create(spec)->accepts_bounds()) << spec;
   }
+  // The message's list is read from the registered engines, not written down: it names every
+  // engine above that takes a box, none that does not, and a user's engine that takes one.
+  const std::string refusal = test::message_of([&] { registry.create("picard")->set_bounds(box); });
+  for (const char* name : {"newton", "dogleg", "broyden", "levenberg-marquardt", "pseudo-transient",
+                           "auto", "ceres", "nlopt"}) {
+    EXPECT_NE(refusal.find(name), std::string::npos) << name << ": " << refusal;
+  }
+  EXPECT_EQ(refusal.find("anderson"), std::string::npos) << refusal;
+  EXPECT_EQ(refusal.find("steffensen"), std::string::npos) << refusal;
+  if (!EngineRegistry<Dynamic>::global().has_entry("boxed-picard")) {
+    EngineRegistry<Dynamic>::global().add(
+        {"boxed-picard",
+         "a user's engine that says it takes a box",
+         {},
+         {"boxed-picard"},
+         [](EngineSpecReader&, SolverOptions o) -> std::unique_ptr<Engine<>> {
+           struct Boxed : PicardEngine<> {
+             using PicardEngine<>::PicardEngine;
+             bool accepts_bounds() const override { return true; }
+           };
+           return std::make_unique<Boxed>(std::move(o));
+         }},
+        "tests/test_bounds.cpp");
+  }
+  EXPECT_NE(
+      test::message_of([&] { registry.create("picard")->set_bounds(box); }).find("boxed-picard"),
+      std::string::npos);
+  // Strict sides: the list of the engines that take them, read the same way.
+  BoxBounds strict = box;
+  strict.strict_lower = StrictBounds::Constant(2, true);
+  const std::string closed =
+      test::message_of([&] { registry.create("ceres")->set_bounds(strict); });
+  EXPECT_NE(closed.find("keeps x in a closed box only"), std::string::npos) << closed;
+  EXPECT_NE(closed.find("levenberg-marquardt"), std::string::npos) << closed;
+  EXPECT_EQ(closed.find("nlopt"), std::string::npos) << closed;
   // A stage that refuses the box leaves auto and its stages as they were.
   auto mixed =
       EngineRegistry<Dynamic>::global().create("auto:order=newton/levenberg-marquardt:geodesic=1");

@@ -29,6 +29,37 @@ TEST(Engines, EachSolvesCosineFixedPoint) {
   expect_dottie(NewtonEngine<1>({.line_search = true}, o));
 }
 
+// Summary::engine holds its own copy of the name: it stays right after the engine is gone, for an
+// engine that names itself from a string it owns (a plugin's may), and is cut at 64 bytes on a
+// UTF-8 boundary.
+TEST(Engines, TheSummaryKeepsTheEngineNameAfterTheEngineIsGone) {
+  class Named : public PicardEngine<1> {
+   public:
+    Named(std::string name, SolverOptions o) : PicardEngine<1>(o), name_(std::move(name)) {}
+    std::string_view name() const override { return name_; }
+
+   private:
+    std::string name_;
+  };
+  // On the heap, with a name past the small-string buffer: a view into it would dangle.
+  const std::string name = "my-own-over-relaxed-picard-engine";
+  auto engine = std::make_unique<Named>(name, test::tolerance(1e-12));
+  Vector<1> x(1.0);
+  const Summary s = engine->solve(test::cosine_problem(), x);
+  engine.reset();  // the engine and its string are gone
+  EXPECT_EQ(s.engine, name);
+  EXPECT_EQ(std::string(s.engine), name);
+  EXPECT_NE(s.brief_report().find(name), std::string::npos) << s.brief_report();
+
+  const std::string long_name = std::string(63, 'a') + "é-tail";  // 'é' straddles byte 64
+  const EngineName cut(long_name);
+  EXPECT_EQ(cut.size(), 63u);
+  EXPECT_EQ(cut.view(), std::string(63, 'a'));
+  EXPECT_EQ(EngineName(std::string(64, 'b')).size(), 64u);
+  EXPECT_EQ(EngineName(std::string(100, 'c')).size(), EngineName::kCapacity);
+  EXPECT_TRUE(EngineName().empty());
+}
+
 TEST(Engines, AccelerationOrdersIterationCountsOnCosine) {
   const SolverOptions o = test::tolerance(1e-12);
   auto iterations = [&](Engine<1>&& e) {

@@ -259,8 +259,8 @@ TEST(Plugins, RefusesALibraryThatIsNotAPluginOrIsBuiltAgainstAnotherNlobs) {
       {"test_plugin_foreign_magic", "is not an nlobs plugin: its nlobs_plugin_info does not"},
       {"test_plugin_null_info", "is not an nlobs plugin: its nlobs_plugin_info does not"},
       {"test_plugin_foreign_layout",
-       "was built for nlobs plugin interface 2; this nlobs has "
-       "interface 1: rebuild it"},
+       "was built for nlobs plugin interface " + std::to_string(kPluginLayout + 1) +
+           "; this nlobs has interface " + std::to_string(kPluginLayout) + ": rebuild it"},
       {"test_plugin_foreign_version",
        "was built against nlobs '0.0.9'; this is nlobs " + std::string(NLOBS_VERSION_STRING)},
       {"test_plugin_foreign_abi", "was built with 'libc++ abi=1'"}};

@@ -7,6 +7,7 @@
 #include "nlobs/solvers/ceres_engine.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 #include "nlobs/solvers/fixed_point_engines.hpp"
+#include "nlobs/solvers/levenberg_marquardt_engine.hpp"
 #include "nlobs/solvers/newton_engine.hpp"
 #include "nlobs/solvers/nlopt_engine.hpp"
 #include "test_support.hpp"
@@ -90,14 +91,93 @@ TEST(EngineRegistry, OptionsReachTheEngine) {
   EXPECT_EQ(l->nlopt_options().relative_step_tolerance, 1e-6);
 }
 
+TEST(EngineRegistry, KeysAreFieldNamesWithTheOldNamesAsAliases) {
+  auto& registry = EngineRegistry<2>::global();
+  for (const char* spec :
+       {"anderson:depth=5,condition_limit=1e6,step_tolerance=1e-3,max_iterations=7",
+        "anderson:m=5,cond=1e6,tol=1e-3,max_iter=7"}) {
+    auto engine = registry.create(spec);
+    auto* a = dynamic_cast<AndersonEngine<2>*>(engine.get());
+    ASSERT_NE(a, nullptr) << spec;
+    EXPECT_EQ(a->accelerator().options().depth, 5) << spec;
+    EXPECT_EQ(a->accelerator().options().condition_limit, 1e6) << spec;
+    EXPECT_EQ(*a->options().stop.step_tolerance, 1e-3) << spec;
+    EXPECT_EQ(a->options().stop.max_iterations, 7) << spec;
+  }
+  for (const char* spec : {"newton:line_search=1,finite_difference=forward,jacobian_reuse=3,"
+                           "residual_tolerance=1e-9,max_evaluations=50",
+                           "newton:linesearch=1,fd=forward,reuse=3,ftol=1e-9,max_evals=50"}) {
+    auto engine = registry.create(spec);
+    auto* n = dynamic_cast<NewtonEngine<2>*>(engine.get());
+    ASSERT_NE(n, nullptr) << spec;
+    EXPECT_TRUE(n->newton_options().line_search) << spec;
+    EXPECT_EQ(n->newton_options().finite_difference, FiniteDifference::kForward) << spec;
+    EXPECT_EQ(n->newton_options().jacobian_reuse, 3) << spec;
+    EXPECT_EQ(*n->options().stop.residual_tolerance, 1e-9) << spec;
+    EXPECT_EQ(n->options().stop.max_evaluations, 50) << spec;
+  }
+  // A key and its alias in one spec: refused, naming both.
+  const std::string both = message_of([&] { registry.create("anderson:m=3,depth=4"); });
+  EXPECT_NE(both.find("'m' and 'depth' name the same option 'depth': give one"), std::string::npos)
+      << both;
+  EXPECT_THROW(registry.create("picard:tol=1e-3,step_tolerance=1e-4"), InvalidInput);
+
+  // levenberg-marquardt's own ftol (MINPACK's) no longer sets the common residual tolerance too.
+  auto lm = registry.create("levenberg-marquardt:ftol=1e-3");
+  auto* l = dynamic_cast<LevenbergMarquardtEngine<2>*>(lm.get());
+  ASSERT_NE(l, nullptr);
+  EXPECT_EQ(l->lm_options().function_tolerance, 1e-3);
+  EXPECT_FALSE(l->options().stop.residual_tolerance.has_value());
+  lm = registry.create("levenberg-marquardt:residual_tolerance=1e-6,function_tolerance=1e-4");
+  l = dynamic_cast<LevenbergMarquardtEngine<2>*>(lm.get());
+  ASSERT_NE(l, nullptr);
+  EXPECT_EQ(l->lm_options().function_tolerance, 1e-4);
+  EXPECT_EQ(*l->options().stop.residual_tolerance, 1e-6);
+  EXPECT_THROW(registry.create("levenberg-marquardt:ftol=1e-3,function_tolerance=1e-4"),
+               InvalidInput);
+  // Where ftol is not the engine's own, it is still the residual tolerance.
+  auto newton = registry.create("newton:ftol=1e-7");
+  EXPECT_EQ(*newton->options().stop.residual_tolerance, 1e-7);
+
+  // A user's engine declaring a common key itself: the key is its own there, aliases included.
+  auto& dynamic = EngineRegistry<Dynamic>::global();
+  if (!dynamic.has_entry("own-iterations")) {
+    dynamic.add({"own-iterations",
+                 "Picard counting its own iterations",
+                 {{"max_iterations", "the engine's own", {"max_iter"}}},
+                 {"own-iterations"},
+                 [](EngineSpecReader& s, SolverOptions o) -> std::unique_ptr<Engine<>> {
+                   if (auto v = s.integer("max_iterations", 1, 100)) o.stop.max_iterations = 2 * *v;
+                   return std::make_unique<PicardEngine<>>(std::move(o));
+                 }},
+                "tests/test_registry.cpp");
+  }
+  EXPECT_EQ(dynamic.create("own-iterations:max_iter=5")->options().stop.max_iterations, 10);
+  EXPECT_THROW(dynamic.create("own-iterations:max_iterations=500"), InvalidInput);  // its range
+  // A registration that declares one name twice is refused when the engine is made, named.
+  if (!dynamic.has_entry("twice-named")) {
+    dynamic.add({"twice-named",
+                 "declares m as an alias of two options",
+                 {{"depth", "a", {"m"}}, {"memory", "b", {"m"}}},
+                 {"twice-named"},
+                 [](EngineSpecReader&, SolverOptions o) -> std::unique_ptr<Engine<>> {
+                   return std::make_unique<PicardEngine<>>(std::move(o));
+                 }},
+                "tests/test_registry.cpp");
+  }
+  EXPECT_NE(message_of([&] { dynamic.create("twice-named"); }).find("'m' twice"),
+            std::string::npos);
+}
+
 TEST(EngineRegistry, ErrorsListWhatIsValid) {
   auto& registry = EngineRegistry<1>::global();
   const std::string unknown = message_of([&] { registry.create("bogus"); });
   EXPECT_NE(unknown.find("unknown engine 'bogus'"), std::string::npos) << unknown;
   EXPECT_NE(unknown.find("steffensen"), std::string::npos) << unknown;
-  const std::string option = message_of([&] { registry.create("anderson:depth=3"); });
-  EXPECT_NE(option.find("unknown option(s) 'depth'"), std::string::npos) << option;
-  EXPECT_NE(option.find("damping"), std::string::npos) << option;  // lists valid options
+  const std::string option = message_of([&] { registry.create("anderson:size=3"); });
+  EXPECT_NE(option.find("unknown option(s) 'size'"), std::string::npos) << option;
+  EXPECT_NE(option.find("damping"), std::string::npos) << option;       // lists valid options
+  EXPECT_NE(option.find("depth or m ("), std::string::npos) << option;  // and their aliases
   EXPECT_NE(
       message_of([&] { registry.create("anderson:m=abc"); }).find("'m=abc' is not an integer"),
       std::string::npos);

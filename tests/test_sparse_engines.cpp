@@ -218,7 +218,7 @@ TEST(SparsePseudoTransient, IsReachableByEngineSpec) {
   }
   EXPECT_NE(test::message_of([&] {
               registry.create("newton:linear=klu,ordering=metis", test::residual_stop(1e-9, 9));
-            }).find("ordering=metis needs linear=umfpack"),
+            }).find("ordering=metis needs linear_solver=umfpack"),
             std::string::npos);
   EXPECT_THROW(registry.create("newton:linear=umfpack,ordering=rcm", test::residual_stop(1e-9, 9)),
                InvalidInput);

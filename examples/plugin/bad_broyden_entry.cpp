@@ -12,12 +12,15 @@ void add_bad_broyden(nlobs::PluginRegistrar& registrar) {
       {.name = "bad-broyden",
        .description = "Broyden's second (bad) method with backtracking and Jacobian restarts "
                       "(example plugin)",
-       .options = {{"backtracks", "step halvings before the Jacobian is renewed; default 10"}},
-       .examples = {"bad-broyden", "bad-broyden:backtracks=4"},
+       // The key names the field it sets; its older, shorter name is an alias.
+       .options = {{"max_backtracks",
+                    "step halvings before the Jacobian is renewed; default 10",
+                    {"backtracks"}}},
+       .examples = {"bad-broyden", "bad-broyden:max_backtracks=4"},
        .make = [](nlobs::EngineSpecReader& spec,
                   nlobs::SolverOptions options) -> std::unique_ptr<nlobs::Engine<>> {
          BadBroydenOptions broyden;
-         if (auto k = spec.integer("backtracks", 0, 60)) broyden.max_backtracks = *k;
+         if (auto k = spec.integer("max_backtracks", 0, 60)) broyden.max_backtracks = *k;
          return std::make_unique<BadBroydenEngine<>>(std::move(options), broyden);
        }});
 }

@@ -47,7 +47,20 @@ EngineSpec parse_engine_spec(std::string_view text) {
 }
 
 EngineSpecReader::EngineSpecReader(const EngineSpec& spec, std::vector<EngineOptionInfo> valid)
-    : spec_(spec), valid_(std::move(valid)), used_values_(spec.values.size(), false) {}
+    : spec_(spec), valid_(std::move(valid)), used_values_(spec.values.size(), false) {
+  // One name, one option: an alias repeated, or equal to another option's key, would let two
+  // reads take the same item (an engine's registration bug, named here when it is created).
+  std::vector<std::string> names;
+  for (const auto& option : valid_) {
+    names.push_back(option.key);
+    names.insert(names.end(), option.aliases.begin(), option.aliases.end());
+  }
+  std::sort(names.begin(), names.end());
+  if (const auto twice = std::adjacent_find(names.begin(), names.end()); twice != names.end()) {
+    throw InvalidInput("engine '" + spec_.name + "' declares the option name " +
+                       quoted_excerpt(*twice) + " twice (as a key or an alias)");
+  }
+}
 
 void EngineSpecReader::fail(const std::string& what) const {
   std::ostringstream os;
@@ -55,24 +68,59 @@ void EngineSpecReader::fail(const std::string& what) const {
      << spec_.name << "': ";
   if (valid_.empty()) os << "(none)";
   for (size_t i = 0; i < valid_.size(); ++i) {
-    os << (i ? ", " : "") << valid_[i].key << " (" << valid_[i].description << ")";
+    os << (i ? ", " : "") << valid_[i].key;
+    for (const auto& alias : valid_[i].aliases) os << " or " << alias;
+    os << " (" << valid_[i].description << ")";
   }
   throw InvalidInput(os.str());
 }
 
-std::optional<std::string> EngineSpecReader::text(const std::string& key) {
-  for (size_t i = 0; i < spec_.values.size(); ++i) {
-    if (spec_.values[i].first == key) {
-      used_values_[i] = true;
-      return spec_.values[i].second;
+std::optional<std::size_t> EngineSpecReader::find(const std::string& key) {
+  const auto known = std::find_if(valid_.begin(), valid_.end(),
+                                  [&key](const EngineOptionInfo& o) { return o.key == key; });
+  const auto names_key = [&](const std::string& given) {
+    return given == key ||
+           (known != valid_.end() &&
+            std::find(known->aliases.begin(), known->aliases.end(), given) != known->aliases.end());
+  };
+  std::optional<std::size_t> found;
+  for (std::size_t i = 0; i < spec_.values.size(); ++i) {
+    if (!names_key(spec_.values[i].first)) continue;
+    if (found) {
+      fail(quoted_excerpt(spec_.values[*found].first) + " and " +
+           quoted_excerpt(spec_.values[i].first) + " name the same option " + quoted_excerpt(key) +
+           ": give one");
     }
+    found = i;
   }
-  return std::nullopt;
+  if (found) used_values_[*found] = true;
+  return found;
 }
 
-std::optional<double> EngineSpecReader::number(const std::string& key) {
-  const auto t = text(key);
-  if (!t) return std::nullopt;
+std::optional<std::string> EngineSpecReader::text(const std::string& key) {
+  const auto i = find(key);
+  if (!i) return std::nullopt;
+  return spec_.values[*i].second;
+}
+
+std::optional<std::string> EngineSpecReader::choice(const std::string& key_name,
+                                                    const std::vector<std::string>& allowed) {
+  const auto i = find(key_name);
+  if (!i) return std::nullopt;
+  const auto& [key, value] = spec_.values[*i];
+  if (std::find(allowed.begin(), allowed.end(), value) == allowed.end()) {
+    std::string list;
+    for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+    fail(quoted_excerpt(key + "=" + value) + " is not one of: " + list);
+  }
+  return value;
+}
+
+std::optional<double> EngineSpecReader::number(const std::string& key_name) {
+  const auto i = find(key_name);
+  if (!i) return std::nullopt;
+  const std::string& key = spec_.values[*i].first;  // as the spec spells it, for messages
+  const std::string* t = &spec_.values[*i].second;
   char* end = nullptr;
   errno = 0;
   const double v = std::strtod(t->c_str(), &end);
@@ -85,9 +133,11 @@ std::optional<double> EngineSpecReader::number(const std::string& key) {
   return v;
 }
 
-std::optional<int> EngineSpecReader::integer(const std::string& key, int min, int max) {
-  const auto t = text(key);
-  if (!t) return std::nullopt;
+std::optional<int> EngineSpecReader::integer(const std::string& key_name, int min, int max) {
+  const auto i = find(key_name);
+  if (!i) return std::nullopt;
+  const std::string& key = spec_.values[*i].first;
+  const std::string* t = &spec_.values[*i].second;
   char* end = nullptr;
   errno = 0;
   const long v = std::strtol(t->c_str(), &end, 10);
@@ -100,9 +150,11 @@ std::optional<int> EngineSpecReader::integer(const std::string& key, int min, in
   return static_cast<int>(v);
 }
 
-std::optional<bool> EngineSpecReader::boolean(const std::string& key) {
-  const auto t = text(key);
-  if (!t) return std::nullopt;
+std::optional<bool> EngineSpecReader::boolean(const std::string& key_name) {
+  const auto i = find(key_name);
+  if (!i) return std::nullopt;
+  const std::string& key = spec_.values[*i].first;
+  const std::string* t = &spec_.values[*i].second;
   if (*t == "1" || *t == "true" || *t == "on") return true;
   if (*t == "0" || *t == "false" || *t == "off") return false;
   fail(quoted_excerpt(key + "=" + *t) + " is not 0/1, true/false or on/off");

@@ -154,8 +154,7 @@ ModulatingKernels::ModulatingKernels(int n, double horizon, ModulatingKernelOpti
            << "' (status " << to_string(s.status) << ", ‖Jᵀr‖ " << gradient.norm() << ")";
         fail(os.str());
       }
-      summary_ = s;
-      summary_->engine = {};  // the engine does not outlive the design: engine() names it
+      summary_ = s;  // its engine name is its own copy (EngineName): valid after the engine
       c = particular + Q2 * RJ.triangularView<Eigen::Upper>().solve(q);
     }
     // Monomial coefficients of a degree-d kernel alternate in sign and grow like 2^d: the

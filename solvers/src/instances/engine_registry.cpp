@@ -6,6 +6,35 @@
 
 namespace nlobs {
 
+namespace detail {
+
+// Read from the engines themselves (each engine of the Dynamic registry, every size's fallback,
+// made with its default options), so that the list follows the registry, a user's and a plugin's
+// engines included. Only on the path of a refusal: it runs every factory.
+std::string engines_taking_bounds(bool strict) {
+  // A factory that itself sets a refused box would come back here: answer without the list.
+  thread_local bool listing = false;
+  if (listing) return "(see nlobs list engines)";
+  listing = true;
+  struct Reset {
+    bool& flag;
+    ~Reset() { flag = false; }
+  } reset{listing};
+  std::string list;
+  for (const auto& entry : EngineRegistry<Dynamic>::global().entries()) {
+    try {
+      const auto engine = EngineRegistry<Dynamic>::global().create(entry.name);
+      if (engine && (strict ? engine->accepts_strict_bounds() : engine->accepts_bounds())) {
+        list += (list.empty() ? "" : ", ") + entry.name;
+      }
+    } catch (...) {  // an engine that cannot be made with its defaults is not listed
+    }
+  }
+  return list.empty() ? "(none registered)" : list;
+}
+
+}  // namespace detail
+
 #define NLOBS_INSTANTIATE(n)           \
   template class EngineRegistry<n>;    \
   template class DynamicSizeEngine<n>; \

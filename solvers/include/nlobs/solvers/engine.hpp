@@ -17,6 +17,12 @@
 
 namespace nlobs {
 
+namespace detail {
+// "newton, dogleg, …": the registered engines that accept bounds (strict: strict ones), asked of
+// the engines themselves; defined with the registry, in the library.
+std::string engines_taking_bounds(bool strict);
+}  // namespace detail
+
 struct SolverOptions {
   StopCriteria stop{};
   bool record_trace = false;  // fill Summary::trace (allocates; off in hot loops)
@@ -72,19 +78,17 @@ class Engine {
   virtual bool accepts_strict_bounds() const { return false; }
   void set_bounds(BoxBounds bounds) {
     if (!bounds.empty() && !accepts_bounds()) {
-      throw InvalidInput(std::string(name()) +
-                         " does not accept bounds; engines that do: newton, dogleg, "
-                         "levenberg-marquardt, broyden, pseudo-transient, auto, ceres, nlopt");
+      throw InvalidInput(std::string(name()) + " does not accept bounds; engines that do: " +
+                         detail::engines_taking_bounds(false));
     }
     if (scaled_solve_running_) {
       throw InvalidInput(std::string(name()) + ": set_bounds during a scaled solve");
     }
     detail::validate_box(name(), bounds);
     if (bounds.any_strict() && !accepts_strict_bounds()) {
-      throw InvalidInput(std::string(name()) +
-                         " keeps x in a closed box only; engines that take strict bounds: "
-                         "newton, dogleg, levenberg-marquardt, broyden, pseudo-transient, and "
-                         "auto when every stage is one of them");
+      throw InvalidInput(
+          std::string(name()) + " keeps x in a closed box only; engines that take strict bounds: " +
+          detail::engines_taking_bounds(true) + " (auto when every stage is one of them)");
     }
     BoxBounds previous = std::move(bounds_);
     bounds_ = std::move(bounds);

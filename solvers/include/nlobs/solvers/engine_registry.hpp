@@ -1,8 +1,12 @@
 #pragma once
 // Engines by name: EngineRegistry<N>::global().create("anderson:m=3,damping=0.5").
 // Every built-in engine is registered; a user registers their own under its own name with
-// add(). Options common to all engines: tol (step tolerance), ftol (residual tolerance),
-// max_iter, max_evals, progress_window.
+// add(). Options common to all engines, named after StopCriteria's fields: step_tolerance (alias
+// tol), residual_tolerance (ftol), max_iterations (max_iter), max_evaluations (max_evals),
+// progress_window. An engine's own option under a common option's key replaces that option on
+// that engine, aliases included; under one of its aliases, it takes that alias only
+// (levenberg-marquardt:ftol is MINPACK's ftol, its function_tolerance; residual_tolerance is
+// still the common one there).
 //
 // One registration serves every size: a fixed-size registry EngineRegistry<N> that has no entry
 // of a name uses the entry of EngineRegistry<Dynamic> through DynamicSizeEngine<N>. An entry
@@ -12,6 +16,7 @@
 // add_builtin_engines<N>(EngineRegistry<N>::global()) from builtin_engines.hpp.
 //
 // This header names no engine: the engines are compiled once, in the solvers library.
+#include <algorithm>
 #include <functional>
 #include <map>
 #include <memory>
@@ -64,10 +69,10 @@ class EngineRegistry {
 
   static const std::vector<EngineOptionInfo>& common_options() {
     static const std::vector<EngineOptionInfo> common = {
-        {"tol", "step tolerance, max norm; default 1e-8"},
-        {"ftol", "residual tolerance ‖F‖∞; default off"},
-        {"max_iter", "maximum iterations; default 10000"},
-        {"max_evals", "maximum function evaluations; default 100000"},
+        {"step_tolerance", "step tolerance, max norm; default 1e-8", {"tol"}},
+        {"residual_tolerance", "residual tolerance ‖F‖∞; default off", {"ftol"}},
+        {"max_iterations", "maximum iterations; default 10000", {"max_iter"}},
+        {"max_evaluations", "maximum function evaluations; default 100000", {"max_evals"}},
         {"progress_window",
          "evaluations without a 0.1 % fall of |F|_2 before a Jacobian-based engine stops "
          "stagnated, 0 = off; default 50"}};
@@ -196,13 +201,39 @@ std::unique_ptr<Engine<N>> EngineRegistry<N>::create(std::string_view spec_text,
     throw InvalidInput("unknown engine " + quoted_excerpt(spec.name) + "; valid engines: " + list);
   }
   std::vector<EngineOptionInfo> valid = entry->options;
-  valid.insert(valid.end(), common_options().begin(), common_options().end());
+  const auto engine_names = [&entry](const std::string& name) {
+    for (const auto& o : entry->options) {
+      if (o.key == name || std::find(o.aliases.begin(), o.aliases.end(), name) != o.aliases.end())
+        return true;
+    }
+    return false;
+  };
+  std::vector<std::string> common_keys;  // those the engine leaves to the common options
+  for (EngineOptionInfo common : common_options()) {
+    if (engine_names(common.key)) continue;
+    std::erase_if(common.aliases, engine_names);
+    common_keys.push_back(common.key);
+    valid.push_back(std::move(common));
+  }
+  const auto common_key = [&common_keys](const char* key) {
+    return std::find(common_keys.begin(), common_keys.end(), key) != common_keys.end();
+  };
   EngineSpecReader reader(spec, valid);
-  if (auto v = reader.number("tol")) base.stop.step_tolerance = *v;
-  if (auto v = reader.number("ftol")) base.stop.residual_tolerance = *v;
-  if (auto v = reader.integer("max_iter", 1, 1000000000)) base.stop.max_iterations = *v;
-  if (auto v = reader.integer("max_evals", 1, 1000000000)) base.stop.max_evaluations = *v;
-  if (auto v = reader.integer("progress_window", 0, 1000000000)) base.stop.progress_window = *v;
+  if (common_key("step_tolerance")) {
+    if (auto v = reader.number("step_tolerance")) base.stop.step_tolerance = *v;
+  }
+  if (common_key("residual_tolerance")) {
+    if (auto v = reader.number("residual_tolerance")) base.stop.residual_tolerance = *v;
+  }
+  if (common_key("max_iterations")) {
+    if (auto v = reader.integer("max_iterations", 1, 1000000000)) base.stop.max_iterations = *v;
+  }
+  if (common_key("max_evaluations")) {
+    if (auto v = reader.integer("max_evaluations", 1, 1000000000)) base.stop.max_evaluations = *v;
+  }
+  if (common_key("progress_window")) {
+    if (auto v = reader.integer("progress_window", 0, 1000000000)) base.stop.progress_window = *v;
+  }
   std::unique_ptr<Engine<N>> engine;
   try {
     engine = entry->make(reader, std::move(base));

@@ -2,7 +2,9 @@
 // Engine spec strings: "name[:item[,item...]]", an item being "key=value" or a bare word
 // (e.g. "steffensen", "anderson:m=3,damping=0.5", "newton:linesearch=1", "ceres:dogleg",
 // "nlopt:LN_BOBYQA,xtol_rel=1e-6"). EngineSpecReader reads typed values and refuses anything
-// the engine does not understand, listing what it does.
+// the engine does not understand, listing what it does. An option's key is the name of the field
+// it sets (NewtonOptions::line_search: line_search=1); the shorter names it had before are its
+// aliases (linesearch=1), accepted alike; giving both is refused.
 #include <optional>
 #include <string>
 #include <string_view>
@@ -24,20 +26,27 @@ struct EngineSpec {
 EngineSpec parse_engine_spec(std::string_view text);
 
 struct EngineOptionInfo {
-  std::string key;          // "m", "damping", ... ; for words: "<word>"
-  std::string description;  // with the default
+  std::string key;                     // "depth", "damping", ... ; for words: "<word>"
+  std::string description;             // with the default
+  std::vector<std::string> aliases{};  // older names of the key ("m"), accepted alike
 };
 
 class EngineSpecReader {
  public:
-  // `valid` lists the options of the engine for error messages.
+  // `valid` lists the options of the engine: for error messages, and the aliases by which each
+  // key may be given.
   EngineSpecReader(const EngineSpec& spec, std::vector<EngineOptionInfo> valid);
+  // Each reads `key` or one of its aliases (InvalidInput when the spec gives more than one).
 
   std::optional<double> number(const std::string& key);
   // An integer in [min, max]; otherwise InvalidInput naming the key, the value and the range.
   std::optional<int> integer(const std::string& key, int min, int max);
   std::optional<bool> boolean(const std::string& key);  // 0/1, true/false, on/off
   std::optional<std::string> text(const std::string& key);
+  // A word among `allowed` ("none", "jacobian"); otherwise InvalidInput naming the key as the
+  // spec spells it, the value and the allowed words.
+  std::optional<std::string> choice(const std::string& key,
+                                    const std::vector<std::string>& allowed);
   // The single bare word, if any, which must be one of `allowed` (empty: any).
   std::optional<std::string> word(const std::vector<std::string>& allowed = {});
   // Throws InvalidInput naming every item not consumed and listing the valid options.
@@ -45,6 +54,8 @@ class EngineSpecReader {
 
  private:
   [[noreturn]] void fail(const std::string& what) const;
+  // The spec item that sets `key` under its name or an alias, marked used; or nullopt.
+  std::optional<std::size_t> find(const std::string& key);
   const EngineSpec& spec_;
   std::vector<EngineOptionInfo> valid_;
   std::vector<bool> used_values_;

@@ -54,8 +54,9 @@ struct StopCriteria {
   // `stagnated` at ‖F‖∞ 1e-5 and 5e-7; from 5000 up it converges, 63 046 iterations). ≥ 0, finite;
   // 0 keeps residual_window alone.
   double residual_window_per_unknown = 0.1;
-  // Progress, counted in evaluations, for the engines that solve a square or least-squares
-  // system with a Jacobian (newton, dogleg, levenberg-marquardt, broyden, pseudo-transient):
+  // Progress, counted in evaluations, for the engines that solve a square system with a
+  // Jacobian (newton, dogleg, levenberg-marquardt, broyden, pseudo-transient; a least-squares
+  // minimum has ‖F‖ > 0, and levenberg-marquardt with m > n ends by its function_tolerance):
   // stagnated when progress_window evaluations of F at iterates and trial points (difference
   // evaluations for a Jacobian are not counted) have not brought ‖F‖₂ below 0.999 × its value
   // at the last such fall (0 = off). ‖F‖₂ is the merit function these engines descend (½‖F‖₂²), and

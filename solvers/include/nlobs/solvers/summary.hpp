@@ -7,6 +7,7 @@
 #include <string_view>
 #include <vector>
 
+#include "nlobs/solvers/engine_name.hpp"
 #include "nlobs/solvers/status.hpp"
 #include "nlobs/solvers/stop_criteria.hpp"
 
@@ -22,7 +23,7 @@ struct TraceEntry {
 
 struct Summary {
   Status status = Status::kInvalidInput;
-  std::string_view engine;       // the engine's name(); valid while the engine lives
+  EngineName engine;             // the engine's name(), held here (engine_name.hpp)
   int iterations = 0;            // completed iterations of the engine's sequence
   int function_evaluations = 0;  // evaluations of G (or F), including finite differences
   int jacobian_evaluations = 0;  // Jacobians computed (user-supplied, AD or finite differences)

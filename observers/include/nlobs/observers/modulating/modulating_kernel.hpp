@@ -59,7 +59,7 @@ class ModulatingKernels {
     return C_;
   }
   // The engine's summary of the last noise-optimal kernel (none at the minimal degree); its
-  // `engine` view is empty, as the engine lives only during the design: engine() is its label.
+  // `engine` is the engine's name, engine() the label of the spec it was made from.
   const std::optional<Summary>& optimisation() const { return summary_; }
   const std::string& engine() const { return engine_; }
 
