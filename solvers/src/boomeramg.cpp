@@ -127,6 +127,17 @@ struct BoomerAmgPreconditioner::Impl {
     rhs = solution = nullptr;
     n = 0;
   }
+  // The ParCSR objects behind the IJ ones, as BoomerAMG takes them.
+  HYPRE_ParCSRMatrix par_matrix() const {
+    void* object = nullptr;
+    HYPRE_IJMatrixGetObject(matrix, &object);
+    return static_cast<HYPRE_ParCSRMatrix>(object);
+  }
+  static HYPRE_ParVector par_vector(HYPRE_IJVector v) {
+    void* object = nullptr;
+    HYPRE_IJVectorGetObject(v, &object);
+    return static_cast<HYPRE_ParVector>(object);
+  }
   static double* data(HYPRE_IJVector v) {
     void* object = nullptr;
     HYPRE_IJVectorGetObject(v, &object);
@@ -213,21 +224,14 @@ LinearStatus BoomerAmgPreconditioner::setup(const SparseJacobian& jac) {
     }
   }
   h.n = n;
-  void* matrix = nullptr;
-  void* rhs = nullptr;
-  void* solution = nullptr;
-  HYPRE_IJMatrixGetObject(h.matrix, &matrix);
-  HYPRE_IJVectorGetObject(h.rhs, &rhs);
-  HYPRE_IJVectorGetObject(h.solution, &solution);
   if (HYPRE_BoomerAMGCreate(&h.solver) != 0) return fail("HYPRE_BoomerAMGCreate");
   // A preconditioner: a fixed number of cycles, no convergence test (tolerance 0), silent.
   HYPRE_BoomerAMGSetPrintLevel(h.solver, 0);
   HYPRE_BoomerAMGSetMaxIter(h.solver, options_.cycles);
   HYPRE_BoomerAMGSetTol(h.solver, 0.0);
   HYPRE_BoomerAMGSetStrongThreshold(h.solver, options_.strong_threshold);
-  if (HYPRE_BoomerAMGSetup(h.solver, static_cast<HYPRE_ParCSRMatrix>(matrix),
-                           static_cast<HYPRE_ParVector>(rhs),
-                           static_cast<HYPRE_ParVector>(solution)) != 0) {
+  if (HYPRE_BoomerAMGSetup(h.solver, h.par_matrix(), h.par_vector(h.rhs),
+                           h.par_vector(h.solution)) != 0) {
     return fail("HYPRE_BoomerAMGSetup", LinearStatus::kSingular);
   }
   message_.clear();
@@ -256,16 +260,9 @@ void BoomerAmgPreconditioner::apply(const Vector<Dynamic>& r, Vector<Dynamic>& z
     b[i] = r[i];
     x[i] = 0.0;
   }
-  void* matrix = nullptr;
-  void* rhs = nullptr;
-  void* solution = nullptr;
-  HYPRE_IJMatrixGetObject(h.matrix, &matrix);
-  HYPRE_IJVectorGetObject(h.rhs, &rhs);
-  HYPRE_IJVectorGetObject(h.solution, &solution);
   HYPRE_ClearAllErrors();
-  const HYPRE_Int code = HYPRE_BoomerAMGSolve(h.solver, static_cast<HYPRE_ParCSRMatrix>(matrix),
-                                              static_cast<HYPRE_ParVector>(rhs),
-                                              static_cast<HYPRE_ParVector>(solution));
+  const HYPRE_Int code =
+      HYPRE_BoomerAMGSolve(h.solver, h.par_matrix(), h.par_vector(h.rhs), h.par_vector(h.solution));
   // Running out of cycles is what a preconditioner asks for (hypre flags it only with a
   // tolerance > 0); any other error leaves x meaningless.
   if ((code & ~HYPRE_ERROR_CONV) != 0) return refuse(describe_hypre_error("HYPRE_BoomerAMGSolve"));
