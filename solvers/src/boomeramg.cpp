@@ -111,7 +111,6 @@ struct BoomerAmgPreconditioner::Impl {
   HYPRE_IJVector rhs = nullptr, solution = nullptr;
   HYPRE_Solver solver = nullptr;
   HYPRE_Int n = 0;
-  std::vector<HYPRE_Int> row_lengths, rows;
 
   ~Impl() { release(); }
   void release() {
@@ -139,9 +138,7 @@ struct BoomerAmgPreconditioner::Impl {
     return static_cast<HYPRE_ParVector>(object);
   }
   static double* data(HYPRE_IJVector v) {
-    void* object = nullptr;
-    HYPRE_IJVectorGetObject(v, &object);
-    return hypre_VectorData(hypre_ParVectorLocalVector(static_cast<hypre_ParVector*>(object)));
+    return hypre_VectorData(hypre_ParVectorLocalVector(par_vector(v)));
   }
 };
 
@@ -193,12 +190,11 @@ LinearStatus BoomerAmgPreconditioner::setup(const SparseJacobian& jac) {
   }
   Impl& h = *impl_;
   const auto n = static_cast<HYPRE_Int>(csr->rows());
-  h.row_lengths.resize(static_cast<std::size_t>(n));
-  h.rows.resize(static_cast<std::size_t>(n));
+  std::vector<HYPRE_Int> rows(static_cast<std::size_t>(n)), row_lengths(rows.size());
   const int* start = csr->outerIndexPtr();
   for (HYPRE_Int i = 0; i < n; ++i) {
-    h.rows[static_cast<std::size_t>(i)] = i;
-    h.row_lengths[static_cast<std::size_t>(i)] = start[i + 1] - start[i];
+    rows[static_cast<std::size_t>(i)] = i;
+    row_lengths[static_cast<std::size_t>(i)] = start[i + 1] - start[i];
   }
   // hypre's refusal of J in its setup (a zero diagonal entry, for one) is a singular J; a
   // failure to build its objects is hypre's own.
@@ -209,10 +205,10 @@ LinearStatus BoomerAmgPreconditioner::setup(const SparseJacobian& jac) {
   };
   if (HYPRE_IJMatrixCreate(MPI_COMM_SELF, 0, n - 1, 0, n - 1, &h.matrix) != 0 ||
       HYPRE_IJMatrixSetObjectType(h.matrix, HYPRE_PARCSR) != 0 ||
-      HYPRE_IJMatrixSetRowSizes(h.matrix, h.row_lengths.data()) != 0 ||
+      HYPRE_IJMatrixSetRowSizes(h.matrix, row_lengths.data()) != 0 ||
       HYPRE_IJMatrixInitialize(h.matrix) != 0 ||
-      HYPRE_IJMatrixSetValues(h.matrix, n, h.row_lengths.data(), h.rows.data(),
-                              csr->innerIndexPtr(), csr->valuePtr()) != 0 ||
+      HYPRE_IJMatrixSetValues(h.matrix, n, row_lengths.data(), rows.data(), csr->innerIndexPtr(),
+                              csr->valuePtr()) != 0 ||
       HYPRE_IJMatrixAssemble(h.matrix) != 0) {
     return fail("assembling J");
   }

@@ -119,16 +119,15 @@ std::optional<std::string> EngineSpecReader::choice(const std::string& key_name,
 std::optional<double> EngineSpecReader::number(const std::string& key_name) {
   const auto i = find(key_name);
   if (!i) return std::nullopt;
-  const std::string& key = spec_.values[*i].first;  // as the spec spells it, for messages
-  const std::string* t = &spec_.values[*i].second;
+  const auto& [key, t] = spec_.values[*i];  // the key as the spec spells it, for messages
   char* end = nullptr;
   errno = 0;
-  const double v = std::strtod(t->c_str(), &end);
+  const double v = std::strtod(t.c_str(), &end);
   // ERANGE on underflow (a subnormal such as 4e-320, or 1e-400 rounded to 0) is a finite number
   // all the same: the option's own check judges its value. Only overflow is refused here.
-  if (end == t->c_str() || *end != '\0' || !std::isfinite(v) ||
+  if (end == t.c_str() || *end != '\0' || !std::isfinite(v) ||
       (errno == ERANGE && std::fabs(v) > std::numeric_limits<double>::min())) {
-    fail(quoted_excerpt(key + "=" + *t) + " is not a finite number");
+    fail(quoted_excerpt(key + "=" + t) + " is not a finite number");
   }
   return v;
 }
@@ -136,15 +135,13 @@ std::optional<double> EngineSpecReader::number(const std::string& key_name) {
 std::optional<int> EngineSpecReader::integer(const std::string& key_name, int min, int max) {
   const auto i = find(key_name);
   if (!i) return std::nullopt;
-  const std::string& key = spec_.values[*i].first;
-  const std::string* t = &spec_.values[*i].second;
+  const auto& [key, t] = spec_.values[*i];
   char* end = nullptr;
   errno = 0;
-  const long v = std::strtol(t->c_str(), &end, 10);
-  if (end == t->c_str() || *end != '\0')
-    fail(quoted_excerpt(key + "=" + *t) + " is not an integer");
+  const long v = std::strtol(t.c_str(), &end, 10);
+  if (end == t.c_str() || *end != '\0') fail(quoted_excerpt(key + "=" + t) + " is not an integer");
   if (errno == ERANGE || v < min || v > max) {
-    fail(quoted_excerpt(key + "=" + *t) + " is out of range: must be in " + std::to_string(min) +
+    fail(quoted_excerpt(key + "=" + t) + " is out of range: must be in " + std::to_string(min) +
          ".." + std::to_string(max));
   }
   return static_cast<int>(v);
@@ -153,11 +150,10 @@ std::optional<int> EngineSpecReader::integer(const std::string& key_name, int mi
 std::optional<bool> EngineSpecReader::boolean(const std::string& key_name) {
   const auto i = find(key_name);
   if (!i) return std::nullopt;
-  const std::string& key = spec_.values[*i].first;
-  const std::string* t = &spec_.values[*i].second;
-  if (*t == "1" || *t == "true" || *t == "on") return true;
-  if (*t == "0" || *t == "false" || *t == "off") return false;
-  fail(quoted_excerpt(key + "=" + *t) + " is not 0/1, true/false or on/off");
+  const auto& [key, t] = spec_.values[*i];
+  if (t == "1" || t == "true" || t == "on") return true;
+  if (t == "0" || t == "false" || t == "off") return false;
+  fail(quoted_excerpt(key + "=" + t) + " is not 0/1, true/false or on/off");
 }
 
 std::optional<std::string> EngineSpecReader::word(const std::vector<std::string>& allowed) {

@@ -35,26 +35,23 @@ const std::vector<EngineOptionInfo>& preconditioner_options() {
 
 std::unique_ptr<LinearPreconditioner> read_preconditioner(EngineSpecReader& reader) {
   const std::string kind = reader.text("preconditioner").value_or("none");
+  // Options of one preconditioner given with another are refused, naming both.
+  const auto belong_to = [&kind](const char* owner, bool given, const char* keys) {
+    if (given && kind != owner) {
+      throw InvalidInput(std::string("linear solver options ") + keys +
+                         " belong to preconditioner=" + owner + ", not " + kind);
+    }
+  };
   IlutOptions ilut;
   const auto drop = reader.number("drop_tolerance");
   const auto fill = reader.integer("fill_factor", 1, kIntMax);
-  if ((drop || fill) && kind != "ilut") {
-    throw InvalidInput(
-        "linear solver options drop_tolerance and fill_factor belong to "
-        "preconditioner=ilut, not " +
-        kind);
-  }
+  belong_to("ilut", drop || fill, "drop_tolerance and fill_factor");
   if (drop) ilut.drop_tolerance = *drop;
   if (fill) ilut.fill_factor = *fill;
   BoomerAmgOptions amg;
   const auto threshold = reader.number("strong_threshold");
   const auto cycles = reader.integer("cycles", 1, 100);
-  if ((threshold || cycles) && kind != "boomeramg") {
-    throw InvalidInput(
-        "linear solver options strong_threshold and cycles belong to "
-        "preconditioner=boomeramg, not " +
-        kind);
-  }
+  belong_to("boomeramg", threshold || cycles, "strong_threshold and cycles");
   if (threshold) amg.strong_threshold = *threshold;
   if (cycles) amg.cycles = *cycles;
   if (kind == "none") return nullptr;
