@@ -202,6 +202,22 @@ TEST_F(BoomerAmg, TakesOneUnknownAndAJacobianNotYetCompressed) {
   EXPECT_NEAR(x[2], 0.5, 1e-12);
 }
 
+TEST_F(BoomerAmg, SolvesTheSameOperatorScaledBy1e300And1eMinus300) {
+  // Hostile magnitudes: the hierarchy's strength test and relaxation are scale-free, so J·1e±300
+  // must neither overflow to NaN nor underflow to a zero pivot.
+  const SparseJacobian unit = convection_diffusion(20, 5.0);
+  const Vector<Dynamic> b = smooth_rhs(unit.rows());
+  for (const double scale : {1e300, 1e-300}) {
+    const SparseJacobian jac = scale * unit;
+    auto solver = make_linear_solver("gmres:preconditioner=boomeramg");
+    ASSERT_EQ(solver->setup(jac), LinearStatus::kSolved) << scale << ": " << solver->message();
+    Vector<Dynamic> x;
+    ASSERT_EQ(solver->solve(b, x, 1e-10), LinearStatus::kSolved)
+        << scale << ": " << solver->message();
+    EXPECT_LE(relative_residual(jac, x, b), 1e-10) << scale;
+  }
+}
+
 TEST_F(BoomerAmg, ASingularJacobianEndsTheKrylovSolveWithANamedFailure) {
   SparseJacobian jac = convection_diffusion(12, 0.0);
   for (SparseJacobian::InnerIterator it(jac, 30); it; ++it) it.valueRef() = 0.0;  // a zero row
