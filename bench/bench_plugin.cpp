@@ -72,7 +72,7 @@ void BM_PluginEngine(benchmark::State& state) {
 BENCHMARK(BM_PluginEngine)->Name("plugin/engine/bad_broyden_bratu8/plugin");
 
 void BM_BuiltInEngine(benchmark::State& state) {
-  example::BadBroydenEngine<> engine(tight(), {});
+  example::BadBroydenEngine<> engine({}, tight());
   solve_bratu(state, engine);
 }
 BENCHMARK(BM_BuiltInEngine)->Name("plugin/engine/bad_broyden_bratu8/built_in");

@@ -148,7 +148,7 @@ TEST(Plugins, TheExampleBroydenEngineSolvesAndFailsClearly) {
   SolverOptions options;
   options.stop.residual_tolerance = 1e-12;
   {  // Rosenbrock's F = (10 (x2 − x1²), 1 − x1) from the far start of MGH
-    Engine engine(options, {});
+    Engine engine({}, options);
     const auto problem = FixedPointProblem<2>::with_autodiff(
         [](const auto& x, auto& g) {
           g[0] = x[0] + 10.0 * (x[1] - x[0] * x[0]);
@@ -163,7 +163,7 @@ TEST(Plugins, TheExampleBroydenEngineSolvesAndFailsClearly) {
     EXPECT_TRUE(s.usable());
   }
   {  // F = (x1² − 1, x2) from x1 = 0: J_F = diag(0, 1) is singular there
-    Engine engine(options, {});
+    Engine engine({}, options);
     const auto problem = FixedPointProblem<2>::with_autodiff(
         [](const auto& x, auto& g) {
           g[0] = x[0] + x[0] * x[0] - 1.0;
@@ -179,7 +179,7 @@ TEST(Plugins, TheExampleBroydenEngineSolvesAndFailsClearly) {
   const auto squares = FixedPointProblem<2>::with_autodiff(
       [](const auto& x, auto& g) { g = x + x.cwiseProduct(x); }, 2);
   {  // F = log x from x < 0: NaN at once
-    Engine engine(options, {});
+    Engine engine({}, options);
     const auto log_problem = FixedPointProblem<2>::from_map(
         [](const Vector<2>& x, Vector<2>& g) { g = x + x.array().log().matrix(); }, 2);
     Vector<2> x(-1.0, 2.0);
@@ -190,7 +190,7 @@ TEST(Plugins, TheExampleBroydenEngineSolvesAndFailsClearly) {
   {  // a budget of 5 evaluations on a problem that needs more
     SolverOptions tight;
     tight.stop.max_evaluations = 5;
-    Engine engine(tight, {});
+    Engine engine({}, tight);
     Vector<2> x(10.0, -10.0);
     const Summary s = engine.solve(squares, x);
     EXPECT_EQ(s.status, Status::kMaxEvaluations);
@@ -199,7 +199,7 @@ TEST(Plugins, TheExampleBroydenEngineSolvesAndFailsClearly) {
   {  // the same without a Jacobian: forward differences count against the budget too
     SolverOptions tight;
     tight.stop.max_evaluations = 4;
-    Engine engine(tight, {});
+    Engine engine({}, tight);
     const auto no_jacobian = FixedPointProblem<2>::from_map(
         [](const Vector<2>& x, Vector<2>& g) { g = x + x.cwiseProduct(x); }, 2);
     Vector<2> x(10.0, -10.0);
@@ -209,7 +209,7 @@ TEST(Plugins, TheExampleBroydenEngineSolvesAndFailsClearly) {
     EXPECT_TRUE(x.allFinite());
     SolverOptions one;
     one.stop.max_evaluations = 1;  // F(x0) only: no room for a Jacobian by differences
-    Engine starved(one, {});
+    Engine starved({}, one);
     Vector<2> y(10.0, -10.0);
     const Summary t = starved.solve(no_jacobian, y);
     EXPECT_EQ(t.status, Status::kMaxEvaluations);
@@ -218,7 +218,7 @@ TEST(Plugins, TheExampleBroydenEngineSolvesAndFailsClearly) {
   {  // forward differences, enough budget: the root of F = x² − 4 from 1 (no AD)
     SolverOptions o;
     o.stop.residual_tolerance = 1e-10;
-    Engine engine(o, {});
+    Engine engine({}, o);
     const auto shifted = FixedPointProblem<2>::from_map(
         [](const Vector<2>& x, Vector<2>& g) {
           g = x + x.cwiseProduct(x) - Vector<2>::Constant(4.0);
@@ -230,10 +230,10 @@ TEST(Plugins, TheExampleBroydenEngineSolvesAndFailsClearly) {
     EXPECT_NEAR(x[0], 2.0, 1e-8);
     EXPECT_NEAR(x[1], 2.0, 1e-8);
   }
-  Engine engine(options, {});
+  Engine engine({}, options);
   Vector<2> bad(std::nan(""), 1.0);
   EXPECT_THROW(engine.solve(squares, bad), InvalidInput);
-  EXPECT_THROW(Engine(options, {.max_backtracks = -1}), InvalidInput);
+  EXPECT_THROW(Engine({.max_backtracks = -1}, options), InvalidInput);
 }
 
 TEST(Plugins, RefusesAPathThatIsNoLoadableLibraryNamingIt) {
@@ -340,10 +340,10 @@ TEST(Plugins, AProgramsOwnRegistrationHasTheSameChecks) {
   EXPECT_FALSE(problem_set_registry().contains("my-set"));
   const auto twice = [](PluginRegistrar& r) {
     r.add_engine({.name = "mine", .make = [](EngineSpecReader&, SolverOptions o) {
-                    return std::unique_ptr<Engine<>>(new example::BadBroydenEngine<>(o, {}));
+                    return std::unique_ptr<Engine<>>(new example::BadBroydenEngine<>({}, o));
                   }});
     r.add_engine({.name = "mine", .make = [](EngineSpecReader&, SolverOptions o) {
-                    return std::unique_ptr<Engine<>>(new example::BadBroydenEngine<>(o, {}));
+                    return std::unique_ptr<Engine<>>(new example::BadBroydenEngine<>({}, o));
                   }});
   };
   try {
@@ -363,7 +363,7 @@ TEST(Plugins, AProgramsOwnRegistrationHasTheSameChecks) {
   }
   const auto good = [](PluginRegistrar& r) {
     r.add_engine({.name = "mine", .make = [](EngineSpecReader&, SolverOptions o) {
-                    return std::unique_ptr<Engine<>>(new example::BadBroydenEngine<>(o, {}));
+                    return std::unique_ptr<Engine<>>(new example::BadBroydenEngine<>({}, o));
                   }});
   };
   const LoadedPlugin loaded = register_extensions(good, "my program");
@@ -585,7 +585,7 @@ TEST(Plugins, TheElfChecksGiveTheFuzzSeedsTheirVerdicts) {
 // An engine entry of the given name (the example's Broyden engine).
 EngineRegistry<Dynamic>::Entry engine_named(const std::string& name) {
   return {.name = name, .make = [](EngineSpecReader&, SolverOptions o) {
-            return std::unique_ptr<Engine<>>(new example::BadBroydenEngine<>(o, {}));
+            return std::unique_ptr<Engine<>>(new example::BadBroydenEngine<>({}, o));
           }};
 }
 

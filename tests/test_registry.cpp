@@ -37,8 +37,9 @@ TEST(EngineSpec, Parses) {
 
 TEST(EngineRegistry, EveryBuiltInRoundTrips) {
   auto& registry = EngineRegistry<1>::global();
-  const std::vector<std::string> expected = {"aitken", "anderson", "ceres",     "newton",
-                                             "nlopt",  "picard",   "steffensen"};
+  const std::vector<std::string> expected = {
+      "aitken", "anderson", "auto",   "broyden",          "ceres",      "dogleg",
+      "newton", "nlopt",    "picard", "pseudo-transient", "steffensen", "levenberg-marquardt"};
   std::vector<std::string> names = registry.names();
   for (const std::string& e : expected) {
     EXPECT_NE(std::find(names.begin(), names.end(), e), names.end()) << e;

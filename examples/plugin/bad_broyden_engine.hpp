@@ -16,14 +16,31 @@
 #include <string_view>
 
 #include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/engine_spec.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
+#include "nlobs/solvers/options_validation.hpp"
 #include "nlobs/solvers/stop_monitor.hpp"
 
 namespace example {
 
+// The engine's options own their checks and their spec, as nlobs' built-in engines' do
+// (bad_broyden_entry.cpp): the registry entry is then nlobs::engine_entry<N, BadBroydenEngine<N>>.
 struct BadBroydenOptions {
-  int max_backtracks = 10;            // halvings of the step before the Jacobian is renewed
-  double sufficient_decrease = 1e-4;  // c in ‖F(x + t s)‖² ≤ (1 − 2ct) ‖F(x)‖²
+  int max_backtracks = 10;            // halvings of the step before the Jacobian is renewed; 0..60
+  double sufficient_decrease = 1e-4;  // c in ‖F(x + t s)‖² ≤ (1 − 2ct) ‖F(x)‖², in (0, 0.5)
+
+  // Throws nlobs::InvalidInput naming the field, its value and the requirement.
+  void validate() const {
+    nlobs::detail::require_option(max_backtracks >= 0 && max_backtracks <= 60, "BadBroydenOptions",
+                                  "max_backtracks", max_backtracks, "must lie in 0..60");
+    nlobs::detail::require_option(sufficient_decrease > 0.0 && sufficient_decrease < 0.5,
+                                  "BadBroydenOptions", "sufficient_decrease", sufficient_decrease,
+                                  "must lie in (0, 0.5)");
+  }
+  // The engine as the registry lists it, and the spec's items read over these values (in
+  // bad_broyden_entry.cpp: only the registry needs them).
+  static nlobs::EngineDescription describe();
+  void read(nlobs::EngineSpecReader& spec);
 };
 
 template <int N = nlobs::Dynamic>
@@ -32,13 +49,11 @@ class BadBroydenEngine final : public nlobs::Engine<N> {
   using Vec = nlobs::Vector<N>;
   using Mat = nlobs::Matrix<N, N>;
 
-  BadBroydenEngine(nlobs::SolverOptions options, BadBroydenOptions broyden)
+  using Options = BadBroydenOptions;
+
+  explicit BadBroydenEngine(BadBroydenOptions broyden = {}, nlobs::SolverOptions options = {})
       : nlobs::Engine<N>(std::move(options)), broyden_(broyden) {
-    if (broyden_.max_backtracks < 0 || !(broyden_.sufficient_decrease > 0.0) ||
-        !(broyden_.sufficient_decrease < 0.5)) {
-      throw nlobs::InvalidInput(
-          "bad-broyden: max_backtracks must be >= 0 and sufficient_decrease in (0, 0.5)");
-    }
+    broyden_.validate();
   }
   std::string_view name() const override { return "bad-broyden"; }
 

@@ -38,6 +38,7 @@
 #include <utility>
 
 #include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/engine_spec.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
 #include "nlobs/solvers/sparse_path.hpp"
 #include "nlobs/solvers/square_system.hpp"
@@ -59,36 +60,19 @@ struct BroydenOptions {
   // Updates the limited-memory form keeps (2 n doubles each) before a fresh Jacobian; 1..1000.
   int memory = 20;
 
-  // Throws InvalidInput naming the field and its value.
+  // Throws InvalidInput naming the field, its value and the requirement (options_validation.hpp).
   void validate() const;
+  // The engine as the registry lists it, the spec keys (field names; older ones as aliases) and
+  // their reading over these values (src/options/broyden_options.cpp).
+  static EngineDescription describe();
+  void read(EngineSpecReader& spec);
 };
-
-inline void BroydenOptions::validate() const {
-  auto fail = [](const char* option, double value, const char* requirement) {
-    std::ostringstream os;
-    os << "BroydenOptions::" << option << " = " << value << " is invalid: " << requirement;
-    throw InvalidInput(os.str());
-  };
-  if (max_backtracks < 0 || max_backtracks > 60) {
-    fail("max_backtracks", max_backtracks, "must lie in 0..60");
-  }
-  if (!(sufficient_decrease > 0.0 && sufficient_decrease < 0.5)) {
-    fail("sufficient_decrease", sufficient_decrease, "must lie in (0, 0.5)");
-  }
-  if (max_updates < 0) fail("max_updates", max_updates, "must be >= 0");
-  if (memory < 1 || memory > 1000) fail("memory", memory, "must lie in 1..1000");
-  detail::check_linear_solver_option("BroydenOptions::linear_solver", linear_solver);
-  if (linear_solver != "auto" && linear_solver != "dense" &&
-      make_linear_solver(linear_solver)->iterative()) {
-    throw InvalidInput("BroydenOptions::linear_solver = \"" + linear_solver +
-                       "\" is invalid: H_0 = J^-1 must be applied exactly, by a direct solver "
-                       "(auto, band-lu, sparse-lu, klu, umfpack) or dense");
-  }
-}
 
 template <int N = Dynamic>
 class BroydenEngine : public Engine<N> {
  public:
+  using Options = BroydenOptions;
+
   explicit BroydenEngine(BroydenOptions broyden = {}, SolverOptions options = {})
       : Engine<N>(std::move(options)), broyden_(broyden) {
     broyden_.validate();

@@ -25,6 +25,7 @@
 
 #include "nlobs/solvers/box_bounds.hpp"
 #include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/engine_spec.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
 #include "nlobs/solvers/residual_source.hpp"
 
@@ -51,26 +52,28 @@ struct CeresOptions {
   bool jacobi_scaling = false;
   bool nonmonotonic_steps = true;
   FiniteDifference finite_difference = FiniteDifference::kCentral;  // problems without ∂F
+
+  // Throws InvalidInput naming the field, its value and the requirement (options_validation.hpp);
+  // the engine adds what depends on its size (TinySolver needs a compile-time one).
+  void validate() const;
+  // The engine as the registry lists it, the spec keys (field names; older ones as aliases; the
+  // method as a bare word) and their reading over these values (src/options/ceres_options.cpp).
+  static EngineDescription describe();
+  void read(EngineSpecReader& spec);
 };
 
 template <int N = Dynamic>
 class CeresEngine : public Engine<N> {
  public:
+  using Options = CeresOptions;
+
   explicit CeresEngine(CeresOptions ceres = {}, SolverOptions options = {})
       : Engine<N>(std::move(options)), ceres_(std::move(ceres)) {
     detail::require_lipschitz_for_error_bound(name(), this->options_.stop);
-    auto fail = [](const std::string& what) { throw InvalidInput("CeresOptions::" + what); };
-    if (!(ceres_.function_tolerance >= 0.0)) fail("function_tolerance must be >= 0");
-    if (!(ceres_.gradient_tolerance >= 0.0)) fail("gradient_tolerance must be >= 0");
-    const bool bounded = ceres_.lower_bounds.size() > 0 || ceres_.upper_bounds.size() > 0;
-    if (ceres_.backend == CeresOptions::Backend::kTinySolver) {
-      if (N == Dynamic) fail("backend = kTinySolver needs a compile-time size");
-      if (bounded) fail("backend = kTinySolver does not support bounds");
-      if (ceres_.method != CeresOptions::Method::kLevenbergMarquardt) {
-        fail("backend = kTinySolver is Levenberg-Marquardt only");
-      }
+    ceres_.validate();
+    if (N == Dynamic && ceres_.backend == CeresOptions::Backend::kTinySolver) {
+      throw InvalidInput("CeresOptions::backend = kTinySolver needs a compile-time size");
     }
-    detail::validate_box("CeresOptions", ceres_.lower_bounds, ceres_.upper_bounds);
     this->bounds_ = {ceres_.lower_bounds, ceres_.upper_bounds};
   }
 

@@ -29,11 +29,11 @@
 #include <cmath>
 #include <limits>
 #include <optional>
-#include <sstream>
 #include <string_view>
 #include <utility>
 
 #include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/engine_spec.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
 #include "nlobs/solvers/square_system.hpp"
@@ -56,19 +56,23 @@ struct DoglegOptions {
   bool broyden_updates = true;
   // Used only when the problem carries no Jacobian.
   FiniteDifference finite_difference = FiniteDifference::kCentral;
+
+  // Throws InvalidInput naming the field, its value and the requirement (options_validation.hpp).
+  void validate() const;
+  // The engine as the registry lists it, the spec keys (field names; older ones as aliases) and
+  // their reading over these values (src/options/dogleg_options.cpp).
+  static EngineDescription describe();
+  void read(EngineSpecReader& spec);
 };
 
 template <int N = Dynamic>
 class DoglegEngine : public Engine<N> {
  public:
+  using Options = DoglegOptions;
+
   explicit DoglegEngine(DoglegOptions dogleg = {}, SolverOptions options = {})
       : Engine<N>(std::move(options)), dogleg_(dogleg) {
-    if (!(dogleg_.initial_radius_factor > 0.0 && std::isfinite(dogleg_.initial_radius_factor))) {
-      std::ostringstream os;
-      os << "DoglegOptions::initial_radius_factor = " << dogleg_.initial_radius_factor
-         << " is invalid: must be finite and > 0";
-      throw InvalidInput(os.str());
-    }
+    dogleg_.validate();
     detail::require_lipschitz_for_error_bound(name(), this->options_.stop);
   }
 

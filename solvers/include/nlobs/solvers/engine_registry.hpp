@@ -38,9 +38,8 @@ namespace nlobs {
 template <int N>
 class EngineRegistry;
 
-// Adds the built-in engines (picard, aitken, steffensen, anderson, newton, ceres, nlopt) to
-// `registry`, skipping names it already has. Defined in builtin_engines.hpp; compiled in the
-// library for its sizes.
+// Adds every built-in engine (`nlobs list engines`) to `registry`, skipping names it already has.
+// Defined in builtin_engines.hpp; compiled in the library for its sizes.
 template <int N>
 void add_builtin_engines(EngineRegistry<N>& registry);
 
@@ -145,6 +144,34 @@ class EngineRegistry {
   std::map<std::string, Entry> entries_;
   std::map<std::string, std::string> sources_;
 };
+
+// The entry of an engine type E (an Engine<N>) built as the built-ins are: E(options, solver
+// options), its options type E::Options giving
+//   static EngineDescription describe();     // name, one line, spec keys, examples
+//   void read(EngineSpecReader& spec);       // the spec's items over the current values
+// (and validate(), which E's constructor calls); or, for an engine without options of its own,
+// E(solver options) and a static E::describe(). A user's engine of this shape registers with
+//   registry.add(engine_entry<Dynamic, MyEngine<>>(), "my program");
+template <int N, typename E>
+typename EngineRegistry<N>::Entry engine_entry() {
+  if constexpr (requires { typename E::Options; }) {
+    using Options = typename E::Options;
+    EngineDescription d = Options::describe();
+    return {std::move(d.name), std::move(d.description), std::move(d.options),
+            std::move(d.examples), [](EngineSpecReader& spec, SolverOptions solver) {
+              Options options;
+              options.read(spec);
+              return std::unique_ptr<Engine<N>>(
+                  std::make_unique<E>(std::move(options), std::move(solver)));
+            }};
+  } else {
+    EngineDescription d = E::describe();
+    return {std::move(d.name), std::move(d.description), std::move(d.options),
+            std::move(d.examples), [](EngineSpecReader&, SolverOptions solver) {
+              return std::unique_ptr<Engine<N>>(std::make_unique<E>(std::move(solver)));
+            }};
+  }
+}
 
 template <int N>
 void EngineRegistry<N>::add(Entry entry, std::string source) {

@@ -31,6 +31,16 @@ struct EngineOptionInfo {
   std::vector<std::string> aliases{};  // older names of the key ("m"), accepted alike
 };
 
+// An engine as the registry and `nlobs list engines` show it: the name a spec starts with, one
+// line on the method, its own options (the common ones are added by the registry) and example
+// specs. Each built-in engine's options type gives its own (NewtonOptions::describe()).
+struct EngineDescription {
+  std::string name{};
+  std::string description{};
+  std::vector<EngineOptionInfo> options{};
+  std::vector<std::string> examples{};
+};
+
 class EngineSpecReader {
  public:
   // `valid` lists the options of the engine: for error messages, and the aliases by which each

@@ -5,6 +5,7 @@
 #include "nlobs/solvers/accelerators/anderson.hpp"
 #include "nlobs/solvers/accelerators/picard_step.hpp"
 #include "nlobs/solvers/accelerators/steffensen.hpp"
+#include "nlobs/solvers/engine_spec.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
 
 namespace nlobs {
@@ -15,6 +16,8 @@ class PicardEngine : public AcceleratedEngine<N, PicardStep<N>> {
  public:
   explicit PicardEngine(SolverOptions options = {})
       : AcceleratedEngine<N, PicardStep<N>>(std::move(options)) {}
+  // The engine as the registry lists it (no options of its own).
+  static EngineDescription describe() { return {"picard", "x <- G(x)", {}, {"picard"}}; }
 };
 
 // Component-wise Δ² transform of the Picard sequence.
@@ -23,6 +26,10 @@ class AitkenEngine : public AcceleratedEngine<N, AitkenTransform<N>> {
  public:
   explicit AitkenEngine(SolverOptions options = {})
       : AcceleratedEngine<N, AitkenTransform<N>>(std::move(options)) {}
+  // The engine as the registry lists it (no options of its own).
+  static EngineDescription describe() {
+    return {"aitken", "component-wise Aitken delta^2 of the Picard sequence", {}, {"aitken"}};
+  }
 };
 
 // Aitken restarted every three iterates.
@@ -31,12 +38,18 @@ class SteffensenEngine : public AcceleratedEngine<N, SteffensenRestart<N>> {
  public:
   explicit SteffensenEngine(SolverOptions options = {})
       : AcceleratedEngine<N, SteffensenRestart<N>>(std::move(options)) {}
+  // The engine as the registry lists it (no options of its own).
+  static EngineDescription describe() {
+    return {"steffensen", "Aitken restarted every three iterates", {}, {"steffensen"}};
+  }
 };
 
 // Anderson mixing of depth m with damping β.
 template <int N = Dynamic>
 class AndersonEngine : public AcceleratedEngine<N, AndersonMixing<N>> {
  public:
+  using Options = AndersonOptions;
+
   explicit AndersonEngine(AndersonOptions anderson = {}, SolverOptions options = {})
       : AcceleratedEngine<N, AndersonMixing<N>>(std::move(options), AndersonMixing<N>(anderson)) {}
 };

@@ -45,6 +45,7 @@
 #include <utility>
 
 #include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/engine_spec.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
 #include "nlobs/solvers/square_system.hpp"
@@ -77,11 +78,20 @@ struct LevenbergMarquardtOptions {
   // QR with column pivoting, as on every other problem). A problem without a sparse Jacobian
   // takes the dense path whatever this says.
   std::string linear_solver = "auto";
+
+  // Throws InvalidInput naming the field, its value and the requirement (options_validation.hpp).
+  void validate() const;
+  // The engine as the registry lists it, the spec keys (field names; older ones as aliases) and
+  // their reading over these values (src/options/levenberg_marquardt_options.cpp).
+  static EngineDescription describe();
+  void read(EngineSpecReader& spec);
 };
 
 template <int N = Dynamic>
 class LevenbergMarquardtEngine : public Engine<N> {
  public:
+  using Options = LevenbergMarquardtOptions;
+
   explicit LevenbergMarquardtEngine(LevenbergMarquardtOptions lm = {}, SolverOptions options = {});
 
   std::string_view name() const override { return "levenberg-marquardt"; }
@@ -138,29 +148,8 @@ class LevenbergMarquardtEngine : public Engine<N> {
 template <int N>
 LevenbergMarquardtEngine<N>::LevenbergMarquardtEngine(LevenbergMarquardtOptions lm,
                                                       SolverOptions options)
-    : Engine<N>(std::move(options)), lm_(lm) {
-  auto require = [](bool ok, const char* option, double value, const char* requirement) {
-    if (ok) return;
-    std::ostringstream os;
-    os << "LevenbergMarquardtOptions::" << option << " = " << value
-       << " is invalid: " << requirement;
-    throw InvalidInput(os.str());
-  };
-  require(lm_.initial_radius_factor > 0.0 && std::isfinite(lm_.initial_radius_factor),
-          "initial_radius_factor", lm_.initial_radius_factor, "must be finite and > 0");
-  require(lm_.function_tolerance >= 0.0 && std::isfinite(lm_.function_tolerance),
-          "function_tolerance", lm_.function_tolerance, "must be finite and >= 0");
-  require(lm_.gradient_tolerance >= 0.0 && std::isfinite(lm_.gradient_tolerance),
-          "gradient_tolerance", lm_.gradient_tolerance, "must be finite and >= 0");
-  require(lm_.acceleration_ratio > 0.0 && std::isfinite(lm_.acceleration_ratio),
-          "acceleration_ratio", lm_.acceleration_ratio, "must be finite and > 0");
-  require(lm_.second_derivative_step > 0.0 && std::isfinite(lm_.second_derivative_step),
-          "second_derivative_step", lm_.second_derivative_step, "must be finite and > 0");
-  if (lm_.linear_solver != "auto" && lm_.linear_solver != "dense" &&
-      lm_.linear_solver != "cholmod") {
-    throw InvalidInput("LevenbergMarquardtOptions::linear_solver = \"" + lm_.linear_solver +
-                       "\" is invalid: must be auto, dense or cholmod");
-  }
+    : Engine<N>(std::move(options)), lm_(std::move(lm)) {
+  lm_.validate();
   detail::require_lipschitz_for_error_bound(name(), this->options_.stop);
 }
 

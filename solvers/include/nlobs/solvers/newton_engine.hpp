@@ -31,6 +31,7 @@
 
 #include "nlobs/solvers/dogleg_engine.hpp"
 #include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/engine_spec.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
 #include "nlobs/solvers/linear/forcing_term.hpp"
@@ -64,40 +65,25 @@ struct NewtonOptions {
   // renewed early when its step did not halve ‖F‖₂, and a line search that fails on a stale one
   // is retried with a fresh one. Not with trust_region.
   int jacobian_reuse = 1;
+
+  // Throws InvalidInput naming the field, its value and the requirement (options_validation.hpp).
+  void validate() const;
+  // The engine as the registry lists it, its spec keys the field names above (line_search=1;
+  // the older names are aliases: linesearch=1), and their reading over these values
+  // (src/options/newton_options.cpp).
+  static EngineDescription describe();
+  void read(EngineSpecReader& spec);
 };
 
 template <int N = Dynamic>
 class NewtonEngine : public Engine<N> {
  public:
+  using Options = NewtonOptions;
+
   explicit NewtonEngine(NewtonOptions newton = {}, SolverOptions options = {})
-      : Engine<N>(std::move(options)), newton_(newton) {
-    auto fail = [](const char* option, double value, const char* requirement) {
-      std::ostringstream os;
-      os << "NewtonOptions::" << option << " = " << value << " is invalid: " << requirement;
-      throw InvalidInput(os.str());
-    };
-    if (!(newton_.sufficient_decrease > 0.0 && newton_.sufficient_decrease < 0.5)) {
-      fail("sufficient_decrease", newton_.sufficient_decrease, "must lie in (0, 0.5)");
-    }
-    if (!(newton_.backtrack_factor > 0.0 && newton_.backtrack_factor < 1.0)) {
-      fail("backtrack_factor", newton_.backtrack_factor, "must lie in (0, 1)");
-    }
-    if (newton_.max_backtracks < 1) fail("max_backtracks", newton_.max_backtracks, "must be >= 1");
-    if (newton_.jacobian_reuse < 1 || newton_.jacobian_reuse > 1000) {
-      fail("jacobian_reuse", newton_.jacobian_reuse, "must lie in 1 .. 1000");
-    }
-    if (newton_.jacobian_reuse > 1 && newton_.trust_region) {
-      throw InvalidInput(
-          "NewtonOptions: jacobian_reuse > 1 (modified Newton) is for the line search or the "
-          "plain step; the trust region evaluates J at every iterate");
-    }
-    detail::check_linear_solver_option("NewtonOptions::linear_solver", newton_.linear_solver);
+      : Engine<N>(std::move(options)), newton_(std::move(newton)) {
+    newton_.validate();
     forcing_ = ForcingTerm(newton_.forcing);
-    if (newton_.line_search && newton_.trust_region) {
-      throw InvalidInput(
-          "NewtonOptions: line_search and trust_region are two globalisations; "
-          "choose one");
-    }
     detail::require_lipschitz_for_error_bound(name(), this->options_.stop);
     if (newton_.trust_region) {
       trust_region_.emplace(

@@ -17,6 +17,7 @@
 
 #include "nlobs/solvers/box_bounds.hpp"
 #include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/engine_spec.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
 #include "nlobs/solvers/objective_problem.hpp"
 #include "nlobs/solvers/residual_source.hpp"
@@ -33,6 +34,15 @@ struct NloptOptions {
   double relative_step_tolerance = 0.0;  // NLopt xtol_rel; 0 = off
   std::optional<double> initial_step{};  // first step of derivative-free algorithms
   FiniteDifference finite_difference = FiniteDifference::kCentral;
+
+  // Throws InvalidInput naming the field, its value and the requirement (options_validation.hpp):
+  // an algorithm NLopt does not have, a malformed box, a global (G*) algorithm without a finite
+  // box, a step or tolerance out of range.
+  void validate() const;
+  // The engine as the registry lists it, the spec keys (field names; older ones as aliases; the
+  // algorithm as a bare word) and their reading over these values (src/options/nlopt_options.cpp).
+  static EngineDescription describe();
+  void read(EngineSpecReader& spec);
 };
 
 // NLopt's algorithm names ("LN_BOBYQA", ...), all of them.
@@ -41,26 +51,17 @@ std::vector<std::string> nlopt_algorithm_names();
 template <int N = Dynamic>
 class NloptEngine : public Engine<N> {
  public:
+  using Options = NloptOptions;
+
   explicit NloptEngine(NloptOptions nlopt = {}, SolverOptions options = {})
       : Engine<N>(std::move(options)), nlopt_(std::move(nlopt)) {
     detail::require_lipschitz_for_error_bound(name(), this->options_.stop);
-    // Look the name up ourselves: nlopt_algorithm_from_string returns -1, not an enumerator,
-    // for an unknown name.
+    nlopt_.validate();
+    // NLopt's enumerators are the positions in nlopt_algorithm_names() (validate() found it).
     const std::vector<std::string> names = nlopt_algorithm_names();
-    const auto found = std::find(names.begin(), names.end(), nlopt_.algorithm);
-    if (found == names.end()) {
-      std::string valid;
-      for (const std::string& a : names) valid += (valid.empty() ? "" : ", ") + a;
-      throw InvalidInput("NloptOptions::algorithm = '" + nlopt_.algorithm +
-                         "' is not an NLopt algorithm; valid: " + valid);
-    }
-    algorithm_ = static_cast<nlopt_algorithm>(found - names.begin());
-    detail::validate_box("NloptOptions", nlopt_.lower_bounds, nlopt_.upper_bounds);
-    require_finite_box_if_global(nlopt_.lower_bounds, nlopt_.upper_bounds);
+    algorithm_ = static_cast<nlopt_algorithm>(
+        std::find(names.begin(), names.end(), nlopt_.algorithm) - names.begin());
     this->bounds_ = {nlopt_.lower_bounds, nlopt_.upper_bounds};
-    if (nlopt_.initial_step && !(*nlopt_.initial_step > 0.0)) {
-      throw InvalidInput("NloptOptions::initial_step must be > 0");
-    }
   }
 
   std::string_view name() const override { return "nlopt"; }
@@ -86,17 +87,12 @@ class NloptEngine : public Engine<N> {
   Summary minimize(const ObjectiveProblem<N>& problem, Vector<N>& x);
 
  private:
-  void require_finite_box_if_global(const Eigen::VectorXd& lb, const Eigen::VectorXd& ub) const {
-    if (!is_global()) return;
-    if (lb.size() == 0 || ub.size() == 0 || !lb.allFinite() || !ub.allFinite()) {
-      throw InvalidInput("NloptOptions: global algorithm " + nlopt_.algorithm +
-                         " needs finite lower_bounds and upper_bounds");
-    }
-  }
   void on_set_bounds() override {
-    require_finite_box_if_global(this->bounds_.lower, this->bounds_.upper);
-    nlopt_.lower_bounds = this->bounds_.lower;
-    nlopt_.upper_bounds = this->bounds_.upper;
+    NloptOptions bounded = nlopt_;  // a refused box leaves the options as they were
+    bounded.lower_bounds = this->bounds_.lower;
+    bounded.upper_bounds = this->bounds_.upper;
+    bounded.validate();
+    nlopt_ = std::move(bounded);
     prepared_n_ = -1;  // prepared again, with the new box, by the next solve
   }
   using ObjectiveThunk = double (*)(void*, const Vector<N>&, Vector<N>*);

@@ -2,7 +2,7 @@
 // A polyalgorithm: engines tried in order within one evaluation budget, each from the start or
 // from the best point so far (smallest ‖F‖∞), until one returns a usable answer
 // (Summary::usable()). The registry's `auto` is this with the stages of kAutoOrder
-// (builtin_engines.hpp), the order measured on the MGH set (docs/solvers.md). Summary::stage names
+// (below), the order measured on the MGH set (docs/solvers.md). Summary::stage names
 // the engine whose answer is returned; Summary::message lists how every stage before it ended (a
 // stage that throws, whatever it throws, is one of them; when every stage that ran threw, the
 // first stage's exception is rethrown unchanged, so that a user's F that throws wherever it is
@@ -21,8 +21,14 @@
 
 #include "nlobs/common/printable.hpp"
 #include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/engine_spec.hpp"
 
 namespace nlobs {
+
+// The stages of the registry's `auto`, in order, each from x0: Newton first (the cheapest when it
+// works), the dogleg where its full steps fail, Levenberg-Marquardt where the dogleg stagnates,
+// the pseudo-transient flow last. Measured on the MGH set against other orders (docs/solvers.md).
+inline constexpr const char* kAutoOrder = "newton/dogleg/levenberg-marquardt/pseudo-transient";
 
 struct PolyalgorithmOptions {
   // true: a stage starts where the stages before it left the smallest ‖F‖∞; false (default):
@@ -45,6 +51,14 @@ struct PolyalgorithmOptions {
   // sparse path — unless no stage has a sparse path (auto:order=dogleg):
   // then all run, densely. 0: run them at any n. ≥ 0.
   Index dense_stage_limit = 1000;
+
+  // Throws InvalidInput naming the field, its value and the requirement (options_validation.hpp).
+  void validate() const;
+  // The registry's `auto` (its stages by `order`, kAutoOrder by default), the spec keys and
+  // their reading over these values; `order` is read by the registry entry, which builds the
+  // stages (src/options/polyalgorithm_options.cpp).
+  static EngineDescription describe();
+  void read(EngineSpecReader& spec);
 };
 
 template <int N = Dynamic>
@@ -55,15 +69,8 @@ class PolyalgorithmEngine : public Engine<N> {
   PolyalgorithmEngine(std::vector<std::unique_ptr<Engine<N>>> stages,
                       PolyalgorithmOptions poly = {}, SolverOptions options = {})
       : Engine<N>(std::move(options)), stages_(std::move(stages)), poly_(poly) {
+    poly_.validate();
     if (stages_.empty()) throw InvalidInput("auto: needs at least one engine to try");
-    if (poly_.shared_minimum < 0) {
-      throw InvalidInput("auto: shared_minimum = " + std::to_string(poly_.shared_minimum) +
-                         " is invalid: must be >= 0 (0 = off)");
-    }
-    if (poly_.dense_stage_limit < 0) {
-      throw InvalidInput("auto: dense_stage_limit = " + std::to_string(poly_.dense_stage_limit) +
-                         " is invalid: must be >= 0 (0 = no limit)");
-    }
     for (const auto& s : stages_) {
       if (!s) throw InvalidInput("auto: a stage engine is null");
       caps_.push_back(s->options().stop.max_evaluations);  // a stage's own cap stays a cap

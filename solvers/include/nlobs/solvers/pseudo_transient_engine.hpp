@@ -48,6 +48,7 @@
 #include <vector>
 
 #include "nlobs/solvers/engine.hpp"
+#include "nlobs/solvers/engine_spec.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
 #include "nlobs/solvers/sparse_path.hpp"
@@ -76,36 +77,23 @@ struct PseudoTransientOptions {
   std::string linear_solver = "auto";
   // ‖b − A p‖₂ ≤ linear_tolerance ‖b‖₂ for a Krylov solver, in (0, 1) (direct ones solve exactly).
   double linear_tolerance = 1e-6;
+
+  // Throws InvalidInput naming the field, its value and the requirement (options_validation.hpp).
+  void validate() const;
+  // The engine as the registry lists it, the spec keys (field names; older ones as aliases) and
+  // their reading over these values (src/options/pseudo_transient_options.cpp).
+  static EngineDescription describe();
+  void read(EngineSpecReader& spec);
 };
 
 template <int N = Dynamic>
 class PseudoTransientEngine : public Engine<N> {
  public:
+  using Options = PseudoTransientOptions;
+
   explicit PseudoTransientEngine(PseudoTransientOptions ptc = {}, SolverOptions options = {})
-      : Engine<N>(std::move(options)), ptc_(ptc) {
-    auto require = [](bool ok, const char* option, double value, const char* requirement) {
-      if (ok) return;
-      std::ostringstream os;
-      os << "PseudoTransientOptions::" << option << " = " << value
-         << " is invalid: " << requirement;
-      throw InvalidInput(os.str());
-    };
-    constexpr double floor = PseudoTransientOptions::kMinPseudoStep;
-    require(ptc_.initial_pseudo_step >= floor && std::isfinite(ptc_.initial_pseudo_step),
-            "initial_pseudo_step (delta0)", ptc_.initial_pseudo_step,
-            "must be finite and >= 2.22e-16 (machine epsilon: a smaller pseudo time step is lost "
-            "to rounding, x + delta F == x wherever |F| <= |x|)");
-    require(ptc_.max_pseudo_step >= ptc_.initial_pseudo_step && std::isfinite(ptc_.max_pseudo_step),
-            "max_pseudo_step (delta_max)", ptc_.max_pseudo_step,
-            "must be finite and >= initial_pseudo_step");
-    require(ptc_.min_pseudo_step >= floor && ptc_.min_pseudo_step <= ptc_.initial_pseudo_step,
-            "min_pseudo_step", ptc_.min_pseudo_step,
-            "must lie in [2.22e-16 (machine epsilon), initial_pseudo_step]");
-    require(ptc_.pseudo_step_growth >= 1.0 && ptc_.pseudo_step_growth <= 10.0,
-            "pseudo_step_growth (growth)", ptc_.pseudo_step_growth, "must lie in [1, 10]");
-    require(ptc_.linear_tolerance > 0.0 && ptc_.linear_tolerance < 1.0, "linear_tolerance",
-            ptc_.linear_tolerance, "must lie in (0, 1)");
-    detail::check_linear_solver_option("PseudoTransientOptions::linear_solver", ptc_.linear_solver);
+      : Engine<N>(std::move(options)), ptc_(std::move(ptc)) {
+    ptc_.validate();
     detail::require_lipschitz_for_error_bound(name(), this->options_.stop);
   }
 

@@ -13,11 +13,12 @@
 // ill-conditioned (condition_limit). Fixed N: all storage is on the stack (depth ≤
 // kMaxFixedDepth), so a solve never allocates; dynamic N allocates in start() when n changes.
 #include <cmath>
-#include <sstream>
 #include <string>
 #include <string_view>
 #include <type_traits>
 
+#include "nlobs/solvers/engine_spec.hpp"
+#include "nlobs/solvers/options_validation.hpp"
 #include "nlobs/solvers/status.hpp"
 #include "nlobs/solvers/types.hpp"
 
@@ -29,34 +30,30 @@ struct AndersonOptions {
   // Oldest history columns are dropped while max|R_ii| / min|R_ii| (a cheap lower bound on
   // cond(R)) exceeds this: nearly dependent differences otherwise give huge γ and wild steps.
   double condition_limit = 1e8;  // > 1
+  // The largest depth at run-time sizes (the history is n × m; more is never useful and would
+  // only exhaust memory: m = 1e9 did); fixed sizes allow AndersonMixing::kMaxFixedDepth.
+  static constexpr int kMaxDepth = 1000;
+
+  // Throws InvalidInput naming the field, its value and the requirement (options_validation.hpp).
+  void validate() const;
+  // The `anderson` engine as the registry lists it, the spec keys (field names; older ones as
+  // aliases) and their reading over these values (src/options/anderson_options.cpp).
+  static EngineDescription describe();
+  void read(EngineSpecReader& spec);
 };
 
 template <int N = Dynamic>
 class AndersonMixing {
  public:
   static constexpr int kMaxFixedDepth = 16;
-  // Dynamic sizes: the history is n × m; a depth beyond this is never useful and would only
-  // exhaust memory (m = 1e9 did).
-  static constexpr int kMaxDynamicDepth = 1000;
+  static constexpr int kMaxDynamicDepth = AndersonOptions::kMaxDepth;
   static constexpr int kMaxDepth = N != Dynamic ? kMaxFixedDepth : kMaxDynamicDepth;
 
   explicit AndersonMixing(AndersonOptions options = {}) : options_(options) {
-    if (options_.depth < 0 || options_.depth > kMaxDepth) {
-      std::ostringstream os;
-      os << "AndersonOptions::depth = " << options_.depth << " is invalid: must be in 0.."
-         << kMaxDepth << (N != Dynamic ? " for fixed sizes" : "");
-      throw InvalidInput(os.str());
-    }
-    if (!(options_.condition_limit > 1.0)) {
-      std::ostringstream os;
-      os << "AndersonOptions::condition_limit = " << options_.condition_limit
-         << " is invalid: must be > 1";
-      throw InvalidInput(os.str());
-    }
-    if (!(options_.damping > 0.0 && options_.damping <= 1.0)) {
-      std::ostringstream os;
-      os << "AndersonOptions::damping = " << options_.damping << " is invalid: must lie in (0, 1]";
-      throw InvalidInput(os.str());
+    options_.validate();
+    if constexpr (N != Dynamic) {
+      detail::require_option(options_.depth <= kMaxFixedDepth, "AndersonOptions", "depth",
+                             options_.depth, "must be in 0..16 for fixed sizes");
     }
   }
 
