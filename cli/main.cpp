@@ -122,6 +122,9 @@ void add_suite_options(CLI::App* app, nlobs::cli::SuiteArguments& a) {
   app->add_flag("--json", a.json, "Print a JSON array instead of the tables");
   app->add_option("--csv", a.csv, "Also write the rows as CSV to FILE ('-': stdout, no table)");
   app->add_flag("--show-x", a.show_x, "Print each row's answer x below it in the table");
+  app->add_flag("--monitor", a.monitor,
+                "Print each iteration of our engines' solves on stderr (solver, problem/start, "
+                "iteration, |step|, |F|); monitored solves are not repeated for their time");
   app->add_option("--time-limit", a.time_limit_s,
                   "Seconds each solve may take; past them its evaluations are refused and the "
                   "row is time_limit (default: none)")

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 #include <ostream>
 #include <stdexcept>
@@ -11,6 +12,7 @@
 #include "nlobs/reference/petsc_solver.hpp"
 #include "nlobs/reference/problem_suite.hpp"
 #include "nlobs/registry/problem_sets.hpp"
+#include "nlobs/solvers/engine.hpp"
 #include "output_file.hpp"
 #include "suite_report.hpp"
 
@@ -62,6 +64,15 @@ void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArg
   options.time_limit_s = args.time_limit_s;
   options.starts =
       args.starts.empty() ? std::vector<std::string>() : reference::split_spec_list(args.starts);
+  if (args.monitor) {
+    options.monitor = [&err](const std::string& solver, const std::string& problem_start,
+                             const IterationRecord& r) {
+      char line[96];
+      std::snprintf(line, sizeof line, "  %6d  |step| %.3e  |F| %.3e\n", r.iteration, r.step_norm,
+                    r.residual_norm);
+      err << nlobs::printable(solver, 60) << "  " << nlobs::printable(problem_start, 80) << line;
+    };
+  }
   // --solvers, or none: each set's own default list (ProblemSetEntry::default_solvers), else the
   // suite's.
   std::vector<std::string> solvers;
@@ -152,7 +163,9 @@ void run_problem_suite(const std::vector<std::string>& selectors, const SuiteArg
       if (starts_of_selection[i].empty()) continue;
       o.starts = starts_of_selection[i];
     }
-    if (args.progress == SuiteArguments::Progress::kTerminal) {
+    if (args.monitor) {
+      // The iterations' lines stand alone: no progress line between them.
+    } else if (args.progress == SuiteArguments::Progress::kTerminal) {
       o.progress = [&, before](int done, int) {
         err << "\rnlobs " << command << ": " << before + done << "/" << total
             << " (problem, start) pairs" << std::flush;

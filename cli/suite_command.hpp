@@ -26,6 +26,10 @@ struct SuiteArguments {
   enum class Progress { kNone, kTerminal, kLines };
   Progress progress = Progress::kNone;
   double progress_interval_s = 10.0;
+  // --monitor: a line on `err` after each iteration of each of our engines' solves (solver,
+  // problem/start, iteration, |step|, |F|); a monitored solve runs once, not repeated for its
+  // time, and the progress line is left out.
+  bool monitor = false;
 };
 
 // Runs every selector ("SET", "SET:n=K", "SET/NAME", "SET/NAME:n=K") in turn and prints the table

@@ -128,6 +128,30 @@ TEST(Cli, ShowXAndTimeLimit) {
   }
 }
 
+// --monitor: one line per iteration of each of our engines (SolverOptions::iteration_callback),
+// on stderr, the last one at the solution; the references are not monitored.
+TEST(Cli, MonitorPrintsEachIteration) {
+  const CliRun r = nlobs::test::run_shell_command(
+      std::string(NLOBS_CLI_PATH) +
+      " solve mgh/rosenbrock --solvers newton:line_search=1,minpack:hybrj --starts x1 --monitor");
+  EXPECT_EQ(r.status, 0) << r.out;
+  std::istringstream lines(r.out);
+  std::string line, last;
+  int count = 0;
+  while (std::getline(lines, line)) {
+    if (line.rfind("newton:line_search=1  rosenbrock/x1  ", 0) != 0) continue;
+    EXPECT_NE(line.find("|step| "), std::string::npos) << line;
+    ++count;
+    last = line;
+  }
+  EXPECT_GE(count, 2) << r.out;
+  EXPECT_EQ(r.out.find("minpack:hybrj  rosenbrock"), std::string::npos) << r.out;
+  // Newton ends where |F| is at rounding level: the last line's |F| is tiny.
+  const std::size_t at = last.find("|F| ");
+  ASSERT_NE(at, std::string::npos) << last;
+  EXPECT_LT(std::stod(last.substr(at + 4)), 1e-8) << last;
+}
+
 // Out-of-range integers are errors naming the option and the range, before anything runs
 // (--seed -1 became 2^64 - 1, huge --steps ended in std::bad_alloc).
 TEST(Cli, OutOfRangeIntegersAreErrors) {

@@ -383,7 +383,7 @@ TEST(Status, EveryStatusHasAName) {
        {Status::kConverged, Status::kMaxIterations, Status::kMaxEvaluations, Status::kStagnated,
         Status::kRepeatedIterates, Status::kDiverged, Status::kNonFinite, Status::kSingularJacobian,
         Status::kInvalidInput, Status::kSolverFailure, Status::kBlockedByBound,
-        Status::kRoundingFloor, Status::kLocalMinimum}) {
+        Status::kRoundingFloor, Status::kLocalMinimum, Status::kStoppedByCallback}) {
     EXPECT_NE(to_string(st), "unknown");
   }
 }

@@ -31,11 +31,11 @@ struct BadBroydenOptions {
 
   // Throws nlobs::InvalidInput naming the field, its value and the requirement.
   void validate() const {
-    nlobs::detail::require_option(max_backtracks >= 0 && max_backtracks <= 60, "BadBroydenOptions",
-                                  "max_backtracks", max_backtracks, "must lie in 0..60");
-    nlobs::detail::require_option(sufficient_decrease > 0.0 && sufficient_decrease < 0.5,
-                                  "BadBroydenOptions", "sufficient_decrease", sufficient_decrease,
-                                  "must lie in (0, 0.5)");
+    nlobs::require_option(max_backtracks >= 0 && max_backtracks <= 60, "BadBroydenOptions",
+                          "max_backtracks", max_backtracks, "must lie in 0..60");
+    nlobs::require_option(sufficient_decrease > 0.0 && sufficient_decrease < 0.5,
+                          "BadBroydenOptions", "sufficient_decrease", sufficient_decrease,
+                          "must lie in (0, 0.5)");
   }
   // The engine as the registry lists it, and the spec's items read over these values (in
   // bad_broyden_entry.cpp: only the registry needs them).

@@ -623,6 +623,13 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
           } else {
             SolverOptions o = base;
             o.stop.max_evaluations = static_cast<int>(std::min<long>(budget, 1L << 30));
+            const std::string problem_start = p.name + "/" + start.label;
+            if (options.monitor) {
+              o.iteration_callback = [&options, &s, &problem_start](const IterationRecord& r) {
+                options.monitor(s, problem_start, r);
+                return IterationDecision::kContinue;
+              };
+            }
             auto engine = registry.create(s, o);
             // The problem's box reaches the engines that take bounds (its strict sides those
             // that take them; Ceres and NLopt the closed box inside it); the others run
@@ -646,7 +653,7 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
                   outcome = {std::string(to_string(sum.status)), meter.count,
                              sum.jacobian_evaluations, sum.message};
                 },
-                kTimingNs, 1, kMaxTimedCalls);
+                kTimingNs, 1, options.monitor ? 1 : kMaxTimedCalls);
           }
           if (meter.timed_out) row.ns = attempt_ns();
         } catch (const TimeLimitStop&) {

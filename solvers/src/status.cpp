@@ -34,6 +34,8 @@ std::string_view to_string(Status status) {
       return "rounding_floor";
     case Status::kLocalMinimum:
       return "local_minimum";
+    case Status::kStoppedByCallback:
+      return "stopped_by_callback";
   }
   return "unknown";
 }

@@ -17,7 +17,7 @@ std::string sci(double v) {
 bool cut_short(Status s) {
   return s == Status::kMaxIterations || s == Status::kMaxEvaluations || s == Status::kStagnated ||
          s == Status::kRepeatedIterates || s == Status::kRoundingFloor ||
-         s == Status::kLocalMinimum;
+         s == Status::kLocalMinimum || s == Status::kStoppedByCallback;
 }
 
 }  // namespace
@@ -58,6 +58,7 @@ std::string Summary::unusable_reason() const {
     case Status::kRepeatedIterates:
     case Status::kRoundingFloor:
     case Status::kLocalMinimum:
+    case Status::kStoppedByCallback:
       if (!judged)
         return status_name + " at a point whose residual does not show a solution" + detail;
       if (residual_norm > small) {

@@ -4,12 +4,12 @@
 namespace nlobs {
 
 void AndersonOptions::validate() const {
-  detail::require_option(depth >= 0 && depth <= kMaxDepth, "AndersonOptions", "depth", depth,
-                         "must be in 0..1000");
-  detail::require_option(condition_limit > 1.0, "AndersonOptions", "condition_limit",
-                         condition_limit, "must be > 1");
-  detail::require_option(damping > 0.0 && damping <= 1.0, "AndersonOptions", "damping", damping,
-                         "must lie in (0, 1]");
+  require_option(depth >= 0 && depth <= kMaxDepth, "AndersonOptions", "depth", depth,
+                 "must be in 0..1000");
+  require_option(condition_limit > 1.0, "AndersonOptions", "condition_limit", condition_limit,
+                 "must be > 1");
+  require_option(damping > 0.0 && damping <= 1.0, "AndersonOptions", "damping", damping,
+                 "must lie in (0, 1]");
 }
 
 EngineDescription AndersonOptions::describe() {

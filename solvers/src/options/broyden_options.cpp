@@ -8,7 +8,6 @@
 namespace nlobs {
 
 void BroydenOptions::validate() const {
-  using detail::require_option;
   constexpr const char* kOwner = "BroydenOptions";
   require_option(max_backtracks >= 0 && max_backtracks <= 60, kOwner, "max_backtracks",
                  max_backtracks, "must lie in 0..60");

@@ -7,10 +7,10 @@
 namespace nlobs {
 
 void CeresOptions::validate() const {
-  detail::require_option(function_tolerance >= 0.0, "CeresOptions", "function_tolerance",
-                         function_tolerance, "must be >= 0");
-  detail::require_option(gradient_tolerance >= 0.0, "CeresOptions", "gradient_tolerance",
-                         gradient_tolerance, "must be >= 0");
+  require_option(function_tolerance >= 0.0, "CeresOptions", "function_tolerance",
+                 function_tolerance, "must be >= 0");
+  require_option(gradient_tolerance >= 0.0, "CeresOptions", "gradient_tolerance",
+                 gradient_tolerance, "must be >= 0");
   if (backend == Backend::kTinySolver) {
     if (lower_bounds.size() > 0 || upper_bounds.size() > 0) {
       throw InvalidInput("CeresOptions::backend = kTinySolver does not support bounds");

@@ -8,9 +8,9 @@
 namespace nlobs {
 
 void DoglegOptions::validate() const {
-  detail::require_option(initial_radius_factor > 0.0 && std::isfinite(initial_radius_factor),
-                         "DoglegOptions", "initial_radius_factor", initial_radius_factor,
-                         "must be finite and > 0");
+  require_option(initial_radius_factor > 0.0 && std::isfinite(initial_radius_factor),
+                 "DoglegOptions", "initial_radius_factor", initial_radius_factor,
+                 "must be finite and > 0");
 }
 
 EngineDescription DoglegOptions::describe() {

@@ -12,12 +12,12 @@ namespace nlobs {
 void LevenbergMarquardtOptions::validate() const {
   constexpr const char* kOwner = "LevenbergMarquardtOptions";
   const auto positive = [&](double value, const char* field) {
-    detail::require_option(value > 0.0 && std::isfinite(value), kOwner, field, value,
-                           "must be finite and > 0");
+    require_option(value > 0.0 && std::isfinite(value), kOwner, field, value,
+                   "must be finite and > 0");
   };
   const auto non_negative = [&](double value, const char* field) {
-    detail::require_option(value >= 0.0 && std::isfinite(value), kOwner, field, value,
-                           "must be finite and >= 0");
+    require_option(value >= 0.0 && std::isfinite(value), kOwner, field, value,
+                   "must be finite and >= 0");
   };
   positive(initial_radius_factor, "initial_radius_factor");
   non_negative(function_tolerance, "function_tolerance");

@@ -7,7 +7,6 @@
 namespace nlobs {
 
 void NewtonOptions::validate() const {
-  using detail::require_option;
   constexpr const char* kOwner = "NewtonOptions";
   require_option(sufficient_decrease > 0.0 && sufficient_decrease < 0.5, kOwner,
                  "sufficient_decrease", sufficient_decrease, "must lie in (0, 0.5)");
@@ -21,6 +20,7 @@ void NewtonOptions::validate() const {
         "NewtonOptions: jacobian_reuse > 1 (modified Newton) is for the line search or the "
         "plain step; the trust region evaluates J at every iterate");
   }
+  static_cast<void>(ForcingTerm(forcing));  // ForcingTermOptions' own checks
   detail::check_linear_solver_option("NewtonOptions::linear_solver", linear_solver);
   if (line_search && trust_region) {
     throw InvalidInput(

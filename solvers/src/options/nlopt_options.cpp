@@ -25,12 +25,12 @@ void NloptOptions::validate() const {
     throw InvalidInput("NloptOptions: global algorithm " + algorithm +
                        " needs finite lower_bounds and upper_bounds");
   }
-  detail::require_option(relative_step_tolerance >= 0.0 && std::isfinite(relative_step_tolerance),
-                         "NloptOptions", "relative_step_tolerance", relative_step_tolerance,
-                         "must be finite and >= 0 (0 = off)");
+  require_option(relative_step_tolerance >= 0.0 && std::isfinite(relative_step_tolerance),
+                 "NloptOptions", "relative_step_tolerance", relative_step_tolerance,
+                 "must be finite and >= 0 (0 = off)");
   if (initial_step) {
-    detail::require_option(*initial_step > 0.0 && std::isfinite(*initial_step), "NloptOptions",
-                           "initial_step", *initial_step, "must be finite and > 0");
+    require_option(*initial_step > 0.0 && std::isfinite(*initial_step), "NloptOptions",
+                   "initial_step", *initial_step, "must be finite and > 0");
   }
 }
 

@@ -8,10 +8,10 @@
 namespace nlobs {
 
 void PolyalgorithmOptions::validate() const {
-  detail::require_option(shared_minimum >= 0, "PolyalgorithmOptions", "shared_minimum",
-                         shared_minimum, "must be >= 0 (0 = off)");
-  detail::require_option(dense_stage_limit >= 0, "PolyalgorithmOptions", "dense_stage_limit",
-                         static_cast<double>(dense_stage_limit), "must be >= 0 (0 = no limit)");
+  require_option(shared_minimum >= 0, "PolyalgorithmOptions", "shared_minimum", shared_minimum,
+                 "must be >= 0 (0 = off)");
+  require_option(dense_stage_limit >= 0, "PolyalgorithmOptions", "dense_stage_limit",
+                 static_cast<double>(dense_stage_limit), "must be >= 0 (0 = no limit)");
 }
 
 EngineDescription PolyalgorithmOptions::describe() {

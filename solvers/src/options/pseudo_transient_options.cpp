@@ -10,7 +10,6 @@
 namespace nlobs {
 
 void PseudoTransientOptions::validate() const {
-  using detail::require_option;
   constexpr const char* kOwner = "PseudoTransientOptions";
   require_option(initial_pseudo_step >= kMinPseudoStep && std::isfinite(initial_pseudo_step),
                  kOwner, "initial_pseudo_step (delta0)", initial_pseudo_step,

@@ -12,6 +12,10 @@
 
 #include "nlobs/registry/problem_sets.hpp"
 
+namespace nlobs {
+struct IterationRecord;  // nlobs/solvers/engine.hpp
+}  // namespace nlobs
+
 namespace nlobs::reference {
 
 struct SuiteRow {
@@ -73,6 +77,13 @@ struct SuiteOptions {
   std::vector<std::string> starts{};
   // Called after each (problem, start) pair, e.g. for a progress line.
   std::function<void(int done, int total)> progress{};
+  // Called after each iteration of each of our engines' solves (SolverOptions::
+  // iteration_callback; the references have their own monitors) with the solver's spec and the
+  // row's "problem/start": `nlobs suite --monitor`. A monitored solve is run once, not repeated
+  // for its timing.
+  std::function<void(const std::string& solver, const std::string& problem_start,
+                     const IterationRecord& record)>
+      monitor{};
 };
 
 // Our engines (registry specs) in the default order, then the default references.

@@ -119,9 +119,7 @@ Summary AcceleratedEngine<N, Accelerator>::solve(const FixedPointProblem<N>& pro
       const double step = (gx_ - point_).template lpNorm<Eigen::Infinity>();
       point_.swap(gx_);
       status = monitor.update(step, step, point_.template lpNorm<Eigen::Infinity>());
-      if (opt.record_trace) {
-        summary.trace.push_back({monitor.iterations(), step, step, point_});
-      }
+      this->after_iteration(summary, status, monitor.iterations(), step, step, point_);
       continue;
     } else {
       const double residual = (gx_ - point_).template lpNorm<Eigen::Infinity>();
@@ -134,9 +132,7 @@ Summary AcceleratedEngine<N, Accelerator>::solve(const FixedPointProblem<N>& pro
         const double step = (estimate_ - last_).template lpNorm<Eigen::Infinity>();
         last_ = estimate_;
         status = monitor.update(step, residual, last_.template lpNorm<Eigen::Infinity>());
-        if (opt.record_trace) {
-          summary.trace.push_back({monitor.iterations(), step, residual, last_});
-        }
+        this->after_iteration(summary, status, monitor.iterations(), step, residual, last_);
       }
       point_.swap(next_);
     }

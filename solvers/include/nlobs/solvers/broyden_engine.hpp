@@ -318,9 +318,7 @@ Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& 
     f_ = ft_;
     fnorm = f_.template lpNorm<Eigen::Infinity>();
     status = monitor.update(step, fnorm, x_.template lpNorm<Eigen::Infinity>(), full_step);
-    if (this->options_.record_trace) {
-      summary.trace.push_back({monitor.iterations(), step, fnorm, x_});
-    }
+    this->after_iteration(summary, status, monitor.iterations(), step, fnorm, x_);
     if (status) break;
     const bool restart = broyden_.max_updates > 0 && updates >= broyden_.max_updates;
     if (!restart && std::isfinite(denominator) &&

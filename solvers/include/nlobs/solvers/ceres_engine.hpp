@@ -34,7 +34,7 @@ namespace nlobs {
 struct CeresOptions {
   enum class Method { kLevenbergMarquardt, kDogleg };
   enum class Backend {
-    kAuto,        // TinySolver for fixed N with LM and no bounds, else the prepared Solver
+    kAuto,        // TinySolver for fixed N with LM, no bounds, no iteration callback, else Solver
     kTinySolver,  // fixed N only; LM only; no bounds
     kSolver,      // ceres::Solve on a prepared ceres::Problem
   };
@@ -74,6 +74,11 @@ class CeresEngine : public Engine<N> {
     if (N == Dynamic && ceres_.backend == CeresOptions::Backend::kTinySolver) {
       throw InvalidInput("CeresOptions::backend = kTinySolver needs a compile-time size");
     }
+    if (this->options_.iteration_callback && ceres_.backend == CeresOptions::Backend::kTinySolver) {
+      throw InvalidInput(
+          "CeresOptions::backend = kTinySolver has no iteration callback "
+          "(SolverOptions::iteration_callback): use kSolver or kAuto");
+    }
     this->bounds_ = {ceres_.lower_bounds, ceres_.upper_bounds};
   }
 
@@ -87,6 +92,7 @@ class CeresEngine : public Engine<N> {
   // Which back end solve() uses (for a fixed-size problem).
   bool uses_tiny_solver() const {
     return N != Dynamic && ceres_.backend != CeresOptions::Backend::kSolver &&
+           !this->options_.iteration_callback &&
            ceres_.method == CeresOptions::Method::kLevenbergMarquardt &&
            ceres_.lower_bounds.size() == 0 && ceres_.upper_bounds.size() == 0;
   }
@@ -181,7 +187,9 @@ class CeresEngine : public Engine<N> {
     s.engine = name();
     // A non-finite value at a trial point is a rejected step (Ceres recovers); at a point where
     // the Jacobian is formed, nothing the solver concludes afterwards can be trusted.
-    if (w.jacobian_failed || (w.non_finite && status != Status::kConverged)) {
+    // A stop the user's callback asked for is theirs, whatever trial points Ceres rejected.
+    if (w.jacobian_failed ||
+        (w.non_finite && status != Status::kConverged && status != Status::kStoppedByCallback)) {
       status = Status::kNonFinite;
     }
     if (w.budget_exhausted) status = Status::kMaxEvaluations;  // cut short, whatever it claims
@@ -260,10 +268,31 @@ class CeresEngine : public Engine<N> {
   struct Monitor : ceres::IterationCallback {
     double cost_target = 0.0;
     const bool* budget = nullptr;
-    const std::exception_ptr* thrown = nullptr;
+    std::exception_ptr* thrown = nullptr;
     bool reached = false;
+    // SolverOptions::iteration_callback, given x_k (update_state_every_iteration keeps the
+    // parameter block current while there is one).
+    const nlobs::IterationCallback* user = nullptr;
+    const double* params = nullptr;
+    int n = 0;
+    bool stopped_by_user = false;
     ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
       if (*thrown) return ceres::SOLVER_ABORT;
+      if (user != nullptr && *user) {
+        try {
+          const IterationRecord record{s.iteration, s.step_norm, std::sqrt(2.0 * s.cost),
+                                       Eigen::Map<const Eigen::VectorXd>(params, n)};
+          if ((*user)(record) == IterationDecision::kStop) {
+            // Not SOLVER_ABORT: on USER_FAILURE Ceres puts x0 back into the parameter block; on
+            // USER_SUCCESS it keeps the iterate the callback saw.
+            stopped_by_user = true;
+            return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+          }
+        } catch (...) {  // rethrown once Solve has returned, as the user's F's would be
+          *thrown = std::current_exception();
+          return ceres::SOLVER_ABORT;
+        }
+      }
       if (s.cost <= cost_target) {
         reached = true;
         return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
@@ -323,8 +352,11 @@ class CeresEngine : public Engine<N> {
     monitor.cost_target = 0.5 * ftol * ftol;
     monitor.budget = &w.budget_exhausted;
     monitor.thrown = &w.thrown;
+    monitor.user = &this->options_.iteration_callback;
+    monitor.params = params_.data();
+    monitor.n = n;
     o.callbacks.push_back(&monitor);
-    o.update_state_every_iteration = false;
+    o.update_state_every_iteration = static_cast<bool>(this->options_.iteration_callback);
     ceres::Solve(o, problem_.get(), &ceres_summary_);
     cost_->callback = nullptr;
     if (w.thrown) std::rethrow_exception(w.thrown);
@@ -332,8 +364,10 @@ class CeresEngine : public Engine<N> {
     Status status = Status::kSolverFailure;
     switch (ceres_summary_.termination_type) {
       case ceres::CONVERGENCE:
-      case ceres::USER_SUCCESS:
         status = Status::kConverged;
+        break;
+      case ceres::USER_SUCCESS:
+        status = monitor.stopped_by_user ? Status::kStoppedByCallback : Status::kConverged;
         break;
       case ceres::NO_CONVERGENCE:
         status = Status::kMaxIterations;

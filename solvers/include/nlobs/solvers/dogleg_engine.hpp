@@ -324,10 +324,8 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
         monitor_status =
             monitor.update(last_step, f_.template lpNorm<Eigen::Infinity>(),
                            x_.template lpNorm<Eigen::Infinity>(), step_was_gauss_newton_);
-        if (this->options_.record_trace) {
-          summary.trace.push_back(
-              {monitor.iterations(), last_step, f_.template lpNorm<Eigen::Infinity>(), x_});
-        }
+        this->after_iteration(summary, monitor_status, monitor.iterations(), last_step,
+                              f_.template lpNorm<Eigen::Infinity>(), x_);
       }
       slow_iterations = actual >= 1e-3 ? 0 : slow_iterations + 1;
       if (fresh_jacobian) ++slow_jacobians;

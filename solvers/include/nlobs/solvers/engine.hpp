@@ -3,6 +3,7 @@
 // x holds the initial guess on entry and the engine's answer on return.
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -23,9 +24,35 @@ namespace detail {
 std::string engines_taking_bounds(bool strict);
 }  // namespace detail
 
+// One completed iteration as an iteration callback sees it: what the trace records (before a
+// scaled solve maps the trace back), x not copied (valid during the call only).
+struct IterationRecord {
+  int iteration;     // 1, 2, … (Ceres: 0 for its starting point; NLopt: the evaluation's count)
+  double step_norm;  // ‖x_k − x_{k−1}‖∞ (Ceres: its ‖Δx‖₂)
+  // ‖F‖∞ where the engine last evaluated it: at x_k for the Newton-type engines; the step for
+  // Picard (F(x_{k−1}) = x_k − x_{k−1}); at the point extrapolated from for aitken, steffensen,
+  // anderson; Ceres: ‖F‖₂ = √(2 cost); NaN where there is no F (NLopt minimising f).
+  double residual_norm;
+  Eigen::Ref<const Eigen::VectorXd> x;  // x_k, in the engine's variables (scaled under a scaling)
+};
+
+// What an iteration callback tells the engine (Ceres' CallbackReturnType).
+enum class IterationDecision { kContinue, kStop };
+
+// Called after every completed iteration of a solve, on the solving thread (Ceres'
+// IterationCallback, PETSc's SNESMonitorSet): to watch progress, log, or end the solve. kStop ends
+// it with Status::kStoppedByCallback at the current iterate, which is judged as any run cut short
+// (usable when ‖F‖ meets the tolerance). An exception it throws leaves solve() as the user's F's
+// would (auto: as a stage's; to cancel, return kStop). It is copied with the options (into each
+// stage of auto, Newton's trust region): keep state by reference.
+using IterationCallback = std::function<IterationDecision(const IterationRecord&)>;
+
 struct SolverOptions {
   StopCriteria stop{};
   bool record_trace = false;  // fill Summary::trace (allocates; off in hot loops)
+  // Empty: none. Every built-in engine calls it (auto through its stages); a user's engine does
+  // when it reports its iterations through Engine::after_iteration.
+  IterationCallback iteration_callback{};
 };
 
 template <int N = Dynamic>
@@ -136,6 +163,20 @@ class Engine {
 
  protected:
   explicit Engine(SolverOptions options) : options_(std::move(options)) { validate(options_.stop); }
+  // What an engine does after each completed iteration (step ‖Δx‖∞, residual ‖F‖∞, iterate x):
+  // the trace entry when record_trace is set, then the iteration callback; its kStop sets
+  // `status` to kStoppedByCallback unless something else already ends the run. No allocation
+  // without a trace.
+  void after_iteration(Summary& summary, std::optional<Status>& status, int iteration, double step,
+                       double residual, const Vector<N>& x) const {
+    if (options_.record_trace) summary.trace.push_back({iteration, step, residual, x});
+    if (options_.iteration_callback &&
+        options_.iteration_callback(IterationRecord{iteration, step, residual, x}) ==
+            IterationDecision::kStop &&
+        !status) {
+      status = Status::kStoppedByCallback;
+    }
+  }
   // Engines holding inner engines (DynamicSizeEngine, Newton's trust region) forward the limit.
   virtual void on_limit_evaluations(int /*max_evaluations*/) {}
   // Engines holding inner engines or a library's own copy of the box (Ceres, NLopt) take it here.

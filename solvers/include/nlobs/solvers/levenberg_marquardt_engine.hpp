@@ -406,10 +406,8 @@ Summary LevenbergMarquardtEngine<N>::run(Model& model, Residual&& residual, Jaco
                                     lambda == 0.0 && !accelerated && !projected)) {
           status = s;
         }
-        if (this->options_.record_trace) {
-          summary.trace.push_back(
-              {monitor.iterations(), last_step, f_.template lpNorm<Eigen::Infinity>(), x_});
-        }
+        this->after_iteration(summary, status, monitor.iterations(), last_step,
+                              f_.template lpNorm<Eigen::Infinity>(), x_);
         if (status) break;
         if (fnorm == 0.0) {
           status = Status::kConverged;

@@ -384,9 +384,7 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
     // A stale J's step is no Newton step: its size says nothing of the distance to a root.
     status = monitor.update(step, fnorm, x_.template lpNorm<Eigen::Infinity>(),
                             !projected && !descent_step && fresh);
-    if (this->options_.record_trace) {
-      summary.trace.push_back({monitor.iterations(), step, fnorm, x_});
-    }
+    this->after_iteration(summary, status, monitor.iterations(), step, fnorm, x_);
   }
 
   x = x_;

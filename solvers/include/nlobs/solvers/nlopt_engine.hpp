@@ -120,6 +120,9 @@ class NloptEngine : public Engine<N> {
           auto* c = static_cast<ResidualContext<M>*>(data);
           c->source->residual(at, c->f);
           ++c->engine->evaluations_;
+          c->engine->report_evaluation(at, c->f.allFinite()
+                                               ? c->f.template lpNorm<Eigen::Infinity>()
+                                               : std::numeric_limits<double>::infinity());
           if (grad != nullptr) {
             c->engine->evaluations_ +=
                 detail::residual_jacobian(*c->source, at, c->f, c->j,
@@ -150,6 +153,21 @@ class NloptEngine : public Engine<N> {
         nlopt_.finite_difference, work, fp, fm);
     grad = row.transpose();
     return evals;
+  }
+
+  // SolverOptions::iteration_callback after each evaluation of F (NLopt has no iterations of its
+  // own): the evaluation's count, the distance from the point evaluated before, ‖F‖∞ (NaN when
+  // minimising f). kStop stops NLopt (force_stop).
+  void report_evaluation(const Vector<N>& at, double residual) {
+    const IterationCallback& callback = this->options_.iteration_callback;
+    if (!callback || stopped_by_user_) return;  // once it said stop, never again
+    const double step =
+        evaluations_ > 1 ? (at - last_reported_).template lpNorm<Eigen::Infinity>() : 0.0;
+    if (callback(IterationRecord{evaluations_, step, residual, at}) == IterationDecision::kStop) {
+      stopped_by_user_ = true;
+      opt_->force_stop();
+    }
+    last_reported_ = at;
   }
 
   static double trampoline(unsigned n, const double* x, double* grad, void* data) {
@@ -189,11 +207,11 @@ class NloptEngine : public Engine<N> {
   std::optional<nlopt::opt> opt_;
   Index prepared_n_ = -1;
   std::vector<double> xv_;
-  Vector<N> x_ = zero_vector<N>(), grad_ = zero_vector<N>();
+  Vector<N> x_ = zero_vector<N>(), grad_ = zero_vector<N>(), last_reported_ = zero_vector<N>();
   ObjectiveThunk thunk_ = nullptr;
   void* context_ = nullptr;
   int evaluations_ = 0, jacobians_ = 0;
-  bool non_finite_ = false;
+  bool non_finite_ = false, stopped_by_user_ = false;
   std::exception_ptr thrown_;  // what a user's F or Jacobian threw during optimize()
 };
 
@@ -222,6 +240,7 @@ Summary NloptEngine<N>::minimize(const ObjectiveProblem<N>& problem, Vector<N>& 
         auto* c = static_cast<Context*>(data);
         const double f = c->problem->evaluate(at);
         ++c->engine->evaluations_;
+        c->engine->report_evaluation(at, std::numeric_limits<double>::quiet_NaN());
         if (grad != nullptr) {
           if (c->problem->has_gradient()) {
             c->problem->gradient(at, *grad);
@@ -243,12 +262,12 @@ Summary NloptEngine<N>::run(Vector<N>& x, double stop_value, ObjectiveThunk thun
   detail::require_inside_box<N>("nlopt", nlopt_.lower_bounds, nlopt_.upper_bounds, x);
   const Index n = x.size();
   if (!opt_ || prepared_n_ != n) prepare(n);
-  if constexpr (N == Dynamic) x_.resize(n), grad_.resize(n);
+  if constexpr (N == Dynamic) x_.resize(n), grad_.resize(n), last_reported_.resize(n);
   opt_->set_stopval(stop_value);
   thunk_ = thunk;
   context_ = context;
   evaluations_ = jacobians_ = 0;
-  non_finite_ = false;
+  non_finite_ = stopped_by_user_ = false;
   thrown_ = nullptr;
   for (Index i = 0; i < n; ++i) xv_[static_cast<size_t>(i)] = x[i];
 
@@ -290,7 +309,9 @@ Summary NloptEngine<N>::run(Vector<N>& x, double stop_value, ObjectiveThunk thun
       s.message = "NLopt: roundoff limited";
       break;
     case nlopt::FORCED_STOP:
-      s.status = non_finite_ ? Status::kNonFinite : Status::kSolverFailure;
+      s.status = stopped_by_user_ ? Status::kStoppedByCallback
+                 : non_finite_    ? Status::kNonFinite
+                                  : Status::kSolverFailure;
       break;
     default:
       s.status = Status::kSolverFailure;

@@ -114,7 +114,7 @@ class PolyalgorithmEngine : public Engine<N> {
     std::vector<double> end_residuals;
     std::vector<std::string> end_labels;
     std::vector<Status> end_statuses;
-    bool shared = false;
+    bool shared = false, stopped_by_callback = false;
     int evaluations = 0, jacobians = 0, iterations = 0;
     std::ostringstream history;
     auto note = [&history](const std::string& what) {
@@ -171,6 +171,16 @@ class PolyalgorithmEngine : public Engine<N> {
         best = trial;
         best_summary = last;
         have_best = true;
+      }
+      // The user's iteration callback (each stage has it, from the registry) ends the whole run.
+      if (last.status == Status::kStoppedByCallback) {
+        stopped_by_callback = true;
+        if (trial.allFinite()) {  // the answer is where the callback stopped, not the best point
+          best = trial;
+          best_summary = last;
+          have_best = true;
+        }
+        break;
       }
       if (last.function_evaluations > left) break;  // a stage that ignored its limit
       if (poly_.shared_minimum > 0 && stopped_without_progress(last.status) && trial.allFinite() &&
@@ -246,6 +256,7 @@ class PolyalgorithmEngine : public Engine<N> {
                 std::to_string(budget) + ") is spent";
     }
     if (!before.empty()) s.message = usable ? "after " + before : before;
+    if (stopped_by_callback) s.status = Status::kStoppedByCallback;
     s.engine = name();
     s.function_evaluations = evaluations;
     s.jacobian_evaluations = jacobians;

@@ -306,10 +306,8 @@ Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vec
     const bool newton_like = !projected && p_.stableNorm() <= 0.01 * delta * previous;
     status = monitor.update(step, f_.template lpNorm<Eigen::Infinity>(),
                             x_.template lpNorm<Eigen::Infinity>(), newton_like);
-    if (this->options_.record_trace) {
-      summary.trace.push_back(
-          {monitor.iterations(), step, f_.template lpNorm<Eigen::Infinity>(), x_});
-    }
+    this->after_iteration(summary, status, monitor.iterations(), step,
+                          f_.template lpNorm<Eigen::Infinity>(), x_);
     if (!status && fnorm == 0.0) status = Status::kConverged;
     // Switched evolution relaxation.
     if (fnorm > 0.0) {

@@ -36,6 +36,9 @@ enum class Status {
   // later stages are not run to find again. Usable when ‖F‖ meets acceptance_tolerance, like the
   // statuses that cut a run short.
   kLocalMinimum,
+  // SolverOptions::iteration_callback returned IterationDecision::kStop: the current iterate is
+  // returned. Usable when ‖F‖ meets acceptance_tolerance, like the statuses that cut a run short.
+  kStoppedByCallback,
 };
 
 // Lowercase snake_case name used in reports and JSON ("converged", "max_iterations", ...).

@@ -69,9 +69,9 @@ struct Summary {
   //   converged:  ‖F‖∞ ≤ small when a residual_tolerance was asked for (a step criterion met
   //               first under Combine::kAny does not excuse a residual above it);
   //   cut short (max_iterations, max_evaluations, stagnated, repeated_iterates,
-  //               rounding_floor, local_minimum): only with ‖F‖∞ ≤ small, on a root problem
-  //               (at a least-squares or minimisation point ‖F‖ does not show a solution: not
-  //               usable);
+  //               rounding_floor, local_minimum, stopped_by_callback): only with ‖F‖∞ ≤ small, on a
+  //               root problem (at a least-squares or minimisation point ‖F‖ does not show a
+  //               solution: not usable);
   //   diverged, non_finite, singular_jacobian, solver_failure, invalid_input,
   //   blocked_by_bound: never.
   bool usable() const;

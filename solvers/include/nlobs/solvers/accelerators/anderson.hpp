@@ -50,11 +50,11 @@ class AndersonMixing {
   static constexpr int kMaxDepth = N != Dynamic ? kMaxFixedDepth : kMaxDynamicDepth;
 
   explicit AndersonMixing(AndersonOptions options = {}) : options_(options) {
-    options_.validate();
-    if constexpr (N != Dynamic) {
-      detail::require_option(options_.depth <= kMaxFixedDepth, "AndersonOptions", "depth",
-                             options_.depth, "must be in 0..16 for fixed sizes");
+    if constexpr (N != Dynamic) {  // the fixed sizes' range first: it is the one that holds
+      require_option(options_.depth >= 0 && options_.depth <= kMaxFixedDepth, "AndersonOptions",
+                     "depth", options_.depth, "must be in 0..16 for fixed sizes");
     }
+    options_.validate();
   }
 
   // Its residuals rise and fall: judged by the best residual over a window (StopMonitor).
