@@ -65,7 +65,9 @@ struct PluginInfo {
 inline constexpr std::uint32_t kPluginMagic = 0x6e6c6f62;  // "nlob"
 // 2: EngineOptionInfo gained aliases and Summary::engine became an EngineName (the engine
 // option keys' change): a plugin built against layout 1 would misread both.
-inline constexpr std::uint32_t kPluginLayout = 2;
+// 3: SolverOptions gained iteration_callback (an engine factory takes SolverOptions by value)
+// and Status gained kStoppedByCallback.
+inline constexpr std::uint32_t kPluginLayout = 3;
 inline constexpr const char* kPluginSymbol = "nlobs_plugin_info";
 
 #define NLOBS_PLUGIN_STRINGIFY_(x) #x

@@ -166,15 +166,12 @@ class Engine {
   // What an engine does after each completed iteration (step ‖Δx‖∞, residual ‖F‖∞, iterate x):
   // the trace entry when record_trace is set, then the iteration callback; its kStop sets
   // `status` to kStoppedByCallback unless something else already ends the run. No allocation
-  // without a trace.
+  // without a trace; the work is out of line, so that a loop without either costs one test
+  // (Picard at n = 5: +2.7 % instructions inline, none out of line; callgrind).
   void after_iteration(Summary& summary, std::optional<Status>& status, int iteration, double step,
                        double residual, const Vector<N>& x) const {
-    if (options_.record_trace) summary.trace.push_back({iteration, step, residual, x});
-    if (options_.iteration_callback &&
-        options_.iteration_callback(IterationRecord{iteration, step, residual, x}) ==
-            IterationDecision::kStop &&
-        !status) {
-      status = Status::kStoppedByCallback;
+    if (options_.record_trace || options_.iteration_callback) [[unlikely]] {
+      report_iteration(summary, status, iteration, step, residual, x);
     }
   }
   // Engines holding inner engines (DynamicSizeEngine, Newton's trust region) forward the limit.
@@ -198,6 +195,17 @@ class Engine {
   Scaling scaling_;
 
  private:
+  [[gnu::noinline]] void report_iteration(Summary& summary, std::optional<Status>& status,
+                                          int iteration, double step, double residual,
+                                          const Vector<N>& x) const {
+    if (options_.record_trace) summary.trace.push_back({iteration, step, residual, x});
+    if (options_.iteration_callback &&
+        options_.iteration_callback(IterationRecord{iteration, step, residual, x}) ==
+            IterationDecision::kStop &&
+        !status) {
+      status = Status::kStoppedByCallback;
+    }
+  }
   bool scaled_solve_running_ = false;
   std::string label_;
 };
