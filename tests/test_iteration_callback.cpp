@@ -185,6 +185,57 @@ TEST(IterationCallback, AStoppedAutoReturnsTheStoppedStagesIterate) {
   EXPECT_EQ(x, seen);
 }
 
+// At n = 100 000 on the sparse path (a chain nlobs does not ship, F_i = x_i + x_i^3/10 - 1 +
+// (x_{i-1} + x_{i+1})/5, its pattern detected): the record is the iterate itself, not a copy,
+// and a stop leaves x where the callback saw it.
+TEST(IterationCallback, ALargeSparseSolveReportsAndStops) {
+  const Index n = 100000;
+  const auto chain = [n](const auto& x) {
+    using T = typename std::decay_t<decltype(x)>::Scalar;
+    Eigen::Matrix<T, Eigen::Dynamic, 1> f(n);
+    for (Index i = 0; i < n; ++i) {
+      const T left = i > 0 ? T(x[i - 1]) : T(0.0), right = i + 1 < n ? T(x[i + 1]) : T(0.0);
+      f[i] = x[i] + 0.1 * x[i] * x[i] * x[i] - 1.0 + 0.2 * (left + right);
+    }
+    return f;
+  };
+  const FixedPointProblem<> problem = to_fixed_point(RootProblem<>::with_autodiff(chain, n, n));
+  std::vector<double> residuals;
+  const double* first_data = nullptr;
+  Eigen::VectorXd seen;
+  SolverOptions o = tight();
+  o.iteration_callback = [&](const IterationRecord& r) {
+    residuals.push_back(r.residual_norm);
+    if (first_data == nullptr) first_data = r.x.data();
+    EXPECT_EQ(r.x.data(), first_data);  // the engine's own iterate each time: no copy
+    if (residuals.size() < 2) return IterationDecision::kContinue;
+    seen = r.x;
+    return IterationDecision::kStop;
+  };
+  auto engine = EngineRegistry<Dynamic>::global().create("newton:line_search=1", o);
+  Vector<> x = Vector<>::Zero(n);
+  const Summary s = engine->solve(problem, x);
+  EXPECT_EQ(s.status, Status::kStoppedByCallback) << s.full_report();
+  EXPECT_FALSE(s.linear_solver.empty()) << "the sparse path";
+  ASSERT_EQ(residuals.size(), 2U);
+  EXPECT_LT(residuals[1], residuals[0]);
+  ASSERT_EQ(seen.size(), n);
+  EXPECT_EQ(x, seen);
+
+  // Run on, the same solve converges; the callback saw every iteration.
+  SolverOptions quiet = tight();
+  int calls = 0;
+  quiet.iteration_callback = [&calls](const IterationRecord&) {
+    ++calls;
+    return IterationDecision::kContinue;
+  };
+  auto on = EngineRegistry<Dynamic>::global().create("newton:line_search=1", quiet);
+  x.setZero();
+  const Summary done = on->solve(problem, x);
+  EXPECT_EQ(done.status, Status::kConverged) << done.full_report();
+  EXPECT_EQ(calls, done.iterations);
+}
+
 // Ceres: TinySolver has no callback; auto takes the Solver back end when one is set.
 TEST(IterationCallback, CeresTakesTheSolverBackEndForACallback) {
   SolverOptions o = tight();
