@@ -2,7 +2,7 @@
 // Broyden's second ("bad") method for F(x) = G(x) − x = 0, an engine nlobs does not ship (nlobs'
 // `broyden` is the first, "good" one; Broyden, Math. Comp. 19, 1965; Dennis & Schnabel,
 // Numerical Methods for Unconstrained Optimization, §8.1): the inverse is updated directly,
-//   H_0 = J_F(x_0)⁻¹,  s_k = −t_k H_k F(x_k)  (t_k: backtracking on ‖F‖₂²),
+//   H_0 = J_F(x_0)⁻¹,  s_k = −t_k H_k F(x_k)  (t_k: nlobs::LineSearch on ‖F‖₂²),
 //   H_{k+1} = H_k + (s_k − H_k y_k) y_kᵀ / (y_kᵀ y_k),  y_k = F(x_{k+1}) − F(x_k):  O(n²) per step.
 // The Jacobian is computed again (the problem's, or forward differences) when the line search
 // finds no decrease along the quasi-Newton direction or the update's denominator vanishes.
@@ -18,6 +18,7 @@
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/engine_spec.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
+#include "nlobs/solvers/line_search.hpp"
 #include "nlobs/solvers/options_validation.hpp"
 #include "nlobs/solvers/stop_monitor.hpp"
 
@@ -54,6 +55,8 @@ class BadBroydenEngine final : public nlobs::Engine<N> {
   explicit BadBroydenEngine(BadBroydenOptions broyden = {}, nlobs::SolverOptions options = {})
       : nlobs::Engine<N>(std::move(options)), broyden_(broyden) {
     broyden_.validate();
+    line_search_.sufficient_decrease = broyden_.sufficient_decrease;
+    line_search_.max_backtracks = broyden_.max_backtracks;
   }
   std::string_view name() const override { return "bad-broyden"; }
 
@@ -124,19 +127,13 @@ class BadBroydenEngine final : public nlobs::Engine<N> {
         break;
       }
       s_ = -(h_ * f_);
-      double t = 1.0;
       const double phi0 = f_.squaredNorm();
-      bool accepted = false;
-      for (int k = 0; k <= broyden_.max_backtracks && evaluations < stop.max_evaluations; ++k) {
-        xt_ = x_ + t * s_;
-        if (residual_at(xt_, ft_) &&
-            ft_.squaredNorm() <= (1.0 - 2.0 * broyden_.sufficient_decrease * t) * phi0) {
-          accepted = true;
-          break;
-        }
-        t *= 0.5;
-      }
-      if (!accepted) {
+      // nlobs' backtracking line search along the engine's own path x + t s.
+      LinePath<decltype(residual_at)> path{*this, residual_at, evaluations, stop.max_evaluations,
+                                           phi0};
+      const nlobs::LineSearch::Result search = line_search_.search(path, 1.0, phi0);
+      const double t = search.t;
+      if (!search.accepted()) {
         // At a root to rounding, no step decreases |F|: a full Newton step (H fresh, not a
         // stale Broyden update) below the step tolerance is the step criterion met; x stays
         // where |F| is smallest.
@@ -185,7 +182,30 @@ class BadBroydenEngine final : public nlobs::Engine<N> {
   }
 
  private:
+  // The path x + t s for nlobs::LineSearch (line_search.hpp): m = ‖F‖₂², whose first-order
+  // change −2t‖F‖₂² is the linear model's (s a quasi-Newton step); the trial in xt_, F in ft_.
+  template <typename Residual>
+  struct LinePath {
+    BadBroydenEngine& engine;
+    Residual& residual_at;
+    const int& evaluations;
+    int max_evaluations;
+    double phi0, t = 0.0;
+    bool exhausted() const { return evaluations >= max_evaluations; }
+    bool move(double step) {
+      t = step;
+      engine.xt_ = engine.x_ + t * engine.s_;
+      return false;
+    }
+    double slope() const { return -2.0 * t * phi0; }
+    double merit() {
+      return residual_at(engine.xt_, engine.ft_) ? engine.ft_.squaredNorm()
+                                                 : std::numeric_limits<double>::quiet_NaN();
+    }
+  };
+
   BadBroydenOptions broyden_;
+  nlobs::LineSearch line_search_;  // Armijo, t halved
   Vec x_ = nlobs::zero_vector<N>(), g_ = nlobs::zero_vector<N>(), f_ = nlobs::zero_vector<N>(),
       s_ = nlobs::zero_vector<N>(), xt_ = nlobs::zero_vector<N>(), ft_ = nlobs::zero_vector<N>(),
       hy_ = nlobs::zero_vector<N>(), y_ = nlobs::zero_vector<N>();

@@ -40,6 +40,7 @@
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/engine_spec.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
+#include "nlobs/solvers/line_search.hpp"
 #include "nlobs/solvers/sparse_path.hpp"
 #include "nlobs/solvers/square_system.hpp"
 #include "nlobs/solvers/stop_monitor.hpp"
@@ -99,8 +100,9 @@ class BroydenEngine : public Engine<N> {
   bool update(double denominator);
   // J_Fᵀ f_ into gradient_ and ‖J_F gradient_‖², at the last fresh Jacobian.
   double gradient_at_jacobian();
-  // Backtracking from t0 along P(x_ + t d): the sufficient-decrease test above (armijo = false),
-  // or Armijo's on ∇φ = gradient_ (armijo = true). Trial in xt_, ft_; false when none.
+  // Backtracking (LineSearch, t halved) from t0 along P(x_ + t d): the sufficient-decrease test
+  // above (armijo = false), or Armijo's with the slope from ∇φ = gradient_ (armijo = true).
+  // Trial in xt_, ft_; false when none.
   bool search(const Vector<N>& d, double t0, bool armijo);
 
   BroydenOptions broyden_;
@@ -197,22 +199,15 @@ double BroydenEngine<N>::gradient_at_jacobian() {
 
 template <int N>
 bool BroydenEngine<N>::search(const Vector<N>& d, double t0, bool armijo) {
-  const detail::Box<N>& box = system_.box();
+  const LineSearch rule{.sufficient_decrease = broyden_.sufficient_decrease,
+                        .shrink = 0.5,
+                        .max_backtracks = broyden_.max_backtracks};
   const double phi0 = f_.squaredNorm();
-  const double c = broyden_.sufficient_decrease;
-  t_ = t0;
-  for (int k = 0; k <= broyden_.max_backtracks && !system_.budget_spent(); ++k) {
-    xt_ = x_ + t_ * d;
-    projected_ = box.project(xt_, x_);
-    if (projected_ && xt_ == x_) return false;  // the box holds x in place along d
-    if (system_.residual(xt_, ft_)) {
-      const double allowed =
-          armijo ? phi0 + 2.0 * c * gradient_.dot(xt_ - x_) : (1.0 - 2.0 * c * t_) * phi0;
-      if (ft_.squaredNorm() <= allowed) return true;
-    }
-    t_ *= 0.5;
-  }
-  return false;
+  detail::ResidualPath<N> path(system_, x_, phi0, d, gradient_, armijo, xt_, ft_);
+  const LineSearch::Result result = rule.search(path, t0, phi0);
+  t_ = result.t;
+  projected_ = path.projected();
+  return result.accepted();
 }
 
 template <int N>
@@ -247,12 +242,7 @@ Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& 
   StopMonitor monitor(stop, x.template lpNorm<Eigen::Infinity>(), /*estimate_lipschitz=*/false);
 
   x_ = x;
-  std::optional<Status> status;
-  if (!system_.residual(x_, f_)) {
-    status = Status::kNonFinite;
-  } else if (detail::solved_at_start(f_, stop)) {
-    status = Status::kConverged;
-  }
+  std::optional<Status> status = system_.first_residual(x_, f_, stop);
   double fnorm = f_.template lpNorm<Eigen::Infinity>();
   bool fresh = false;  // H is the inverse of a Jacobian computed at x_
   int updates = 0;

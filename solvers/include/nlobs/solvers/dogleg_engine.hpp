@@ -202,12 +202,7 @@ Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
   const double eps = std::numeric_limits<double>::epsilon();
 
   x_ = x;
-  std::optional<Status> status;
-  if (!system_.residual(x_, f_)) {
-    status = Status::kNonFinite;
-  } else if (detail::solved_at_start(f_, stop)) {
-    status = Status::kConverged;
-  }
+  std::optional<Status> status = system_.first_residual(x_, f_, stop);
   double fnorm = f_.stableNorm();  // overflow-safe, as MINPACK's enorm
   double delta = 0.0, xnorm = 0.0, last_step = 0.0;
   int slow_iterations = 0, slow_jacobians = 0;  // MINPACK's nslow1, nslow2

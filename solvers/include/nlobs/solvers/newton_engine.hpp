@@ -2,7 +2,8 @@
 // Newton's method on F(x) = G(x) − x (for a root problem adapted with Ψ = I this is F itself;
 // on the window problem it is the Moraal–Grizzle observer, [MG95]:
 // w ← w + (∂H/∂w)⁻¹ (Y − H(w))). The Jacobian J = ∂G − I comes from the problem (user-supplied
-// or AD) or from finite differences. Optional backtracking line search on ½‖F‖₂² (Armijo).
+// or AD) or from finite differences. Optional backtracking line search on ½‖F‖₂² (Armijo,
+// LineSearch of line_search.hpp).
 // Or a trust-region globalisation: the dogleg step between the Newton and the Cauchy step in
 // ‖p‖₂ ≤ Δ, a fresh Jacobian at every iterate (DoglegEngine without Broyden updates, whose
 // radius rules and stop tests it shares).
@@ -34,6 +35,7 @@
 #include "nlobs/solvers/engine_spec.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
 #include "nlobs/solvers/library_sizes.hpp"
+#include "nlobs/solvers/line_search.hpp"
 #include "nlobs/solvers/linear/forcing_term.hpp"
 #include "nlobs/solvers/linear/linear_solver.hpp"
 #include "nlobs/solvers/linear/make_linear_solver.hpp"
@@ -249,43 +251,35 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
   summary.engine = name();
   StopMonitor monitor(stop, x.template lpNorm<Eigen::Infinity>(), /*estimate_lipschitz=*/false);
 
-  // Backtracking along the projected path P(x + t d), t = t0, t0·factor, …: the first t with
-  // ‖F(x_t)‖₂² ≤ ‖F(x)‖₂² + 2c ∇φᵀ(x_t − x), φ = ½‖F‖₂², ∇φ = J_Fᵀ F (Armijo). For the Newton
-  // direction without a box ∇φᵀ t d = −t‖F‖₂², the test in its usual form. With armijo = false,
-  // the first finite trial. x_t in xt_, F(x_t) in ft_; false when none, or when the box holds x
-  // in place (held_in_place).
+  // Backtracking along the projected path P(x + t d) (LineSearch: Armijo on ‖F‖₂², with the
+  // slope ∇φᵀ(x_t − x), ∇φ = J_Fᵀ F, where the box may cut the path); without a line search the
+  // full step, taken where F is finite. x_t in xt_, F(x_t) in ft_; false when none is accepted,
+  // or when the box holds x in place (held_in_place).
+  const LineSearch line_search{
+      .kind = newton_.line_search ? LineSearch::Kind::kBacktracking : LineSearch::Kind::kFullStep,
+      .sufficient_decrease = newton_.sufficient_decrease,
+      .shrink = newton_.backtrack_factor,
+      .max_backtracks = newton_.max_backtracks};
+  LineSearch stale_line_search = line_search;
+  stale_line_search.max_backtracks = std::min(newton_.max_backtracks, kStaleBacktracks);
   bool projected = false, held_in_place = false;
   double t = 1.0;
   // An inexact (Krylov) step has ∇φᵀΔx = −‖F‖² + Fᵀr, not −‖F‖²: the Armijo test then takes the
-  // slope from ∇φ = J_Fᵀ F as a projected step does.
+  // slope from ∇φ as a projected step does.
   const bool inexact = sparse && linear_.iterative();
-  auto search = [&](const Vector<N>& d, double t0, bool armijo, int max_backtracks) {
+  auto search = [&](const Vector<N>& d, double t0, const LineSearch& rule) {
     const double phi0 = f_.squaredNorm();
-    t = t0;
-    for (int k = 0; k <= max_backtracks && !system_.budget_spent(); ++k) {
-      xt_ = x_ + t * d;
-      projected = box.project(xt_, x_);
-      held_in_place = projected && xt_ == x_;
-      if (held_in_place) return false;  // every component that would move is held
-      const bool finite = system_.residual(xt_, ft_);
-      if (!armijo) return finite;
-      const double decrease = projected || box.active() || inexact
-                                  ? -2.0 * newton_.sufficient_decrease * gradient_.dot(xt_ - x_)
-                                  : 2.0 * newton_.sufficient_decrease * t * phi0;
-      // (A projected Newton path need not descend: ∇φᵀ(x_t − x) > 0 still allows no increase.)
-      if (finite && ft_.squaredNorm() <= std::min(phi0 - decrease, phi0)) return true;
-      t *= newton_.backtrack_factor;
-    }
-    return false;
+    detail::ResidualPath<N> path(system_, x_, phi0, d, gradient_, box.active() || inexact, xt_,
+                                 ft_);
+    const LineSearch::Result result = rule.search(path, t0, phi0);
+    t = result.t;
+    projected = path.projected();
+    held_in_place = result.outcome == LineSearch::Outcome::kHeld;
+    return result.accepted();
   };
 
   x_ = x;
-  std::optional<Status> status;
-  if (!system_.residual(x_, f_)) {
-    status = Status::kNonFinite;
-  } else if (detail::solved_at_start(f_, stop)) {
-    status = Status::kConverged;
-  }
+  std::optional<Status> status = system_.first_residual(x_, f_, stop);
   double fnorm = f_.template lpNorm<Eigen::Infinity>();
   // Modified Newton: iterations the current J has served (0: none yet), and whether to renew it.
   int jacobian_age = 0;
@@ -319,9 +313,7 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
     bool descent_step = false;
     // A stale J's step gets a few backtracks (and without a line search must lower ‖F‖₂): when
     // it fails, J is renewed at x_ at once, before any fallback that would judge by it.
-    bool accepted =
-        search(dx_, 1.0, newton_.line_search,
-               fresh ? newton_.max_backtracks : std::min(newton_.max_backtracks, kStaleBacktracks));
+    bool accepted = search(dx_, 1.0, fresh ? line_search : stale_line_search);
     if (accepted && !fresh && !newton_.line_search && !(ft_.squaredNorm() < f_.squaredNorm())) {
       accepted = false;
     }
@@ -333,7 +325,7 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
       const double curvature = merit_curvature(sparse);
       if (curvature > 0.0) {
         dx_ = -gradient_;
-        accepted = search(dx_, gradient_.squaredNorm() / curvature, true, newton_.max_backtracks);
+        accepted = search(dx_, gradient_.squaredNorm() / curvature, line_search);
         descent_step = true;
       }
     }

@@ -185,12 +185,7 @@ Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vec
   StopMonitor monitor(stop, x.template lpNorm<Eigen::Infinity>(), /*estimate_lipschitz=*/false);
 
   x_ = x;
-  std::optional<Status> status;
-  if (!system_.residual(x_, f_)) {
-    status = Status::kNonFinite;
-  } else if (detail::solved_at_start(f_, stop)) {
-    status = Status::kConverged;
-  }
+  std::optional<Status> status = system_.first_residual(x_, f_, stop);
   double fnorm = f_.stableNorm();  // overflow-safe
   double delta = ptc_.initial_pseudo_step;
   const int sigma = ptc_.flow == PseudoTransientOptions::Flow::kFixedPoint ? 1 : -1;

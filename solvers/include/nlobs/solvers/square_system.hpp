@@ -11,6 +11,7 @@
 #include "nlobs/solvers/box_bounds.hpp"
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/finite_difference.hpp"
+#include "nlobs/solvers/line_search.hpp"
 #include "nlobs/solvers/linear/linear_solver.hpp"
 #include "nlobs/solvers/sparse/sparsity_pattern.hpp"
 #include "nlobs/solvers/stop_monitor.hpp"
@@ -36,6 +37,13 @@ inline int evaluate_sparse_jacobian(SparseJacobianState& state, const Vector<Dyn
   return spent;
 }
 
+// x0 already solves F: ‖F(x0)‖₂ = 0, or StopCriteria's residual criterion holds there.
+template <int N>
+bool solved_at_start(const Vector<N>& f, const StopCriteria& stop) {
+  const double largest = f.template lpNorm<Eigen::Infinity>();
+  return largest == 0.0 || (stop.residual_tolerance && largest <= *stop.residual_tolerance);
+}
+
 template <int N>
 class SquareSystem {
  public:
@@ -53,6 +61,15 @@ class SquareSystem {
     progress_.start(stop.progress_window);
     evaluations_ = jacobians_ = 0;
     if constexpr (N == Dynamic) g_.resize(x0.size()), fd_.resize(x0.size());
+  }
+
+  // The run's first residual, f = F(x0): kNonFinite when it is not finite, kConverged when x0
+  // already solves F (solved_at_start), nullopt when the engine is to iterate.
+  std::optional<Status> first_residual(const Vector<N>& x0, Vector<N>& f,
+                                       const StopCriteria& stop) {
+    if (!residual(x0, f)) return Status::kNonFinite;
+    if (solved_at_start(f, stop)) return Status::kConverged;
+    return std::nullopt;
   }
 
   // f = F(x) = G(x) − x (the problem's own F when it has one); false when a value is not finite.
@@ -172,11 +189,48 @@ class SquareSystem {
   Box<N> box_;
 };
 
-// x0 already solves F: ‖F(x0)‖₂ = 0, or StopCriteria's residual criterion holds there.
+// The path of the engines on F for LineSearch (line_search.hpp): x(t) = P(x + t d), projected
+// onto the system's box, the merit m = ‖F‖₂², the trial point in `xt` and F there in `ft`.
+// δm(t) = 2∇φᵀ(x(t) − x) with ∇φ = J_Fᵀ F (`gradient`, φ = ½‖F‖₂²) when slope_from_gradient — a
+// path the box may cut, an inexact (Krylov) step, the steepest-descent path — else −2t‖F‖₂²,
+// exact for the Newton step d = −J_F⁻¹F and the model's prediction for a quasi-Newton one.
 template <int N>
-bool solved_at_start(const Vector<N>& f, const StopCriteria& stop) {
-  const double largest = f.template lpNorm<Eigen::Infinity>();
-  return largest == 0.0 || (stop.residual_tolerance && largest <= *stop.residual_tolerance);
-}
+class ResidualPath {
+ public:
+  ResidualPath(SquareSystem<N>& system, const Vector<N>& x, double merit, const Vector<N>& d,
+               const Vector<N>& gradient, bool slope_from_gradient, Vector<N>& xt, Vector<N>& ft)
+      : system_(system),
+        x_(x),
+        d_(d),
+        gradient_(gradient),
+        xt_(xt),
+        ft_(ft),
+        merit_(merit),
+        slope_from_gradient_(slope_from_gradient) {}
+
+  bool exhausted() const { return system_.budget_spent(); }
+  bool move(double t) {
+    t_ = t;
+    xt_ = x_ + t * d_;
+    projected_ = system_.box().project(xt_, x_);
+    return projected_ && xt_ == x_;
+  }
+  double slope() const {
+    return slope_from_gradient_ ? 2.0 * gradient_.dot(xt_ - x_) : -2.0 * t_ * merit_;
+  }
+  double merit() {
+    return system_.residual(xt_, ft_) ? ft_.squaredNorm()
+                                      : std::numeric_limits<double>::quiet_NaN();
+  }
+  // The box cut the last move short.
+  bool projected() const { return projected_; }
+
+ private:
+  SquareSystem<N>& system_;
+  const Vector<N>&x_, &d_, &gradient_;
+  Vector<N>&xt_, &ft_;
+  double merit_, t_ = 0.0;
+  bool slope_from_gradient_, projected_ = false;
+};
 
 }  // namespace nlobs::detail

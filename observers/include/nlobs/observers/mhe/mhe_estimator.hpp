@@ -21,7 +21,7 @@
 // On a linear model this is the Kalman filter's prior, and the MHE's estimate is the Kalman
 // filter's at every step for any N (tested to 1e-9).
 //
-// The solver: Gauss–Newton on V with a projected backtracking line search (Armijo,
+// The solver: Gauss–Newton on V with a projected backtracking line search (LineSearch, Armijo:
 // V(z_α) ≤ V(z) + 2σ ∇(V/2)ᵀ(z_α − z), σ = 1e-4, z_α = Π(z + α Δz), α halved up to 30 times);
 // with bounds, the projected Newton method of [Ber82]: states at a bound whose gradient points
 // out are held and the step solved for the others. Warm start: the previous solution shifted
@@ -64,6 +64,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "nlobs/models/model.hpp"
@@ -73,6 +74,7 @@
 #include "nlobs/observers/core/sample_clock.hpp"
 #include "nlobs/observers/mhe/block_tridiagonal.hpp"
 #include "nlobs/observers/mhe/mhe_options.hpp"
+#include "nlobs/solvers/line_search.hpp"
 #include "nlobs/solvers/summary.hpp"
 
 namespace nlobs {
@@ -197,8 +199,10 @@ class MheEstimator final : public Observer {
 
  private:
   static constexpr const char* kEngine = "gauss-newton";
-  static constexpr double kSufficientDecrease = 1e-4;
-  static constexpr int kMaxBacktracks = 30;
+  // Armijo on V along the projected path, σ = 1e-4, α halved up to 30 times; a path that does
+  // not descend (∇Vᵀ(z_α − z) ≥ 0) is given up at once, for the projected gradient.
+  static constexpr LineSearch kLineSearch{
+      .sufficient_decrease = 1e-4, .shrink = 0.5, .max_backtracks = 30, .require_descent = true};
 
   struct Node {
     long k = 0;
@@ -590,22 +594,32 @@ class MheEstimator final : public Observer {
     return {slope, step};
   }
 
-  // Backtracks along Π(x + α d) from α = 1; true (trial_ holding the point, `value` its V) when
-  // a point decreases V enough.
-  bool line_search(double& value, double& step) {
-    double alpha = 1.0;
-    for (int b = 0; b <= kMaxBacktracks; ++b, alpha *= 0.5) {
-      const auto [slope, s] = project_step(alpha);
-      if (!(slope < 0.0)) return false;
-      const double trial_value = cost(trial_);
-      ++evaluations_;
-      if (trial_value <= value + 2.0 * kSufficientDecrease * slope) {
-        value = trial_value;
-        step = s;
-        return true;
-      }
+  // The path z_α = Π(z + α d) of the horizon's states for LineSearch, m = V: the trial in
+  // trial_, δm = 2∇(V/2)ᵀ(z_α − z), ‖z_α − z‖∞ kept for the step's norm.
+  struct HorizonPath {
+    MheEstimator& mhe;
+    double half_slope = 0.0, step = 0.0;
+    bool exhausted() const { return false; }
+    bool move(double alpha) {
+      std::tie(half_slope, step) = mhe.project_step(alpha);
+      return false;  // a held path has δm = 0: require_descent ends it
     }
-    return false;
+    double slope() const { return 2.0 * half_slope; }
+    double merit() {
+      ++mhe.evaluations_;
+      return mhe.cost(mhe.trial_);
+    }
+  };
+
+  // Backtracks along Π(z + α d) from α = 1 (kLineSearch); true (trial_ holding the point,
+  // `value` its V, `step` its ‖z_α − z‖∞) when a point decreases V enough.
+  bool line_search(double& value, double& step) {
+    HorizonPath path{*this};
+    const LineSearch::Result result = kLineSearch.search(path, 1.0, value);
+    if (!result.accepted()) return false;
+    value = result.merit;
+    step = path.step;
+    return true;
   }
 
   double states_norm() const {
