@@ -13,26 +13,20 @@
 // literature's examples need (concentrations ≥ 0) — are a box. Bounds on w would be nonlinear
 // constraints in these unknowns: not offered.
 //
-// The arrival cost: when sample j = k − N leaves the horizon, x̄ and P become the EKF's
-// prediction from the filtered estimate x̂_{j|j} (the estimate this MHE reported at j), the
-// filtering update of [RRM03]:
-//   P⁺ = (P⁻¹ + Hᵀ R⁻¹ H)⁻¹,  x̄ ← f(x̂_{j|j}, u_j, j),  P ← F P⁺ Fᵀ + Q,
-// with H = ∂h/∂x, F = ∂f/∂x at x̂_{j|j} (forward-mode AD), R⁻¹ that of the outputs measured at j.
-// On a linear model this is the Kalman filter's prior, and the MHE's estimate is the Kalman
-// filter's at every step for any N (tested to 1e-9).
+// The arrival cost (ArrivalCost, arrival_cost.hpp): when sample j = k − N leaves the horizon,
+// x̄ and P become the EKF's prediction from the filtered estimate x̂_{j|j} (the estimate this MHE
+// reported at j), the filtering update of [RRM03]. On a linear model this is the Kalman
+// filter's prior, and the MHE's estimate is the Kalman filter's at every step for any N (tested
+// to 1e-9).
 //
-// The solver: Gauss–Newton on V with a projected backtracking line search (LineSearch, Armijo:
-// V(z_α) ≤ V(z) + 2σ ∇(V/2)ᵀ(z_α − z), σ = 1e-4, z_α = Π(z + α Δz), α halved up to 30 times);
-// with bounds, the projected Newton method of [Ber82]: states at a bound whose gradient points
-// out are held and the step solved for the others. Warm start: the previous solution shifted
-// by one sample, the new state predicted by the model. real_time_iteration takes one iteration per
-// sample ([DBS05]). Each step's Summary: converged (‖Δz‖∞ ≤ step_tolerance (1 + ‖z‖∞), or the
-// full step's first-order decrease −2∇(V/2)ᵀΔz ≤ cost_tolerance · V), max_iterations, stagnated (no
-// decrease along the projected Newton nor the projected gradient path) or non_finite (V not finite
-// at the warm start: the step keeps the last estimate); residual_norm is the projected gradient
-// ‖∇(V/2)‖∞ at the last linearisation, objective V. The estimate is the lowest V found: a solve cut
-// short (and every real-time iteration) still lowered V from the warm start, so it is used
-// (ObserverStep::used_unusable_answer says so).
+// The solver (ProjectedGaussNewton, nlobs/solvers/least_squares/projected_gauss_newton.hpp, its
+// stop rules and Summary there): Gauss–Newton on V, this class giving the block-tridiagonal
+// linear algebra (HorizonProblem below), with a projected backtracking line search and, with
+// bounds, the projected Newton method of [Ber82]. Warm start: the previous solution shifted by
+// one sample, the new state predicted by the model. real_time_iteration takes one iteration per
+// sample ([DBS05]). A step whose V is not finite at the warm start keeps the last estimate. The
+// estimate is the lowest V found: a solve cut short (and every real-time iteration) still
+// lowered V from the warm start, so it is used (ObserverStep::used_unusable_answer says so).
 //
 // A sample's outputs may be missing one by one (a non-finite entry): its term weighs the
 // measured outputs by the inverse of their own block of R; measurement_missing is set only
@@ -64,7 +58,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
-#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "nlobs/models/model.hpp"
@@ -72,9 +66,10 @@
 #include "nlobs/observers/core/observer.hpp"
 #include "nlobs/observers/core/option_checks.hpp"
 #include "nlobs/observers/core/sample_clock.hpp"
+#include "nlobs/observers/mhe/arrival_cost.hpp"
 #include "nlobs/observers/mhe/block_tridiagonal.hpp"
 #include "nlobs/observers/mhe/mhe_options.hpp"
-#include "nlobs/solvers/line_search.hpp"
+#include "nlobs/solvers/least_squares/projected_gauss_newton.hpp"
 #include "nlobs/solvers/summary.hpp"
 
 namespace nlobs {
@@ -110,7 +105,10 @@ class MheEstimator final : public Observer {
     const double inf = std::numeric_limits<double>::infinity();
     lower_ = options_.lower_bounds.size() ? State(options_.lower_bounds) : State::Constant(n, -inf);
     upper_ = options_.upper_bounds.size() ? State(options_.upper_bounds) : State::Constant(n, inf);
-    iterations_ = options_.real_time_iteration ? 1 : static_cast<int>(options_.max_iterations);
+    gauss_newton_ = ProjectedGaussNewton(
+        {.max_iterations = options_.real_time_iteration ? 1 : options_.max_iterations,
+         .step_tolerance = options_.step_tolerance,
+         .cost_tolerance = options_.cost_tolerance});
 
     const auto h = static_cast<std::size_t>(options_.horizon);
     nodes_.reserve(h + 1);  // a late sample is inserted before the oldest leaves
@@ -127,7 +125,7 @@ class MheEstimator final : public Observer {
     missing_ = Eigen::VectorXd::Constant(p, kMissing);
 
     info_.name = options_.name;
-    info_.engine = kEngine;
+    info_.engine = ProjectedGaussNewton::kName;
     info_.signals = {{"cost", SignalKind::kDiagnostic}};
     step_.signals = Eigen::VectorXd::Zero(1);
     reset();
@@ -136,10 +134,8 @@ class MheEstimator final : public Observer {
   void reset() override {
     nodes_.clear();
     clock_.reset();
-    prior_ = options_.initial_estimate;
-    prior_cov_ = p0_;
-    prior_inv_ = p0_inv_;
-    estimate_ = prior_;
+    arrival_.reset(options_.initial_estimate, p0_, p0_inv_);
+    estimate_ = arrival_.mean();
     late_dropped_ = 0;
     chain_ = false;
     info_.warnings.clear();
@@ -186,8 +182,8 @@ class MheEstimator final : public Observer {
   long late_measurements_dropped() const { return late_dropped_; }
 
   // The arrival cost's x̄ and P (the prior on the horizon's first state).
-  const State& arrival_mean() const { return prior_; }
-  const StateMatrix& arrival_covariance() const { return prior_cov_; }
+  const State& arrival_mean() const { return arrival_.mean(); }
+  const StateMatrix& arrival_covariance() const { return arrival_.covariance(); }
   // The horizon's estimates x̂_{k−M+1|k}, …, x̂_{k|k} (M ≤ N samples so far), oldest first, one
   // per column.
   Eigen::MatrixXd horizon_estimates() const {
@@ -198,12 +194,6 @@ class MheEstimator final : public Observer {
   }
 
  private:
-  static constexpr const char* kEngine = "gauss-newton";
-  // Armijo on V along the projected path, σ = 1e-4, α halved up to 30 times; a path that does
-  // not descend (∇Vᵀ(z_α − z) ≥ 0) is given up at once, for the projected gradient.
-  static constexpr LineSearch kLineSearch{
-      .sufficient_decrease = 1e-4, .shrink = 0.5, .max_backtracks = 30, .require_descent = true};
-
   struct Node {
     long k = 0;
     double t = 0.0;
@@ -281,7 +271,7 @@ class MheEstimator final : public Observer {
   // leaves when the horizon is full.
   void append(long k, const std::optional<ModelStep>& move, double t, const Eigen::VectorXd& y,
               const Eigen::VectorXd& u) {
-    State guess = prior_;
+    State guess = arrival_.mean();
     if (move) {
       Node& last = nodes_.back();
       last.next = *move;
@@ -458,9 +448,9 @@ class MheEstimator final : public Observer {
              (x.array() <= upper_.array()).all() && inside_domain(x);
     };
     const std::size_t m = nodes_.size();
-    const std::size_t first = chain_ && nodes_.front().x == prior_ ? m - 1 : 0;
+    const std::size_t first = chain_ && nodes_.front().x == arrival_.mean() ? m - 1 : 0;
     for (std::size_t i = first; i < m; ++i) {
-      trial_[i] = i == 0 ? prior_
+      trial_[i] = i == 0 ? arrival_.mean()
                          : advance(model_, i == first ? nodes_[i - 1].x : trial_[i - 1],
                                    nodes_[i - 1].u, nodes_[i - 1].next);
       if (!usable(trial_[i])) {
@@ -471,7 +461,7 @@ class MheEstimator final : public Observer {
     for (std::size_t i = first; i < m; ++i) nodes_[i].x = trial_[i];
     chain_ = true;
     Summary summary;
-    summary.engine = kEngine;
+    summary.engine = ProjectedGaussNewton::kName;
     summary.status = Status::kConverged;
     summary.objective = 0.0;
     summary.residual_norm = 0.0;
@@ -485,30 +475,13 @@ class MheEstimator final : public Observer {
   // The filtering update of the arrival cost along the sample that leaves the horizon.
   void drop_oldest(long k) {
     const Node& old = nodes_.front();
-    const Eigen::Index n = model_.states();
-    StateMatrix fj(n, n);
-    OutputJacobian hj(model_.outputs(), n);
-    state_jacobian(model_, old.filtered, old.u, old.next, fj);
-    StateMatrix updated = prior_cov_;  // a node without a measurement: P⁺ = P
-    if ((old.measured.array() > 0.0).any()) {
-      output_jacobian(model_, old.filtered, hj);
-      const StateMatrix information = prior_inv_ + hj.transpose() * old.r_inv * hj;
-      updated = inverse(information);
-    }
-    StateMatrix covariance = fj * updated * fj.transpose() + old.next.weight * q_;
-    covariance = 0.5 * (covariance + covariance.transpose());
-    const State mean = advance(model_, old.filtered, old.u, old.next);
-    const Eigen::LLT<StateMatrix> llt(covariance);
-    if (!mean.allFinite() || !covariance.allFinite() || llt.info() != Eigen::Success) {
+    if (!arrival_.update(model_, old.filtered, old.u, old.next, (old.measured.array() > 0.0).any(),
+                         old.r_inv, q_)) {
       std::ostringstream os;
       os << name() << ": the arrival cost's update along sample k = " << old.k << " (at k = " << k
          << ") is not finite or not positive definite; x̄ and P kept";
       mark_non_finite_estimate(step_, os.str());
-      return;
     }
-    prior_ = mean;
-    prior_cov_ = covariance;
-    prior_inv_ = llt.solve(StateMatrix::Identity(n, n));
   }
 
   bool inside_domain(const State& x) const { return domain_violation_of(model_, x).empty(); }
@@ -517,8 +490,7 @@ class MheEstimator final : public Observer {
   // finite or a state leaves the model's domain).
   double cost(const std::vector<State>& xs) const {
     const std::size_t m = active_;
-    const State e0 = xs[0] - prior_;
-    double v = e0.dot(prior_inv_ * e0);
+    double v = arrival_.cost(xs[0]);
     for (std::size_t i = 0; i < m; ++i) {
       if (!inside_domain(xs[i])) return std::numeric_limits<double>::infinity();
       const Output e = nodes_[i].y - Output(model_.h(xs[i]));
@@ -543,8 +515,8 @@ class MheEstimator final : public Observer {
       diag_[i].noalias() = h_jac_[i].transpose() * (node.r_inv * h_jac_[i]);
       grad_[i].noalias() = -h_jac_[i].transpose() * ry;
     }
-    diag_[0] += prior_inv_;
-    grad_[0].noalias() += prior_inv_ * (nodes_[0].x - prior_);
+    diag_[0] += arrival_.information();
+    grad_[0].noalias() += arrival_.information() * (nodes_[0].x - arrival_.mean());
     for (std::size_t i = 0; i + 1 < m; ++i) {
       // The move's noise is weight · Q (an interval off the grid): its inverse weighs the term.
       const double scale = 1.0 / nodes_[i].next.weight;
@@ -594,34 +566,6 @@ class MheEstimator final : public Observer {
     return {slope, step};
   }
 
-  // The path z_α = Π(z + α d) of the horizon's states for LineSearch, m = V: the trial in
-  // trial_, δm = 2∇(V/2)ᵀ(z_α − z), ‖z_α − z‖∞ kept for the step's norm.
-  struct HorizonPath {
-    MheEstimator& mhe;
-    double half_slope = 0.0, step = 0.0;
-    bool exhausted() const { return false; }
-    bool move(double alpha) {
-      std::tie(half_slope, step) = mhe.project_step(alpha);
-      return false;  // a held path has δm = 0: require_descent ends it
-    }
-    double slope() const { return 2.0 * half_slope; }
-    double merit() {
-      ++mhe.evaluations_;
-      return mhe.cost(mhe.trial_);
-    }
-  };
-
-  // Backtracks along Π(z + α d) from α = 1 (kLineSearch); true (trial_ holding the point,
-  // `value` its V, `step` its ‖z_α − z‖∞) when a point decreases V enough.
-  bool line_search(double& value, double& step) {
-    HorizonPath path{*this};
-    const LineSearch::Result result = kLineSearch.search(path, 1.0, value);
-    if (!result.accepted()) return false;
-    value = result.merit;
-    step = path.step;
-    return true;
-  }
-
   double states_norm() const {
     double norm = 0.0;
     for (std::size_t i = 0; i < active_; ++i) {
@@ -630,70 +574,51 @@ class MheEstimator final : public Observer {
     return norm;
   }
 
+  // The horizon's problem for ProjectedGaussNewton: z = the states of the first active_ nodes.
+  struct HorizonProblem {
+    MheEstimator& mhe;
+    double start_cost() {
+      for (std::size_t i = 0; i < mhe.active_; ++i) mhe.trial_[i] = mhe.nodes_[i].x;
+      return mhe.cost(mhe.trial_);
+    }
+    double linearise() {
+      mhe.linearise();
+      return mhe.hold_active_bounds();
+    }
+    bool newton_direction() {
+      const std::size_t m = mhe.active_;
+      for (std::size_t i = 0; i < m; ++i) mhe.direction_[i] = -mhe.grad_[i];
+      if (!mhe.solver_.factor(mhe.diag_, mhe.sub_, m)) return false;
+      mhe.solver_.solve(mhe.direction_, m);
+      return true;
+    }
+    void gradient_direction() {
+      for (std::size_t i = 0; i < mhe.active_; ++i) {
+        mhe.direction_[i] = -mhe.grad_[i].cwiseQuotient(mhe.diag_[i].diagonal());
+      }
+    }
+    std::pair<double, double> project(double alpha) { return mhe.project_step(alpha); }
+    double trial_cost() { return mhe.cost(mhe.trial_); }
+    void accept() {
+      for (std::size_t i = 0; i < mhe.active_; ++i) mhe.nodes_[i].x = mhe.trial_[i];
+    }
+    double norm() const { return mhe.states_norm(); }
+  };
+
   // Minimises V over the first m nodes (their states left at the answer) and returns the
   // Summary, V in its objective; a V not finite at the warm start marks the step.
   Summary solve(long k, std::size_t m) {
     active_ = m;
     chain_ = false;
-    Summary summary;
-    summary.engine = kEngine;
-    evaluations_ = 0;
-    for (std::size_t i = 0; i < m; ++i) trial_[i] = nodes_[i].x;
-    double value = cost(trial_);
-    ++evaluations_;
-    summary.status = Status::kMaxIterations;
-    if (!std::isfinite(value)) {
-      summary.status = Status::kNonFinite;
+    HorizonProblem problem{*this};
+    Summary summary = gauss_newton_.minimise(problem);
+    if (summary.status == Status::kNonFinite) {
       std::ostringstream os;
       os << name() << ": the cost V at sample k = " << k << " is not finite at the warm start "
          << "(the model overflows or leaves its domain); kept the last estimate";
       mark_non_finite_estimate(step_, os.str());
       summary.message = step_.failure_message;
     }
-    int iteration = 0;
-    while (summary.status == Status::kMaxIterations && iteration < iterations_) {
-      linearise();
-      ++iteration;
-      summary.residual_norm = hold_active_bounds();
-      for (std::size_t i = 0; i < m; ++i) direction_[i] = -grad_[i];
-      if (!solver_.factor(diag_, sub_, m)) {  // only by rounding: P, Q are definite
-        summary.status = Status::kSingularJacobian;
-        summary.message = "the Gauss-Newton matrix is not positive definite";
-        break;
-      }
-      solver_.solve(direction_, m);
-      const double tolerance = options_.step_tolerance * (1.0 + states_norm());
-      const auto [slope, full_step] = project_step(1.0);
-      // A projected step that does not descend (slope ≥ 0) is not a converged one: the line
-      // search below refuses it and the projected gradient is tried.
-      if (full_step <= tolerance ||
-          (slope < 0.0 && -2.0 * slope <= options_.cost_tolerance * value)) {
-        summary.status = Status::kConverged;
-        summary.step_norm = full_step;
-        break;
-      }
-      double step = 0.0;
-      bool moved = line_search(value, step);
-      if (!moved) {  // the projected Newton path failed: the projected gradient, scaled by H's
-                     // diagonal
-        for (std::size_t i = 0; i < m; ++i) {
-          direction_[i] = -grad_[i].cwiseQuotient(diag_[i].diagonal());
-        }
-        moved = line_search(value, step);
-      }
-      if (!moved) {
-        summary.status = Status::kStagnated;
-        summary.message = "no decrease of the cost along the projected Newton or gradient path";
-        break;
-      }
-      for (std::size_t i = 0; i < m; ++i) nodes_[i].x = trial_[i];
-      summary.step_norm = step;
-      if (step <= tolerance) summary.status = Status::kConverged;
-    }
-    summary.iterations = iteration;
-    summary.jacobian_evaluations = iteration;
-    summary.function_evaluations = evaluations_;
-    summary.objective = value;
     return summary;
   }
 
@@ -702,10 +627,8 @@ class MheEstimator final : public Observer {
   StateMatrix p0_, p0_inv_, q_, q_inv_;
   OutputMatrix r_, r_inv_;
   State lower_, upper_;
-  int iterations_ = 1;
-  // The arrival cost: x̄, P and P⁻¹.
-  State prior_;
-  StateMatrix prior_cov_, prior_inv_;
+  ProjectedGaussNewton gauss_newton_;
+  ArrivalCost<Model> arrival_;
   State estimate_;
   std::vector<Node> nodes_;  // the horizon's samples, oldest first
   // Gauss–Newton workspace, one entry per sample of the horizon.
@@ -714,7 +637,6 @@ class MheEstimator final : public Observer {
   std::vector<State> grad_, direction_, trial_, w_res_;
   std::vector<Output> y_res_;
   detail::BlockTridiagonalCholesky<Model::kStates> solver_;
-  int evaluations_ = 0;
   std::size_t active_ = 0;  // the nodes of the problem being solved (the first active_)
   // The nodes' states are the model's prediction chain from x̄ (predict_unmeasured_horizon()).
   bool chain_ = false;
