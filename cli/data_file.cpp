@@ -10,7 +10,7 @@
 #include <string_view>
 #include <vector>
 
-#include "input_file.hpp"
+#include "nlobs/runs/input_file.hpp"
 #include "nlobs/solvers/status.hpp"
 
 namespace nlobs::cli {

@@ -9,8 +9,8 @@
 #include "nlobs/registry/model_registry.hpp"
 #include "nlobs/registry/observer_types.hpp"
 #include "nlobs/registry/problem_sets.hpp"
+#include "nlobs/runs/scenario.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
-#include "scenario.hpp"
 #include "solve_chua_window.hpp"
 
 namespace nlobs::cli {

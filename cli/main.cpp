@@ -21,9 +21,9 @@
 #include "nlobs/reference/problem_suite.hpp"
 #include "nlobs/registry/plugin.hpp"
 #include "nlobs/registry/problem_sets.hpp"
+#include "nlobs/runs/scenario.hpp"
 #include "output_directory.hpp"
 #include "run_command.hpp"
-#include "scenario.hpp"
 #include "solve_chua_window.hpp"
 #include "suite_command.hpp"
 
@@ -196,7 +196,7 @@ int run_command_line(int argc, char** argv) {
   nlobs::cli::RunOptions run_options;
   run->add_option("scenario", scenario, "Built-in scenario name or JSON scenario file")->required();
   CLI::Option* steps_opt = run->add_option("--steps", steps, "Number of samples")
-                               ->check(integer_in(1L, nlobs::cli::kMaxSteps));
+                               ->check(integer_in(1L, nlobs::kMaxScenarioSteps));
   CLI::Option* noise_opt =
       run->add_option("--noise", noise, "Std. deviation of Gaussian measurement noise")
           ->check(finite_in(0.0, std::numeric_limits<double>::max(), "SIGMA >= 0"));

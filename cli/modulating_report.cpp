@@ -14,45 +14,6 @@
 #include "run_support.hpp"
 
 namespace nlobs::cli {
-namespace {
-
-// Largest of a row over [from, K); NaN as soon as one entry is not finite.
-double max_over(const Eigen::MatrixXd& e, Eigen::Index row, Eigen::Index from) {
-  double worst = 0.0;
-  if (from >= e.cols()) return NAN;
-  for (Eigen::Index k = from; k < e.cols(); ++k) {
-    const double v = e(row, k);
-    if (!(v <= worst)) worst = v;  // NaN propagates
-  }
-  return worst;
-}
-
-}  // namespace
-
-std::optional<ModulatingMetrics> modulating_metrics(const RunResult& r, size_t i,
-                                                    long horizon_index) {
-  const auto error = signal_row(r.signal_info[i], SignalKind::kCanonicalError);
-  const auto norm = signal_row(r.signal_info[i], SignalKind::kCanonicalNorm);
-  if (!error || !norm) return std::nullopt;
-  const Eigen::MatrixXd& e = r.signals[i];
-  const Eigen::Index K = e.cols();
-  ModulatingMetrics m;
-  if (K == 0) return m;
-  const double scale = e.row(*norm).maxCoeff();
-  m.abs_after_horizon = max_over(e, *error, std::max<Eigen::Index>(horizon_index, 0));
-  m.rel_after_horizon = m.abs_after_horizon / scale;
-  m.final_rel = max_over(e, *error, K - std::max<Eigen::Index>(K / 10, 1)) / scale;
-  const Eigen::Index from = std::max<Eigen::Index>(r.settle_index, 0);
-  if (from < K) {
-    m.eta_rms_after =
-        std::sqrt(e.row(*error).tail(K - from).squaredNorm() / static_cast<double>(K - from));
-  }
-  if (const auto bound = signal_row(r.signal_info[i], SignalKind::kCanonicalBound)) {
-    m.max_bound = max_over(e, *bound, 0);
-  }
-  return m;
-}
-
 void print_modulating_metrics(const RunResult& r, const std::vector<long>& horizon_indices,
                               std::ostream& out) {
   bool header = false;
@@ -70,16 +31,6 @@ void print_modulating_metrics(const RunResult& r, const std::vector<long>& horiz
                   fmt(m->eta_rms_after).c_str(), fmt(m->max_bound).c_str());
     out << line;
   }
-}
-
-void add_modulating_json(const RunResult& r, size_t i, long horizon_index, nlohmann::json& o) {
-  const auto m = modulating_metrics(r, i, horizon_index);
-  if (!m) return;
-  o["max_eta_rel_error_after_horizon"] = number_or_null(m->rel_after_horizon);
-  o["max_eta_error_after_horizon"] = number_or_null(m->abs_after_horizon);
-  o["final_eta_rel_error"] = number_or_null(m->final_rel);
-  o["eta_rms_after"] = number_or_null(m->eta_rms_after);
-  o["max_eta_bound"] = number_or_null(m->max_bound);
 }
 
 bool is_modulating_sweep(const std::string& key) {

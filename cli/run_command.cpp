@@ -18,9 +18,10 @@
 #include "gnuplot.hpp"
 #include "modulating_report.hpp"
 #include "nlobs/observers/core/simulation.hpp"
+#include "nlobs/runs/scenario.hpp"
+#include "nlobs/runs/scenario_run.hpp"
 #include "run_outputs.hpp"
 #include "run_support.hpp"
-#include "scenario.hpp"
 
 namespace nlobs::cli {
 namespace {
@@ -29,124 +30,11 @@ namespace fs = std::filesystem;
 
 }  // namespace
 
-nlohmann::json number_or_null(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
-}
-
-namespace {
-
-nlohmann::json vector_or_null(const Eigen::VectorXd& v) {
-  nlohmann::json a = nlohmann::json::array();
-  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(number_or_null(v[i]));
-  return a;
-}
-
-}  // namespace
-
 std::string fmt(double v, const char* f) {
   if (!std::isfinite(v)) return "-";
   char buf[32];
   std::snprintf(buf, sizeof buf, f, v);
   return buf;
-}
-
-namespace {
-
-// Observers that publish a per-sample solve residual (kSolveResidual: the MVT's ‖X(β)‖): its
-// largest finite value over the run, or nothing for other observers.
-std::optional<double> max_beta_residual(const RunResult& r, size_t i) {
-  const auto row = signal_row(r.signal_info[i], SignalKind::kSolveResidual);
-  if (!row) return std::nullopt;
-  double worst = 0.0;
-  for (Eigen::Index k = 0; k < r.signals[i].cols(); ++k) {
-    const double v = r.signals[i](*row, k);
-    if (std::isfinite(v)) worst = std::max(worst, v);
-  }
-  return worst;
-}
-
-}  // namespace
-
-void add_coordinate_errors(const Measurements& data,
-                           const std::vector<std::unique_ptr<Observer>>& observers, RunResult& r) {
-  if (!data.has_truth()) return;
-  for (size_t i = 0; i < observers.size(); ++i) {
-    const auto& info = r.signal_info[i];
-    std::vector<Eigen::Index> rows = signal_rows(info, SignalKind::kEmbeddedEstimate);
-    const bool canonical = rows.empty();
-    if (canonical) rows = signal_rows(info, SignalKind::kCanonicalEstimate);
-    // The observer's coordinates of the truth: its (or the user's model's) code, which may
-    // throw anything; that sample's error is then unknown (NaN), as for a size that does not
-    // match.
-    const auto coordinates = [&](Eigen::Index k) -> Eigen::VectorXd {
-      try {
-        return observers[i]->coordinates_at(data.x.col(k), data.t[k]);
-      } catch (...) {
-        return Eigen::VectorXd::Constant(1, NAN);  // not empty: the observer has coordinates
-      }
-    };
-    // Nothing to compare with (no coordinates_at), or done already (a second call).
-    if (rows.empty() || data.steps() == 0 || coordinates(0).size() == 0 ||
-        signal_row(info, canonical ? SignalKind::kCanonicalError : SignalKind::kEmbeddedError)) {
-      continue;
-    }
-    const Eigen::Index K = data.steps();
-    const auto size = static_cast<Eigen::Index>(rows.size());
-    Eigen::MatrixXd& signals = r.signals[i];
-    const Eigen::Index added = canonical ? 2 : 1, at = signals.rows();
-    signals.conservativeResize(at + added, Eigen::NoChange);
-    Eigen::VectorXd estimate(size);
-    for (Eigen::Index k = 0; k < K; ++k) {
-      const Eigen::VectorXd z = coordinates(k);
-      for (Eigen::Index j = 0; j < size; ++j) {
-        estimate[j] = signals(rows[static_cast<size_t>(j)], k);
-      }
-      // An observer whose coordinates_at() does not match its published estimate: NaN.
-      signals(at, k) = z.size() == size ? (z - estimate).norm() : NAN;
-      if (canonical) signals(at + 1, k) = z.size() == size ? z.norm() : NAN;
-    }
-    if (canonical) {
-      r.signal_info[i].push_back({"eta_error", SignalKind::kCanonicalError});
-      r.signal_info[i].push_back({"eta_norm", SignalKind::kCanonicalNorm});
-    } else {
-      r.signal_info[i].push_back({"z_error", SignalKind::kEmbeddedError});
-    }
-  }
-}
-
-std::optional<EmbeddedMetrics> embedded_metrics(const RunResult& r, size_t i) {
-  const auto& info = r.signal_info[i];
-  const auto error_row = signal_row(info, SignalKind::kEmbeddedError);
-  const std::vector<Eigen::Index> z_rows = signal_rows(info, SignalKind::kEmbeddedEstimate);
-  const auto residual_row = signal_row(info, SignalKind::kProjectionResidual);
-  const auto jumps_row = signal_row(info, SignalKind::kJumpCount);
-  if (!error_row || z_rows.empty()) return std::nullopt;
-  const Eigen::MatrixXd& e = r.signals[i];
-  const Eigen::Index K = e.cols(), row = *error_row;
-  EmbeddedMetrics m;
-  if (K == 0) return m;
-  Eigen::VectorXd zhat(static_cast<Eigen::Index>(z_rows.size()));
-  for (Eigen::Index k = 0; k < K; ++k) {
-    for (Eigen::Index j = 0; j < zhat.size(); ++j) zhat[j] = e(z_rows[static_cast<size_t>(j)], k);
-    const double norm = zhat.norm();
-    if (!(norm <= m.max_zhat_norm)) m.max_zhat_norm = norm;  // NaN propagates
-  }
-  m.final_z_error = e(row, K - 1);
-  for (Eigen::Index k = K - 1; k >= 0 && e(row, k) < 1e-6; --k) m.time_index_below = k;
-  const Eigen::Index from = std::max<Eigen::Index>(r.settle_index, 0);
-  if (from >= K) return m;  // nothing after the settle index: the "after" figures stay NaN
-  double sum = 0.0, worst = 0.0;
-  for (Eigen::Index k = from; k < K; ++k) {
-    sum += e(row, k) * e(row, k);
-    if (residual_row) {
-      const double res = e(*residual_row, k);
-      if (!(res <= worst)) worst = res;
-    }
-  }
-  m.z_rms_after = std::sqrt(sum / static_cast<double>(K - from));
-  if (residual_row) m.max_residual_after = worst;  // NaN for an observer without one
-  if (jumps_row) m.jumps = e(*jumps_row, K - 1);
-  return m;
 }
 
 namespace {
@@ -256,72 +144,7 @@ void print_bounds(const nlohmann::json& bounds, std::ostream& out) {
   }
 }
 
-nlohmann::json summary_json(const Scenario& s, const Measurements& data, const RunResult& r,
-                            const std::string& source, const nlohmann::json& bounds,
-                            const std::vector<std::string>& warnings,
-                            const std::vector<long>& horizon_indices) {
-  nlohmann::json observers = nlohmann::json::array();
-  for (const ObserverMetrics& m : r.metrics) {
-    nlohmann::json o{{"name", m.name},
-                     {"engine", m.engine},
-                     {"iterations_mean", m.iterations_mean},
-                     {"iterations_max", m.iterations_max},
-                     {"first_window_iterations", m.first_window_iterations},
-                     {"evaluations_mean", m.evaluations_mean},
-                     {"ns_per_step", m.ns_per_step},
-                     {"failures", m.failures}};
-    if (data.has_truth()) {
-      o["mse"] = vector_or_null(m.mse);
-      o["mse_after_window"] = vector_or_null(m.mse_after_window);
-      o["max_error_after"] = vector_or_null(m.max_error_after);
-    }
-    if (!m.first_failure.empty()) o["first_failure"] = m.first_failure;
-    const size_t i = observers.size();
-    if (data.has_truth()) {
-      const long k = first_index_staying_below(data.x, r.estimates[i], 1e-3);
-      o["time_to_1e-3"] = k >= 0 ? nlohmann::json(data.t[k]) : nlohmann::json(nullptr);
-    }
-    if (const auto residual = max_beta_residual(r, i)) o["max_beta_residual"] = *residual;
-    if (const auto em = embedded_metrics(r, i)) {
-      o["max_zhat_norm"] = number_or_null(em->max_zhat_norm);
-      o["time_to_z_1e-6"] = em->time_index_below >= 0 ? nlohmann::json(data.t[em->time_index_below])
-                                                      : nlohmann::json(nullptr);
-      o["final_z_error"] = number_or_null(em->final_z_error);
-      o["z_rms_after"] = number_or_null(em->z_rms_after);
-      o["max_projection_residual_after"] = number_or_null(em->max_residual_after);
-      o["projection_jumps"] = em->jumps;
-    }
-    add_modulating_json(r, i, horizon_indices[i], o);
-    observers.push_back(o);
-  }
-  nlohmann::json j{{"scenario", s.name}, {"steps", data.steps()},  {"noise_std", s.noise},
-                   {"seed", s.seed},     {"observers", observers}, {"settle_index", r.settle_index},
-                   {"source", source}};
-  if (!data.stop_message.empty()) j["stop_message"] = data.stop_message;
-  if (s.settle_time >= 0.0) j["settle_time"] = s.settle_time;
-  if (s.process_noise > 0.0) j["process_noise_std"] = s.process_noise;
-  if (!bounds.empty()) j["pi_bounds"] = bounds;
-  if (!warnings.empty()) j["warnings"] = warnings;
-  return j;
-}
-
 }  // namespace
-
-void make_names_unique(RunResult& r) {
-  std::set<std::string> taken;
-  for (const ObserverMetrics& m : r.metrics) taken.insert(m.name);
-  std::set<std::string> seen;
-  for (ObserverMetrics& m : r.metrics) {
-    if (seen.insert(m.name).second) continue;
-    std::string renamed;
-    for (int copy = 2; renamed.empty() || taken.count(renamed); ++copy) {
-      renamed = m.name + " #" + std::to_string(copy);
-    }
-    taken.insert(renamed);
-    seen.insert(renamed);
-    m.name = renamed;
-  }
-}
 
 std::chrono::milliseconds plot_timeout(const RunOptions& options) {
   return std::chrono::milliseconds(static_cast<long long>(std::ceil(options.plot_timeout * 1e3)));
@@ -329,17 +152,6 @@ std::chrono::milliseconds plot_timeout(const RunOptions& options) {
 
 bool have_gnuplot() {
   return find_gnuplot().has_value();
-}
-
-Measurements simulate_scenario(const Scenario& s, const AnyModel& model) {
-  SimulationOptions sim;
-  sim.steps = s.steps;
-  sim.noise_std = s.noise;
-  sim.process_noise_std = s.process_noise;
-  sim.seed = s.seed;
-  sim.sample_time = model.sample_time() > 0 ? model.sample_time() : 1.0;
-  sim.input = [&s, &model](long k) { return scenario_input(s, model, k); };
-  return simulate(model, s.x0, sim);
 }
 
 std::vector<double> parse_sweep_values(const std::string& key, const std::string& list,
@@ -489,9 +301,10 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
                   std::ostream& err) {
   Scenario s = load_scenario(name);
   if (options.steps) {
-    if (*options.steps < 1 || *options.steps > kMaxSteps) {
+    if (*options.steps < 1 || *options.steps > kMaxScenarioSteps) {
       throw std::invalid_argument("--steps " + std::to_string(*options.steps) +
-                                  " is out of range: must be in 1.." + std::to_string(kMaxSteps));
+                                  " is out of range: must be in 1.." +
+                                  std::to_string(kMaxScenarioSteps));
     }
     s.steps = *options.steps;
   }
@@ -512,58 +325,30 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
   // Before any computation: a second run into the same --out fails now, not after its work.
   std::optional<OutputDirectoryLock> out_lock;
   if (!options.out_dir.empty()) out_lock.emplace(options.out_dir);
-  const ModelInstance instance = scenario_model(s);
-  const AnyModel& model = instance.discrete;
 
-  Measurements data;
-  std::string source = "simulation";
-  if (options.data_file.empty()) {
-    data = simulate_scenario(s, model);
-    if (!data.stop_message.empty()) err << "nlobs: simulation " << data.stop_message << '\n';
-    if (data.steps() == 0) throw std::runtime_error("the simulation produced no samples");
-  } else {
-    data = read_measurements_csv(options.data_file, model.outputs(), model.inputs(),
-                                 options.allow_late);
-    source = options.data_file;
+  RunSettings settings;
+  settings.trace_first_window = !options.out_dir.empty();
+  if (!options.data_file.empty()) {
+    const AnyModel model = scenario_model(s).discrete;  // the scenario's own, not built again
+    settings.data = read_measurements_csv(options.data_file, model.outputs(), model.inputs(),
+                                          options.allow_late);
+    settings.data_source = options.data_file;
   }
-
+  PreparedScenario prepared = prepare_scenario(std::move(s), settings);
+  if (!prepared.data.stop_message.empty()) {
+    err << "nlobs: simulation " << prepared.data.stop_message << '\n';
+  }
   if (!options.sweep.empty()) {
-    long settle = -1;
-    if (s.settle_time >= 0.0) {
-      const double T = model.sample_time() > 0 ? model.sample_time() : 1.0;
-      settle = static_cast<long>(
-          std::min(std::ceil(s.settle_time / T - 1e-9), static_cast<double>(data.steps())));
-    }
-    run_sweep(s, instance, data, settle < 0 ? 0 : settle, options, out, err);
+    run_sweep(prepared.scenario, prepared.model, prepared.data, std::max(prepared.settle_index, 0L),
+              options, out, err);
     return;
   }
-  Eigen::Index longest = 1;
-  auto observers = make_observers(s, instance, !options.out_dir.empty());
-  for (const auto& o : observers) longest = std::max(longest, o->info().window);
-  if (longest > data.steps()) {
-    std::ostringstream os;
-    os << "a window of " << longest << " samples is longer than the data (" << data.steps()
-       << " samples)";
-    throw std::invalid_argument(os.str());
-  }
 
-  long settle_index = -1;
-  if (s.settle_time >= 0.0) {
-    const double T = model.sample_time() > 0 ? model.sample_time() : 1.0;
-    settle_index = static_cast<long>(
-        std::min(std::ceil(s.settle_time / T - 1e-9), static_cast<double>(data.steps())));
-  }
-  std::vector<std::string> warnings;
-  const nlohmann::json bounds = observer_reports(s, &warnings);
-  for (const auto& o : observers) {
-    for (const auto& w : o->info().warnings) warnings.push_back(w);
-  }
-  for (const auto& w : warnings) err << "nlobs: warning: " << w << '\n';
-
+  const std::string scenario_name = prepared.scenario.name;
   const auto start = std::chrono::steady_clock::now();
   auto last = start;
   bool printed = false;
-  RunResult r = run_observers(data, observers, settle_index, [&](long done, long total) {
+  settings.progress = [&](long done, long total) {
     const auto now = std::chrono::steady_clock::now();
     if (now - start < std::chrono::seconds(1) ||
         (now - last < std::chrono::milliseconds(250) && done < total)) {
@@ -571,36 +356,30 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
     }
     last = now;
     printed = true;
-    err << "\rnlobs run " << s.name << ": " << (100 * done / total) << "% of " << total
+    err << "\rnlobs run " << scenario_name << ": " << (100 * done / total) << "% of " << total
         << " observer steps" << std::flush;
-  });
+  };
+  // (The progress line ends before a warning the run finds is printed.)
+  settings.warning = [&err, &printed](const std::string& w) {
+    if (printed) err << '\n';
+    printed = false;
+    err << "nlobs: warning: " << w << '\n';
+  };
+  ScenarioRun run = run_prepared(std::move(prepared), settings);
   if (printed) err << '\n';
-  make_names_unique(r);
-  // What the run itself found (a window map that does not contract, a singular guess).
-  for (const auto& o : observers) {
-    for (const auto& w : o->info().warnings) {
-      if (std::find(warnings.begin(), warnings.end(), w) != warnings.end()) continue;
-      warnings.push_back(w);
-      err << "nlobs: warning: " << w << '\n';
-    }
-  }
-  add_coordinate_errors(data, observers, r);
-
-  std::vector<long> horizon_indices;  // the first sample with a full window, per observer
-  for (const auto& o : observers)
-    horizon_indices.push_back(static_cast<long>(o->info().window) - 1);
-  print_table(s, data, r, out);
-  print_modulating_metrics(r, horizon_indices, out);
-  print_bounds(bounds, out);
+  const Scenario& sc = run.prepared.scenario;
+  const Measurements& data = run.prepared.data;
+  print_table(sc, data, run.result, out);
+  print_modulating_metrics(run.result, run.horizon_indices, out);
+  print_bounds(run.observer_reports, out);
 
   if (!options.out_dir.empty()) {
     OutputDirectory dir(options.out_dir);  // summary.json removed: incomplete from here
     const std::vector<std::string> plots =
-        write_run_files(dir, s, data, r, plot_timeout(options), warnings, err);
+        write_run_files(dir, sc, data, run.result, plot_timeout(options), run.warnings, err);
     dir.remove_stale_files();
     // Last: summary.json marks a complete output directory.
-    dir.write("summary.json",
-              summary_json(s, data, r, source, bounds, warnings, horizon_indices).dump(2) + "\n");
+    dir.write("summary.json", summary_json(run).dump(2) + "\n");
     out << "wrote " << (dir.path() / "summary.json").string()
         << ", trajectories.csv, plot_data.csv, scenario.json";
     for (const auto& p : plots) out << ", " << p;

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "nlobs/observers/core/simulation.hpp"
+#include "nlobs/runs/scenario.hpp"
 #include "output_directory.hpp"
-#include "scenario.hpp"
 
 namespace nlobs::cli {
 

@@ -1,15 +1,15 @@
 # `cmake --install` produces a CMake package: find_package(nlobs) gives nlobs::solvers,
-# nlobs::models, nlobs::observers and nlobs::registry (and nlobs::common, which they share), the
+# nlobs::models, nlobs::observers, nlobs::registry and nlobs::runs (and nlobs::common, which they share), the
 # nlobs_add_plugin() function, and with COMPONENTS reference the reference solvers
 # (nlobs::reference: KINSOL, MINPACK, GSL and the suite runner).
 include(CMakePackageConfigHelpers)
 
-install(TARGETS nlobs_common nlobs_solvers nlobs_models nlobs_observers nlobs_registry
+install(TARGETS nlobs_common nlobs_solvers nlobs_models nlobs_observers nlobs_registry nlobs_runs
         EXPORT nlobsTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-foreach(layer common solvers models observers registry)
+foreach(layer common solvers models observers registry runs)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${layer}/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 endforeach()
 

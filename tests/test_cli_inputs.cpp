@@ -12,9 +12,9 @@
 #include <string>
 
 #include "data_file.hpp"
-#include "input_file.hpp"
 #include "nlobs/registry/json_reader.hpp"
-#include "scenario.hpp"
+#include "nlobs/runs/input_file.hpp"
+#include "nlobs/runs/scenario.hpp"
 
 namespace nlobs::cli {
 namespace {

@@ -12,9 +12,9 @@
 #include "nlobs/observers/baselines/baselines.hpp"
 #include "nlobs/registry/observer_types.hpp"
 #include "nlobs/registry/register_model.hpp"
+#include "nlobs/runs/scenario.hpp"
 #include "run_command.hpp"
 #include "run_support.hpp"
-#include "scenario.hpp"
 
 namespace nlobs::cli {
 namespace {

@@ -26,10 +26,10 @@
 #include "nlobs/common/printable.hpp"
 #include "nlobs/reference/problem_suite.hpp"
 #include "nlobs/registry/plugin.hpp"
+#include "nlobs/runs/scenario.hpp"
 #include "plugin_file.hpp"
 #include "run_command.hpp"
 #include "run_support.hpp"
-#include "scenario.hpp"
 
 namespace nlobs {
 namespace {
@@ -87,10 +87,10 @@ TEST(Plugins, APluginModelRunsWithTheObserverTypesItAdmitsAndAPluginEngine) {
   std::ifstream file(NLOBS_EXAMPLE_SCENARIO);
   ASSERT_TRUE(file) << NLOBS_EXAMPLE_SCENARIO;
   const nlohmann::json json = nlohmann::json::parse(file);
-  const cli::Scenario s = cli::parse_scenario(json, NLOBS_EXAMPLE_SCENARIO);
-  const ModelInstance model = cli::scenario_model(s);
-  const Measurements data = cli::simulate_scenario(s, model.discrete);
-  auto observers = cli::make_observers(s, model, false);
+  const Scenario s = parse_scenario(json, NLOBS_EXAMPLE_SCENARIO);
+  const ModelInstance model = scenario_model(s);
+  const Measurements data = simulate_scenario(s, model.discrete);
+  auto observers = make_observers(s, model, false);
   const RunResult r = run_observers(data, observers, 200);  // after 10 s, the settle time
   ASSERT_EQ(r.metrics.size(), 6u);
   for (const ObserverMetrics& m : r.metrics) {
@@ -115,8 +115,8 @@ TEST(Plugins, APluginModelRunsWithTheObserverTypesItAdmitsAndAPluginEngine) {
   nlohmann::json modulating = json;
   modulating["observers"] = nlohmann::json::parse(R"([{"type": "modulating"}])");
   try {
-    const cli::Scenario m = cli::parse_scenario(modulating, "modulating");
-    cli::make_observers(m, cli::scenario_model(m), false);
+    const Scenario m = parse_scenario(modulating, "modulating");
+    make_observers(m, scenario_model(m), false);
     ADD_FAILURE() << "the modulating observer accepted a model without a canonical form";
   } catch (const std::exception& e) {
     EXPECT_TRUE(contains(e.what(), "modulating on model 'fitzhugh-nagumo': no canonical form"))

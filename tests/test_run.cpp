@@ -23,9 +23,9 @@
 #include "nlobs/models/systems.hpp"
 #include "nlobs/observers/core/simulation.hpp"
 #include "nlobs/observers/pi/pi_bound.hpp"
+#include "nlobs/runs/scenario.hpp"
 #include "run_command.hpp"
 #include "run_support.hpp"
-#include "scenario.hpp"
 #include "short_tests.hpp"
 
 namespace nlobs::cli {

@@ -18,10 +18,10 @@
 #include "nlobs/registry/observer_types.hpp"
 #include "nlobs/registry/problem_sets.hpp"
 #include "nlobs/registry/register_model.hpp"
+#include "nlobs/runs/scenario.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 #include "run_command.hpp"
 #include "run_support.hpp"
-#include "scenario.hpp"
 #include "solve_chua_window.hpp"
 
 namespace nlobs::cli {

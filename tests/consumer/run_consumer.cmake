@@ -22,7 +22,8 @@ execute_process(COMMAND ${CMAKE_COMMAND} --build ${WORK_DIR}/build RESULT_VARIAB
 if(rc)
   message(FATAL_ERROR "building the consumer failed (${rc})")
 endif()
-foreach(program consumer consumer_engine_by_name consumer_window_estimator consumer_reference_suite)
+foreach(program consumer consumer_engine_by_name consumer_window_estimator consumer_reference_suite
+                consumer_scenario_run)
   execute_process(COMMAND ${WORK_DIR}/build/${program} RESULT_VARIABLE rc)
   if(rc)
     message(FATAL_ERROR "the consumer's ${program} ran but failed (${rc})")

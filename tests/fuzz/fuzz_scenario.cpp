@@ -10,22 +10,22 @@
 #include <string>
 
 #include "nlobs/registry/json_reader.hpp"
-#include "scenario.hpp"
+#include "nlobs/runs/scenario.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t size) {
   std::istringstream in(std::string(reinterpret_cast<const char*>(bytes), size));
-  nlobs::cli::Scenario scenario;
+  nlobs::Scenario scenario;
   try {
-    scenario = nlobs::cli::parse_scenario(nlobs::parse_json(in, "fuzz.json"), "fuzz.json");
+    scenario = nlobs::parse_scenario(nlobs::parse_json(in, "fuzz.json"), "fuzz.json");
   } catch (const std::invalid_argument&) {
     return 0;  // refused with a message: fine
   }
   // What was accepted round-trips (scenario.json in an output directory relies on it).
-  const nlohmann::json written = nlobs::cli::to_json(scenario);
-  const nlohmann::json again = nlobs::cli::to_json(nlobs::cli::parse_scenario(written, "again"));
+  const nlohmann::json written = nlobs::to_json(scenario);
+  const nlohmann::json again = nlobs::to_json(nlobs::parse_scenario(written, "again"));
   if (again != written) std::abort();
   try {
-    (void)nlobs::cli::scenario_model(scenario);
+    (void)nlobs::scenario_model(scenario);
   } catch (const std::invalid_argument&) {
     // a model that refuses its parameters: fine
   }

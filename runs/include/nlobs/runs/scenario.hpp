@@ -1,7 +1,10 @@
 #pragma once
-// Scenarios for `nlobs run`: built-in ones by name, or JSON files with the same fields
-// (docs/cli.md). Parsing is strict: an unknown key, a wrong type or a missing field is an
-// error naming the file and the key.
+// Scenarios: a model, a true initial state, the data's length, noise and input, and the observers
+// to run on it — built-in ones by name, or JSON files with the same fields (docs/cli.md,
+// "Scenario files"). Parsing is strict: an unknown key, a wrong type or a missing field is an
+// error naming the file and the key. The run layer's first part: a scenario is parsed (its
+// model built once, here) and then run by run_scenario (scenario_run.hpp); `nlobs run` and the
+// bindings call both.
 #include <Eigen/Core>
 #include <cstdint>
 #include <map>
@@ -13,14 +16,15 @@
 
 #include "nlobs/observers/core/any_model.hpp"
 #include "nlobs/observers/core/observer.hpp"
+#include "nlobs/observers/core/simulation.hpp"
 #include "nlobs/registry/model_registry.hpp"
 #include "nlobs/registry/observer_types.hpp"
 
-namespace nlobs::cli {
+namespace nlobs {
 
 // Samples of a run, checked before anything is allocated (n × steps doubles per observer are
 // kept).
-inline constexpr long kMaxSteps = 10'000'000;
+inline constexpr long kMaxScenarioSteps = 10'000'000;
 
 struct InputSpec {
   std::string kind = "zero";                // zero | constant | sin
@@ -46,6 +50,13 @@ struct Scenario {
   // Start of "after": metrics after the transient (MSE, max error) count t >= settle_time;
   // negative: after the longest window has filled.
   double settle_time = -1.0;
+  // The model parse_scenario built from `model` (to validate it), kept so that a run does not
+  // build it again; scenario_model() builds afresh when `model` has changed since.
+  struct BuiltModel {
+    nlohmann::json spec;  // the `model` it was built from
+    ModelInstance instance;
+  };
+  std::shared_ptr<const BuiltModel> built_model{};
 };
 
 std::vector<std::string> builtin_scenarios();
@@ -57,6 +68,9 @@ nlohmann::json to_json(const Scenario& scenario);
 // Builds the model and the observers a scenario describes. `trace_first_window`: window
 // estimators record the engine's trace of their first window (for the convergence plot).
 ModelInstance scenario_model(const Scenario& scenario);
+// The true system simulated (steps, noise, seed, input); a domain exit ends the data early with
+// Measurements::stop_message set.
+Measurements simulate_scenario(const Scenario& scenario, const AnyModel& model);
 std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& scenario,
                                                       const ModelInstance& model,
                                                       bool trace_first_window);
@@ -66,4 +80,4 @@ Eigen::VectorXd scenario_input(const Scenario& scenario, const AnyModel& model, 
 // channel the gains, N, the paper's δ and our ultimate bounds); warnings are appended.
 nlohmann::json observer_reports(const Scenario& scenario, std::vector<std::string>* warnings);
 
-}  // namespace nlobs::cli
+}  // namespace nlobs

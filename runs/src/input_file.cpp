@@ -1,4 +1,4 @@
-#include "input_file.hpp"
+#include "nlobs/runs/input_file.hpp"
 
 #include <cerrno>
 #include <cstring>
@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <system_error>
 
-namespace nlobs::cli {
+namespace nlobs {
 
 std::ifstream open_input_file(const std::string& path, const std::string& what) {
   namespace fs = std::filesystem;
@@ -31,4 +31,4 @@ std::ifstream open_input_file(const std::string& path, const std::string& what) 
   return in;
 }
 
-}  // namespace nlobs::cli
+}  // namespace nlobs

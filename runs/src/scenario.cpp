@@ -1,4 +1,4 @@
-#include "scenario.hpp"
+#include "nlobs/runs/scenario.hpp"
 
 #include <cmath>
 #include <filesystem>
@@ -8,11 +8,11 @@
 #include <stdexcept>
 #include <string>
 
-#include "input_file.hpp"
 #include "nlobs/common/printable.hpp"
 #include "nlobs/registry/json_reader.hpp"
+#include "nlobs/runs/input_file.hpp"
 
-namespace nlobs::cli {
+namespace nlobs {
 namespace {
 
 nlohmann::json vector_json(const Eigen::VectorXd& v) {
@@ -356,7 +356,10 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
   if (!r.has("model")) r.fail("missing field 'model'");
   auto model_spec = r.object("model");
   s.model = model_spec->json();
-  const ModelInstance instance = make_model_instance(*model_spec);  // validates now, naming keys
+  // Built now, to validate (naming keys), and kept for the run.
+  auto built = std::make_shared<const Scenario::BuiltModel>(
+      Scenario::BuiltModel{s.model, make_model_instance(*model_spec)});
+  const ModelInstance& instance = built->instance;
   const AnyModel& model = instance.discrete;
   s.x0 = r.required_vector("x0");
   s.initial_guess = r.required_vector("initial_guess");
@@ -366,7 +369,7 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
     r.fail("'x0' and 'initial_guess' must have " + std::to_string(model.states()) +
            " entries (the model's states)");
   }
-  if (auto v = r.integer("steps", 1, kMaxSteps)) s.steps = *v;
+  if (auto v = r.integer("steps", 1, kMaxScenarioSteps)) s.steps = *v;
   if (auto v = r.number("noise")) {
     if (*v < 0) r.fail("'noise' must be >= 0");
     s.noise = *v;
@@ -408,6 +411,7 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
   }
   r.finish({"name", "model", "x0", "initial_guess", "steps", "noise", "process_noise", "seed",
             "input", "observers", "reported", "settle_time"});
+  s.built_model = std::move(built);
   return s;
 }
 
@@ -434,8 +438,22 @@ nlohmann::json to_json(const Scenario& s) {
 }
 
 ModelInstance scenario_model(const Scenario& s) {
+  // The model parse_scenario built, unless the scenario's model has been edited since (a sweep
+  // over one of its parameters).
+  if (s.built_model && s.built_model->spec == s.model) return s.built_model->instance;
   JsonReader m(s.model, s.name + ".model");
   return make_model_instance(m);
+}
+
+Measurements simulate_scenario(const Scenario& s, const AnyModel& model) {
+  SimulationOptions sim;
+  sim.steps = s.steps;
+  sim.noise_std = s.noise;
+  sim.process_noise_std = s.process_noise;
+  sim.seed = s.seed;
+  sim.sample_time = model.sample_time() > 0 ? model.sample_time() : 1.0;
+  sim.input = [&s, &model](long k) { return scenario_input(s, model, k); };
+  return simulate(model, s.x0, sim);
 }
 
 Eigen::VectorXd scenario_input(const Scenario& s, const AnyModel& model, long k) {
@@ -480,4 +498,4 @@ nlohmann::json observer_reports(const Scenario& s, std::vector<std::string>* war
   return out;
 }
 
-}  // namespace nlobs::cli
+}  // namespace nlobs

@@ -4,9 +4,9 @@
 #include <fstream>
 #include <string>
 
-namespace nlobs::cli {
+namespace nlobs {
 
 // `what` says what the file is for ("data file", "scenario file"). Throws std::invalid_argument.
 std::ifstream open_input_file(const std::string& path, const std::string& what);
 
-}  // namespace nlobs::cli
+}  // namespace nlobs

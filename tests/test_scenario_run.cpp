@@ -1,0 +1,194 @@
+// The run layer (nlobs/runs/): a scenario parsed, prepared and run below the CLI. Its model is
+// built once (a model nlobs does not ship counts its builds); recorded data of the wrong shape is
+// refused naming what is wrong; warnings arrive once and in order; a run's result holds the
+// metrics summary.json reports; and `nlobs run` (the CLI) reports what the library returns.
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "nlobs/registry/register_model.hpp"
+#include "nlobs/runs/scenario_run.hpp"
+
+namespace nlobs {
+namespace {
+
+// x' = −a x + u-free, y = x: a decay nlobs does not ship.
+struct Decay : ModelSizes<1, 0, 1> {
+  double a = 0.5;
+  template <typename T>
+  State<T> vector_field(const State<T>& x, const Input&, double) const {
+    return State<T>(-a * x[0]);
+  }
+  template <typename T>
+  Output<T> h(const State<T>& x) const {
+    return x.template head<1>();
+  }
+};
+
+std::atomic<int> decay_builds{0};
+
+void register_counted_decay() {
+  static const bool done = [] {
+    ModelEntry entry = model_entry(ModelDefinition<Decay>{
+        .name = "counted-decay",
+        .description = "x' = -a x, y = x; counts its builds (test_scenario_run)",
+        .parameters = {{"a", "decay rate", [](Decay& m) -> double& { return m.a; }}}});
+    entry.make = [inner = entry.make](JsonReader& parameters, double step, Scheme scheme) {
+      ++decay_builds;
+      return inner(parameters, step, scheme);
+    };
+    model_registry().add(entry, "test_scenario_run");
+    return true;
+  }();
+  (void)done;
+}
+
+nlohmann::json decay_scenario() {
+  return {{"name", "decay-test"},
+          {"model", {{"name", "counted-decay"}, {"parameters", {{"a", 0.5}}}, {"step", 0.01}}},
+          {"x0", {2.0}},
+          {"initial_guess", {1.0}},
+          {"steps", 300},
+          {"noise", 0.001},
+          {"observers",
+           {{{"type", "ekf"},
+             {"process_covariance", {{1e-8}}},
+             {"measurement_covariance", {{1e-6}}},
+             {"initial_covariance", {{1.0}}}},
+            {{"type", "luenberger"}, {"gain", {0.3}}}}}};
+}
+
+TEST(ScenarioRun, TheModelIsBuiltOnceFromParseToResult) {
+  register_counted_decay();
+  const int before = decay_builds;
+  const Scenario s = parse_scenario(decay_scenario(), "decay-test");
+  EXPECT_EQ(decay_builds - before, 1);
+  const ScenarioRun run = run_scenario(s);
+  EXPECT_EQ(decay_builds - before, 1) << "the run built the model again";
+  ASSERT_EQ(run.result.metrics.size(), 2u);
+  EXPECT_LT(run.result.metrics[0].mse_after_window[0], 1e-4);  // the EKF tracks the decay
+
+  // A scenario whose model was edited since it was parsed builds the edited one.
+  Scenario edited = s;
+  edited.model["parameters"]["a"] = 2.0;
+  const ScenarioRun faster = run_scenario(edited);
+  EXPECT_EQ(decay_builds - before, 2);
+  // x(t) = 2 e^{-a t}: the truth at the last sample says which a was simulated.
+  const double t = faster.prepared.data.t[299];
+  EXPECT_NEAR(faster.prepared.data.x(0, 299), 2.0 * std::exp(-2.0 * t), 1e-6);
+}
+
+TEST(ScenarioRun, RecordedDataOfTheWrongShapeIsRefusedNamingIt) {
+  register_counted_decay();
+  const Scenario s = parse_scenario(decay_scenario(), "decay-test");
+  const auto error_of = [&](const Measurements& data) -> std::string {
+    try {
+      run_scenario(s, {.data = data, .data_source = "mine.csv"});
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "<no error>";
+  };
+  Measurements two_outputs;
+  two_outputs.y = Eigen::MatrixXd::Zero(2, 10);
+  two_outputs.t = Eigen::VectorXd::LinSpaced(10, 0.0, 0.09);
+  EXPECT_EQ(error_of(two_outputs), "the data from mine.csv has 2 outputs where the model has 1");
+  Measurements no_times;
+  no_times.y = Eigen::MatrixXd::Zero(1, 10);
+  EXPECT_EQ(error_of(no_times), "the data from mine.csv has not one time per sample");
+  Measurements empty;
+  empty.y = Eigen::MatrixXd::Zero(1, 0);
+  EXPECT_EQ(error_of(empty), "the data from mine.csv has no sample");
+  Measurements wrong_truth = two_outputs;
+  wrong_truth.y = Eigen::MatrixXd::Zero(1, 10);
+  wrong_truth.x = Eigen::MatrixXd::Zero(3, 10);
+  EXPECT_EQ(error_of(wrong_truth),
+            "the data from mine.csv has a true state that is not the model's 1 states at every "
+            "sample");
+
+  // Recorded data of the right shape, one output missing (NaN) and a huge value: a run, not a
+  // crash; no truth, so no error metrics.
+  Measurements recorded;
+  recorded.t = Eigen::VectorXd::LinSpaced(50, 0.0, 0.49);
+  recorded.y = (2.0 * (-0.5 * recorded.t.array()).exp()).matrix().transpose();
+  recorded.y(0, 7) = std::numeric_limits<double>::quiet_NaN();
+  recorded.y(0, 20) = 1e300;
+  const ScenarioRun run = run_scenario(s, {.data = recorded, .data_source = "mine.csv"});
+  EXPECT_EQ(run.prepared.source, "mine.csv");
+  EXPECT_EQ(run.result.estimates[0].cols(), 50);
+  const nlohmann::json summary = summary_json(run);
+  EXPECT_EQ(summary["source"], "mine.csv");
+  EXPECT_FALSE(summary["observers"][0].contains("mse"));
+}
+
+TEST(ScenarioRun, AWindowLongerThanTheDataIsRefusedBeforeTheRun) {
+  Scenario s = load_scenario("chua-fp");
+  s.steps = 4;  // ceres' window holds 6 samples
+  try {
+    run_scenario(s);
+    FAIL() << "ran";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("window of 6 samples is longer than the data (4"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(ScenarioRun, TheResultHoldsWhatSummaryJsonReports) {
+  Scenario s = load_scenario("chua-fp");
+  s.steps = 80;
+  std::vector<std::string> warned;
+  long last_done = 0, calls = 0;
+  const ScenarioRun run =
+      run_scenario(s, {.progress = [&](long done, long) { last_done = done, ++calls; },
+                       .warning = [&](const std::string& w) { warned.push_back(w); }});
+  EXPECT_EQ(warned, run.warnings);  // each once, in the order kept
+  EXPECT_GT(calls, 0);
+  EXPECT_EQ(last_done, 80 * static_cast<long>(s.observers.size()));
+  const nlohmann::json j = summary_json(run);
+  EXPECT_EQ(j["scenario"], "chua-fp");
+  EXPECT_EQ(j["steps"], 80);
+  EXPECT_EQ(j["source"], "simulation");
+  ASSERT_EQ(j["observers"].size(), s.observers.size());
+  for (std::size_t i = 0; i < s.observers.size(); ++i) {
+    const nlohmann::json& o = j["observers"][i];
+    EXPECT_EQ(o["name"], run.result.metrics[i].name);
+    ASSERT_EQ(o["mse"].size(), 3u);
+    for (Eigen::Index c = 0; c < 3; ++c) {
+      const double mse = run.result.metrics[i].mse[c];
+      if (std::isfinite(mse)) {
+        EXPECT_EQ(o["mse"][c].get<double>(), mse);
+      } else {
+        EXPECT_TRUE(o["mse"][c].is_null());
+      }
+    }
+  }
+  // The horizon index is each observer's window less one.
+  EXPECT_EQ(run.horizon_indices.size(), s.observers.size());
+}
+
+TEST(ScenarioRun, EmbeddedAndCanonicalMetricsComeWithTheObserversThatPublishThem) {
+  Scenario hg = load_scenario("hg-duffing");
+  hg.steps = 2000;
+  const nlohmann::json h = summary_json(run_scenario(hg));
+  bool embedded = false;
+  for (const auto& o : h["observers"]) embedded |= o.contains("max_zhat_norm");
+  EXPECT_TRUE(embedded);
+
+  Scenario mf = load_scenario("mf-lti");
+  mf.steps = 801;
+  const nlohmann::json m = summary_json(run_scenario(mf));
+  bool canonical = false;
+  for (const auto& o : m["observers"]) canonical |= o.contains("max_eta_rel_error_after_horizon");
+  EXPECT_TRUE(canonical);
+}
+
+}  // namespace
+}  // namespace nlobs
