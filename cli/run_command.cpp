@@ -334,10 +334,13 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
                                           options.allow_late);
     settings.data_source = options.data_file;
   }
-  PreparedScenario prepared = prepare_scenario(std::move(s), settings);
+  PreparedScenario prepared = prepare_scenario(std::move(s), std::move(settings));
   if (!prepared.data.stop_message.empty()) {
     err << "nlobs: simulation " << prepared.data.stop_message << '\n';
   }
+  if (prepared.data.steps() == 0) throw std::runtime_error("the simulation produced no samples");
+  settings = RunSettings{};
+  settings.trace_first_window = !options.out_dir.empty();
   if (!options.sweep.empty()) {
     run_sweep(prepared.scenario, prepared.model, prepared.data, std::max(prepared.settle_index, 0L),
               options, out, err);

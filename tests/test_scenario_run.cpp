@@ -98,10 +98,12 @@ TEST(ScenarioRun, RecordedDataOfTheWrongShapeIsRefusedNamingIt) {
   };
   Measurements two_outputs;
   two_outputs.y = Eigen::MatrixXd::Zero(2, 10);
+  two_outputs.u = Eigen::MatrixXd::Zero(0, 10);
   two_outputs.t = Eigen::VectorXd::LinSpaced(10, 0.0, 0.09);
   EXPECT_EQ(error_of(two_outputs), "the data from mine.csv has 2 outputs where the model has 1");
   Measurements no_times;
   no_times.y = Eigen::MatrixXd::Zero(1, 10);
+  no_times.u = Eigen::MatrixXd::Zero(0, 10);
   EXPECT_EQ(error_of(no_times), "the data from mine.csv has not one time per sample");
   Measurements empty;
   empty.y = Eigen::MatrixXd::Zero(1, 0);
@@ -115,8 +117,16 @@ TEST(ScenarioRun, RecordedDataOfTheWrongShapeIsRefusedNamingIt) {
 
   // Recorded data of the right shape, one output missing (NaN) and a huge value: a run, not a
   // crash; no truth, so no error metrics.
+  Measurements no_input_columns;  // u must have one (empty) column per sample, as simulate gives
+  no_input_columns.y = Eigen::MatrixXd::Zero(1, 10);
+  no_input_columns.t = Eigen::VectorXd::LinSpaced(10, 0.0, 0.09);
+  EXPECT_EQ(error_of(no_input_columns),
+            "the data from mine.csv has inputs u of 0x0 where the model's 0 inputs at 10 samples "
+            "need 0x10");
+
   Measurements recorded;
   recorded.t = Eigen::VectorXd::LinSpaced(50, 0.0, 0.49);
+  recorded.u = Eigen::MatrixXd::Zero(0, 50);
   recorded.y = (2.0 * (-0.5 * recorded.t.array()).exp()).matrix().transpose();
   recorded.y(0, 7) = std::numeric_limits<double>::quiet_NaN();
   recorded.y(0, 20) = 1e300;
@@ -126,6 +136,24 @@ TEST(ScenarioRun, RecordedDataOfTheWrongShapeIsRefusedNamingIt) {
   const nlohmann::json summary = summary_json(run);
   EXPECT_EQ(summary["source"], "mine.csv");
   EXPECT_FALSE(summary["observers"][0].contains("mse"));
+}
+
+TEST(ScenarioRun, ASimulationWithoutASampleIsRefusedWithItsStopMessage) {
+  // The lander's mass x3 starts below zero: the model leaves its domain at the first sample.
+  nlohmann::json j = to_json(load_scenario("pi-lander"));
+  j["x0"][2] = -1.0;
+  const Scenario s = parse_scenario(j, "pi-lander, no mass");
+  const PreparedScenario prepared = prepare_scenario(s);
+  EXPECT_EQ(prepared.data.steps(), 0);
+  ASSERT_FALSE(prepared.data.stop_message.empty());
+  try {
+    run_prepared(prepared);
+    FAIL() << "ran";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("the simulation produced no samples"), std::string::npos) << what;
+    EXPECT_NE(what.find(prepared.data.stop_message), std::string::npos) << what;
+  }
 }
 
 TEST(ScenarioRun, AWindowLongerThanTheDataIsRefusedBeforeTheRun) {
@@ -188,6 +216,20 @@ TEST(ScenarioRun, EmbeddedAndCanonicalMetricsComeWithTheObserversThatPublishThem
   bool canonical = false;
   for (const auto& o : m["observers"]) canonical |= o.contains("max_eta_rel_error_after_horizon");
   EXPECT_TRUE(canonical);
+}
+
+TEST(ScenarioRun, BuiltInScenariosAreTheirDataFilesReadAsAUsersFile) {
+  // Each built-in is runs/scenarios/NAME.json: its name inside is its file's, and the same file
+  // given by path reads to the same scenario.
+  const std::vector<std::string> names = builtin_scenarios();
+  ASSERT_EQ(names.size(), 13u);
+  for (const std::string& name : names) {
+    const Scenario builtin = load_scenario(name);
+    EXPECT_EQ(builtin.name, name);
+    EXPECT_FALSE(builtin.description.empty()) << name;
+    const Scenario file = load_scenario(std::string(NLOBS_SCENARIO_DIR) + "/" + name + ".json");
+    EXPECT_EQ(to_json(file), to_json(builtin)) << name;
+  }
 }
 
 }  // namespace

@@ -51,8 +51,12 @@ void check_data(const Measurements& data, const AnyModel& model, const std::stri
            std::to_string(model.outputs()));
   }
   if (data.t.size() != data.steps()) refuse("has not one time per sample");
-  if (model.inputs() > 0 && (data.u.rows() != model.inputs() || data.u.cols() != data.steps())) {
-    refuse("has not the model's " + std::to_string(model.inputs()) + " inputs at every sample");
+  // (A model without inputs takes u of 0 rows, one column per sample, as a simulation gives.)
+  if (data.u.rows() != model.inputs() || data.u.cols() != data.steps()) {
+    refuse("has inputs u of " + std::to_string(data.u.rows()) + "x" +
+           std::to_string(data.u.cols()) + " where the model's " + std::to_string(model.inputs()) +
+           " inputs at " + std::to_string(data.steps()) + " samples need " +
+           std::to_string(model.inputs()) + "x" + std::to_string(data.steps()));
   }
   if (data.has_truth() && (data.x.rows() != model.states() || data.x.cols() != data.steps())) {
     refuse("has a true state that is not the model's " + std::to_string(model.states()) +
@@ -116,22 +120,17 @@ nlohmann::json summary_json(const ScenarioRun& run) {
   return j;
 }
 
-PreparedScenario prepare_scenario(Scenario scenario, const RunSettings& settings) {
+PreparedScenario prepare_scenario(Scenario scenario, RunSettings settings) {
   ModelInstance instance = scenario_model(scenario);
   const AnyModel& model = instance.discrete;
   Measurements data;
   std::string source = "simulation";
   if (settings.data) {
     check_data(*settings.data, model, settings.data_source);
-    data = *settings.data;
-    source = settings.data_source;
+    data = std::move(*settings.data);  // (settings is the caller's copy, or moved in)
+    source = std::move(settings.data_source);
   } else {
-    data = simulate_scenario(scenario, model);
-    if (data.steps() == 0) {
-      throw std::runtime_error(
-          "the simulation produced no samples" +
-          (data.stop_message.empty() ? std::string() : " (" + data.stop_message + ")"));
-    }
+    data = simulate_scenario(scenario, model);  // no sample at all: run_prepared refuses it
   }
   const long settle_index = settle_index_of(scenario, model, data.steps());
   return PreparedScenario{std::move(scenario), std::move(instance), std::move(data),
@@ -139,6 +138,12 @@ PreparedScenario prepare_scenario(Scenario scenario, const RunSettings& settings
 }
 
 ScenarioRun run_prepared(PreparedScenario prepared, const RunSettings& settings) {
+  if (prepared.data.steps() == 0) {
+    throw std::runtime_error("the simulation produced no samples" +
+                             (prepared.data.stop_message.empty()
+                                  ? std::string()
+                                  : " (" + prepared.data.stop_message + ")"));
+  }
   ScenarioRun run{std::move(prepared), {}, nlohmann::json::array(), {}, {}};
   const Scenario& s = run.prepared.scenario;
   const Measurements& data = run.prepared.data;
@@ -177,8 +182,13 @@ ScenarioRun run_prepared(PreparedScenario prepared, const RunSettings& settings)
   return run;
 }
 
-ScenarioRun run_scenario(Scenario scenario, const RunSettings& settings) {
-  return run_prepared(prepare_scenario(std::move(scenario), settings), settings);
+ScenarioRun run_scenario(Scenario scenario, RunSettings settings) {
+  // The data, if any, moves into the prepared scenario; the callbacks stay for the run.
+  RunSettings prepare;
+  prepare.data = std::move(settings.data);
+  prepare.data_source = settings.data_source;
+  settings.data.reset();
+  return run_prepared(prepare_scenario(std::move(scenario), std::move(prepare)), settings);
 }
 
 }  // namespace nlobs

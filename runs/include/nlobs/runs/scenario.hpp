@@ -38,7 +38,8 @@ using ReportedFigures = std::map<std::string, std::map<std::string, double>>;
 
 struct Scenario {
   std::string name;
-  nlohmann::json model;  // {"name": ..., "parameters": {...}, "scheme": ..., "step": ...}
+  std::string description;  // where the scenario comes from (a paper's example), optional
+  nlohmann::json model;     // {"name": ..., "parameters": {...}, "scheme": ..., "step": ...}
   Eigen::VectorXd x0, initial_guess;
   long steps = 400;
   double noise = 0.0;
@@ -59,18 +60,23 @@ struct Scenario {
   std::shared_ptr<const BuiltModel> built_model{};
 };
 
+// The built-in scenarios' names: runs/scenarios/NAME.json, compiled in (and installed to
+// share/nlobs/scenarios/), read by the reader a user's file goes through.
 std::vector<std::string> builtin_scenarios();
 // A built-in name, or a path to a JSON file. Throws std::invalid_argument otherwise.
 Scenario load_scenario(const std::string& name_or_file);
 Scenario parse_scenario(const nlohmann::json& json, const std::string& where);
 nlohmann::json to_json(const Scenario& scenario);
 
-// Builds the model and the observers a scenario describes. `trace_first_window`: window
-// estimators record the engine's trace of their first window (for the convergence plot).
+// The scenario's model: the one parse_scenario built (shared by every copy of the Scenario and
+// every run of it: a model with mutable state of its own is not to be run from two threads at
+// once), or built afresh when `model` was edited since.
 ModelInstance scenario_model(const Scenario& scenario);
 // The true system simulated (steps, noise, seed, input); a domain exit ends the data early with
 // Measurements::stop_message set.
 Measurements simulate_scenario(const Scenario& scenario, const AnyModel& model);
+// The observers a scenario describes, on its model. `trace_first_window`: window estimators
+// record the engine's trace of their first window (for the convergence plot).
 std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& scenario,
                                                       const ModelInstance& model,
                                                       bool trace_first_window);

@@ -45,10 +45,11 @@ struct PreparedScenario {
 };
 
 // Builds the model (the one parse_scenario built, unless the scenario's model was edited) and
-// simulates, or takes settings.data after checking its sizes against the model. A simulation
-// that leaves the model's domain ends early with data.stop_message set; one that gives no
-// sample throws std::runtime_error.
-PreparedScenario prepare_scenario(Scenario scenario, const RunSettings& settings = {});
+// simulates, or takes settings.data (moved: pass the settings with std::move to keep one copy
+// of large data) after checking its sizes against the model. A simulation that leaves the
+// model's domain ends early with data.stop_message set (no sample at all: run_prepared
+// refuses it).
+PreparedScenario prepare_scenario(Scenario scenario, RunSettings settings = {});
 
 struct ScenarioRun {
   PreparedScenario prepared;
@@ -60,11 +61,12 @@ struct ScenarioRun {
   std::vector<long> horizon_indices;  // per observer, the first sample with a full window
 };
 
-// Runs every observer of the scenario on the prepared data. Throws std::invalid_argument when a
-// window is longer than the data, or an observer cannot be built (naming it).
+// Runs every observer of the scenario on the prepared data. Throws std::runtime_error when the
+// data has no sample (its stop message in the text), std::invalid_argument when a window is
+// longer than the data, or an observer cannot be built (naming it).
 ScenarioRun run_prepared(PreparedScenario prepared, const RunSettings& settings = {});
 // prepare_scenario, then run_prepared.
-ScenarioRun run_scenario(Scenario scenario, const RunSettings& settings = {});
+ScenarioRun run_scenario(Scenario scenario, RunSettings settings = {});
 
 // The run as summary.json holds it: per observer its metrics (MSE per state, iterations,
 // failures, the papers' figures where they apply), the scenario's settings and the warnings.

@@ -3,12 +3,14 @@
 // (PETSc's SNESLineSearch "bt" without the cubic fit, and "basic"; LBFGS++'s backtracking
 // policy): the trials t = t₀, ρ t₀, ρ² t₀, … (at most max_backtracks shrinks), the first
 // accepted ending the search:
-//   kBacktracking:  m(x(t)) ≤ min(m(x) + c δm(t), m(x))          (Armijo, [NW06] (3.4), [DS96]
-//   §6.3) kFullStep:      the first trial only, accepted where m is defined (no globalisation)
+//   kBacktracking  m(x(t)) ≤ min(m(x) + c δm(t), m(x))   (Armijo; [NW06] (3.4), [DS96] §6.3)
+//   kFullStep      the first trial only, accepted where m is defined (no globalisation)
 // δm(t) is the path's first-order change of m from x to x(t), ∇mᵀ(x(t) − x); for m = ‖F‖₂² and
 // the Newton step d = −J_F⁻¹F on x(t) = x + t d it is −2t‖F‖₂², the test in its usual form
 // ‖F(x + t d)‖₂² ≤ (1 − 2ct)‖F‖₂². The min keeps a path that does not descend (a projected one,
-// δm > 0) from raising m; with require_descent the search ends there instead.
+// δm > 0) from raising m; with require_descent the search ends there instead. (Where m is
+// within a factor 2 of the largest double, δm = −2t m overflows and no trial passes: ‖F‖₂ above
+// 9.5e153 for the engines on F, whose m = ‖F‖₂² overflows at 1.3e154 anyway.)
 //
 // The path is the caller's (a concept, as LBFGS++'s line search is a policy): the engines on F
 // (newton, broyden) take detail::ResidualPath (square_system.hpp), x(t) = P(x + t d) projected
@@ -52,7 +54,7 @@ struct LineSearch {
   };
   struct Result {
     Outcome outcome = Outcome::kNoDecrease;
-    double t = 0.0;      // the last trial's t (the accepted one's when accepted)
+    double t = 0.0;      // the accepted trial's t; otherwise where the search stopped
     double merit = 0.0;  // m(x(t)) at the last trial evaluated
     int trials = 0;      // evaluations of m
     bool accepted() const { return outcome == Outcome::kAccepted; }

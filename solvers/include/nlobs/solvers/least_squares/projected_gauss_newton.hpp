@@ -9,16 +9,16 @@
 // (Armijo on V, δV = 2gᵀ(z_α − z), a path that does not descend given up at once), and when that
 // path finds no decrease, along the scaled projected gradient d = −g ⊘ diag(H).
 //
-// Stop rules, in the order they are tested:
+// Stop rules:
+//   non_finite         V not finite at the start (the problem is left as it was)
+//   singular_jacobian  H not positive definite (by rounding only when W is definite)
 //   converged          before the search, the full projected step is small,
 //                      ‖Π(z + d) − z‖∞ ≤ step_tolerance (1 + ‖z‖∞), or its first-order decrease is
 //                      at V's rounding, −2gᵀ(Π(z + d) − z) ≤ cost_tolerance · V (where a line
-//                      search would fail for want of digits); after it, the step taken is small
-//                      (StopMonitor's relative step criterion, the same bound)
-//   max_iterations     StopMonitor's, after max_iterations linearisations
+//                      search would fail for want of digits); after it, the step taken meets the
+//                      same bound (‖z‖∞ before the step)
 //   stagnated          no decrease of V along either path
-//   singular_jacobian  H not positive definite (by rounding only when W is definite)
-//   non_finite         V not finite at the start (the problem is left as it was)
+//   max_iterations     StopMonitor's, after max_iterations linearisations
 // The Summary: iterations and jacobian_evaluations count the linearisations, function_evaluations
 // the evaluations of V, residual_norm is ‖g‖∞ projected at the last linearisation, objective V at
 // the answer, which is the lowest V found: a run cut short still lowered V from the start.
@@ -81,8 +81,8 @@ class ProjectedGaussNewton {
     options_.validate();
     criteria_.max_iterations =
         static_cast<int>(std::min<long>(options_.max_iterations, std::numeric_limits<int>::max()));
-    criteria_.step_tolerance = options_.step_tolerance;
-    criteria_.relative_step = true;
+    // The step tests are this solver's own (above): the monitor counts the iterations.
+    criteria_.step_tolerance.reset();
     // V falls at every accepted step (Armijo): the tests for runs that do not are moot here.
     criteria_.stagnation_patience = 0;
     criteria_.residual_window = 0;
@@ -171,8 +171,13 @@ Summary ProjectedGaussNewton::minimise(Problem& problem) const {
       }
       problem.accept();
       summary.step_norm = step;
-      // (‖g‖ is no residual that falls to 0 at a least-squares minimum: unknown to the monitor.)
-      status = monitor.update(step, std::numeric_limits<double>::quiet_NaN(), norm);
+      if (step <= options_.step_tolerance * (1.0 + norm)) {
+        status = Status::kConverged;
+      } else {
+        // (‖g‖ is no residual that falls to 0 at a least-squares minimum: unknown to the
+        // monitor.)
+        status = monitor.update(step, std::numeric_limits<double>::quiet_NaN(), norm);
+      }
     }
     summary.status = *status;
   }
