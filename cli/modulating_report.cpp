@@ -37,34 +37,27 @@ bool is_modulating_sweep(const std::string& key) {
   return key != "theta";
 }
 
-void run_modulating_sweep(const Scenario& s, const std::string& key,
-                          const std::vector<double>& values, const Measurements& data,
-                          long settle_index, const RunOptions& options, std::ostream& out,
-                          std::ostream& err) {
-  namespace fs = std::filesystem;
+void run_modulating_sweep(const PreparedScenario& prepared, const std::string& key,
+                          const std::vector<double>& values, const RunOptions& options,
+                          std::ostream& out, std::ostream& err) {
+  const Scenario& s = prepared.scenario;
+  const Measurements& data = prepared.data;
   const bool observer_key = key == "horizon" || key == "sample_period";
-  // The observers that take the key (the modulating ones); sample_period only where it is on.
-  const auto swept = [&](const ObserverSpec& o) {
-    return has_key(o, key) &&
-           (key != "sample_period" || observer_spec_json(o).value("sample_period", 0.0) > 0.0);
-  };
   if (observer_key && std::none_of(s.observers.begin(), s.observers.end(),
                                    [&](const ObserverSpec& o) { return has_key(o, key); })) {
     throw std::invalid_argument("--sweep " + key + " needs a modulating observer in the scenario");
   }
   if (observer_key && key == "sample_period" &&
-      std::none_of(s.observers.begin(), s.observers.end(), swept)) {
+      std::none_of(s.observers.begin(), s.observers.end(), [](const ObserverSpec& o) {
+        return has_key(o, "sample_period") &&
+               observer_spec_json(o).value("sample_period", 0.0) > 0.0;
+      })) {
     throw std::invalid_argument(
         "--sweep sample_period needs a modulating observer in sampled-data mode (sample_period "
         "> 0) in the scenario");
   }
   if (!data.has_truth()) throw std::invalid_argument("--sweep needs simulated data (the truth)");
-  if (key == "horizon" && data.steps() > 1) {
-    // Every row counts the same samples: those after the longest horizon has filled.
-    const double delta = data.t[1] - data.t[0];
-    const double longest = *std::max_element(values.begin(), values.end());
-    settle_index = std::max(settle_index, static_cast<long>(std::ceil(longest / delta - 1e-9)));
-  }
+  const SweepRun sweep = sweep_for_cli(prepared, key, values, {});
   std::ostringstream csv;
   csv << std::setprecision(10) << csv_field(key)
       << ",observer,x_rms_after,x2_rms_after,eta_rms_after,max_eta_rel_error_after_horizon,"
@@ -72,7 +65,7 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
          "max_eta_error_after_horizon\n";
   char line[320];
   out << "sweep over " << key << " on scenario " << s.name << " (noise sigma " << s.noise
-      << "); 'after' counts samples k >= " << settle_index
+      << "); 'after' counts samples k >= " << sweep.settle_index
       << "; converged: final relative eta error < 1e-3\n";
   std::snprintf(line, sizeof line, "%-10s %-22s %11s %11s %11s %11s %11s %11s %5s %9s\n",
                 key.c_str(), "observer", "x RMS", "x2 RMS", "eta RMS", "eta rel hor", "eta rel end",
@@ -85,55 +78,13 @@ void run_modulating_sweep(const Scenario& s, const std::string& key,
   };
   std::vector<Row> rows;
   std::vector<std::string> names;
-  for (double value : values) {
-    Scenario run = s;
-    Measurements local;
-    const Measurements* d = &data;
-    if (!observer_key) run.model["parameters"][key] = value;
-    const std::string which = "--sweep " + key + " = " + fmt(value, "%g") + ": ";
-    const auto named = [&](auto&& build) {
-      try {
-        return build();
-      } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument(which + e.what());
-      }
-    };
-    const ModelInstance instance = named([&] {
-      try {
-        return scenario_model(run);
-      } catch (const std::invalid_argument& e) {
-        if (observer_key) throw;
-        throw std::invalid_argument(std::string(e.what()) +
-                                    " (a sweep key is theta, horizon, sample_period or a "
-                                    "parameter of the scenario's model)");
-      }
-    });
-    if (observer_key) {
-      for (size_t i = 0; i < run.observers.size(); ++i) {
-        ObserverSpec& o = run.observers[i];
-        if (!swept(o)) continue;
-        o = named([&] {
-          return with_key(o, key, value, instance,
-                          s.name + ".observers[" + std::to_string(i) + "]");
-        });
-      }
-    } else {
-      local = simulate_scenario(run, instance.discrete);
-      if (!local.stop_message.empty()) {
-        throw std::runtime_error(which + "simulation " + local.stop_message);
-      }
-      d = &local;
-    }
-    auto observers = named([&] { return make_observers(run, instance, false); });
-    RunResult r = run_observers(*d, observers, settle_index);
-    make_names_unique(r);
-    add_coordinate_errors(*d, observers, r);
-    if (names.empty()) {
-      for (const ObserverMetrics& m : r.metrics) names.push_back(m.name);
-    }
-    for (size_t i = 0; i < observers.size(); ++i) {
+  for (const ObserverMetrics& m : sweep.values.front().result.metrics) names.push_back(m.name);
+  for (const SweepValue& v : sweep.values) {
+    const double value = v.value;
+    const RunResult& r = v.result;
+    for (size_t i = 0; i < r.metrics.size(); ++i) {
       const ObserverMetrics& m = r.metrics[i];
-      const auto mm = modulating_metrics(r, i, static_cast<long>(observers[i]->info().window) - 1);
+      const auto mm = modulating_metrics(r, i, v.horizon_indices[i]);
       const double x_rms =
           m.mse_after_window.size() ? std::sqrt(m.mse_after_window.sum()) : std::nan("");
       const double x2_rms =

@@ -12,6 +12,7 @@
 #include "nlobs/observers/core/simulation.hpp"
 #include "nlobs/runs/run_metrics.hpp"
 #include "nlobs/runs/scenario.hpp"
+#include "nlobs/runs/scenario_run.hpp"
 #include "run_command.hpp"
 
 namespace nlobs::cli {
@@ -22,9 +23,8 @@ void print_modulating_metrics(const RunResult& r, const std::vector<long>& horiz
 // --sweep horizon=…, sample_period=… (the modulating observers' keys) or PARAMETER=… (the
 // model's, re-simulating the data per value). Writes sweep.csv, sweep.dat, sweep.png with --out.
 bool is_modulating_sweep(const std::string& key);
-void run_modulating_sweep(const Scenario& s, const std::string& key,
-                          const std::vector<double>& values, const Measurements& data,
-                          long settle_index, const RunOptions& options, std::ostream& out,
-                          std::ostream& err);
+void run_modulating_sweep(const PreparedScenario& prepared, const std::string& key,
+                          const std::vector<double>& values, const RunOptions& options,
+                          std::ostream& out, std::ostream& err);
 
 }  // namespace nlobs::cli

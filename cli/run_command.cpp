@@ -20,6 +20,7 @@
 #include "nlobs/observers/core/simulation.hpp"
 #include "nlobs/runs/scenario.hpp"
 #include "nlobs/runs/scenario_run.hpp"
+#include "nlobs/runs/sweep.hpp"
 #include "run_outputs.hpp"
 #include "run_support.hpp"
 
@@ -154,6 +155,21 @@ bool have_gnuplot() {
   return find_gnuplot().has_value();
 }
 
+SweepRun sweep_for_cli(const PreparedScenario& prepared, const std::string& key,
+                       const std::vector<double>& values, const SweepSettings& settings) {
+  const auto flag = [](const std::exception& e) {
+    const std::string what = e.what();
+    return what.rfind("sweep ", 0) == 0 ? "--" + what : what;
+  };
+  try {
+    return run_sweep(prepared, key, values, settings);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(flag(e));
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(flag(e));
+  }
+}
+
 std::vector<double> parse_sweep_values(const std::string& key, const std::string& list,
                                        bool positive) {
   std::vector<double> values;
@@ -180,9 +196,11 @@ namespace {
 
 // --sweep theta=v1,v2,…: the high_gain observers once per θ on the same data ([HG-EMB23]'s
 // peaking/noise trade-off: peaking grows as θ shrinks, noise amplification too). Other keys
-// are the modulating-function sweeps (modulating_report.cpp).
-void run_sweep(const Scenario& s, const ModelInstance& model, const Measurements& data,
-               long settle_index, const RunOptions& options, std::ostream& out, std::ostream& err) {
+// are the modulating-function table (modulating_report.cpp); both run the library's sweep.
+void run_sweep(const PreparedScenario& prepared, const RunOptions& options, std::ostream& out,
+               std::ostream& err) {
+  const Scenario& s = prepared.scenario;
+  const Measurements& data = prepared.data;
   const std::string& spec = options.sweep;
   const auto eq = spec.find('=');
   if (eq == std::string::npos || eq == 0) {
@@ -193,53 +211,38 @@ void run_sweep(const Scenario& s, const ModelInstance& model, const Measurements
     // horizon and sample_period: > 0; a model parameter (the disturbance level a_max) may be 0.
     const std::vector<double> values =
         parse_sweep_values(key, spec.substr(eq + 1), key == "horizon" || key == "sample_period");
-    run_modulating_sweep(s, key, values, data, settle_index, options, out, err);
+    run_modulating_sweep(prepared, key, values, options, out, err);
     return;
   }
   const std::vector<double> values = parse_sweep_values(key, spec.substr(eq + 1), true);
-  Scenario only = s;
-  only.observers.clear();
-  std::vector<size_t> index;  // of each swept observer in the scenario, for messages
-  for (size_t i = 0; i < s.observers.size(); ++i) {
-    if (!has_key(s.observers[i], "theta")) continue;
-    only.observers.push_back(s.observers[i]);
-    index.push_back(i);
-  }
-  if (only.observers.empty()) {
+  if (std::none_of(s.observers.begin(), s.observers.end(),
+                   [](const ObserverSpec& o) { return has_key(o, "theta"); })) {
     throw std::invalid_argument("--sweep theta needs a high_gain observer in the scenario");
   }
   if (!data.has_truth()) throw std::invalid_argument("--sweep needs simulated data (the truth)");
+  const SweepRun sweep = sweep_for_cli(prepared, key, values, {.only_swept_observers = true});
   std::ostringstream csv;
   csv << std::setprecision(10)
       << "theta,observer,max_zhat_norm,z_rms_after,x_rms_after,time_to_z_1e-6,jumps,"
          "failures,us_per_step\n";
   char line[256];
   out << "sweep over theta on scenario " << s.name << " (noise sigma " << s.noise
-      << "); 'after' counts samples k >= " << settle_index << "\n";
+      << "); 'after' counts samples k >= " << sweep.settle_index << "\n";
   std::snprintf(line, sizeof line, "%-8s %-20s %12s %12s %12s %14s %6s %9s\n", "theta", "observer",
                 "max||zhat||", "z RMS after", "x RMS after", "z<1e-6 from", "jumps", "us/step");
   out << line;
   std::vector<std::string> names;
+  for (const ObserverMetrics& m : sweep.values.front().result.metrics) names.push_back(m.name);
   struct Row {
     double theta;
     std::string name;
     double peak, z_rms, x_rms;
   };
   std::vector<Row> rows;
-  for (double theta : values) {
-    Scenario run = only;
-    for (size_t i = 0; i < run.observers.size(); ++i) {
-      run.observers[i] = with_key(run.observers[i], "theta", theta, model,
-                                  s.name + ".observers[" + std::to_string(index[i]) + "]");
-    }
-    auto observers = make_observers(run, model, false);
-    RunResult r = run_observers(data, observers, settle_index);
-    make_names_unique(r);
-    add_coordinate_errors(data, observers, r);
-    if (names.empty()) {
-      for (const ObserverMetrics& m : r.metrics) names.push_back(m.name);
-    }
-    for (size_t i = 0; i < observers.size(); ++i) {
+  for (const SweepValue& v : sweep.values) {
+    const double theta = v.value;
+    const RunResult& r = v.result;
+    for (size_t i = 0; i < r.metrics.size(); ++i) {
       const auto em = embedded_metrics(r, i);
       const ObserverMetrics& m = r.metrics[i];
       // RMS of ‖x − x̂‖₂: the per-state mean squares summed over the states.
@@ -342,8 +345,7 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
   settings = RunSettings{};
   settings.trace_first_window = !options.out_dir.empty();
   if (!options.sweep.empty()) {
-    run_sweep(prepared.scenario, prepared.model, prepared.data, std::max(prepared.settle_index, 0L),
-              options, out, err);
+    run_sweep(prepared, options, out, err);
     return;
   }
 

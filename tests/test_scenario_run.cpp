@@ -15,6 +15,7 @@
 
 #include "nlobs/registry/register_model.hpp"
 #include "nlobs/runs/scenario_run.hpp"
+#include "nlobs/runs/sweep.hpp"
 
 namespace nlobs {
 namespace {
@@ -229,6 +230,72 @@ TEST(ScenarioRun, BuiltInScenariosAreTheirDataFilesReadAsAUsersFile) {
     EXPECT_FALSE(builtin.description.empty()) << name;
     const Scenario file = load_scenario(std::string(NLOBS_SCENARIO_DIR) + "/" + name + ".json");
     EXPECT_EQ(to_json(file), to_json(builtin)) << name;
+  }
+}
+
+TEST(Sweep, AnyObserverKeyIsSweptOnTheSameData) {
+  // The sliding-mode observer's gamma: a key no sweep knew by name before (chua-fp).
+  Scenario s = load_scenario("chua-fp");
+  s.steps = 60;
+  const PreparedScenario prepared = prepare_scenario(s);
+  const SweepRun sweep = run_sweep(prepared, "gamma", {5.0, 20.0});
+  EXPECT_FALSE(sweep.model_parameter);
+  ASSERT_EQ(sweep.swept.size(), 1u);
+  EXPECT_EQ(s.observers[sweep.swept[0]].type, "sliding_mode");
+  EXPECT_EQ(sweep.run.size(), s.observers.size());  // every observer runs
+  ASSERT_EQ(sweep.values.size(), 2u);
+  const std::size_t smo = sweep.swept[0];
+  // Only the swept observer's result depends on the value.
+  const RunResult& a = sweep.values[0].result;
+  const RunResult& b = sweep.values[1].result;
+  EXPECT_NE(a.metrics[smo].mse[0], b.metrics[smo].mse[0]);
+  EXPECT_EQ(a.metrics[0].mse[0], b.metrics[0].mse[0]);  // window:picard, untouched
+  // Only the swept ones, when asked.
+  const SweepRun only = run_sweep(prepared, "gamma", {5.0}, {.only_swept_observers = true});
+  ASSERT_EQ(only.values[0].result.metrics.size(), 1u);
+  EXPECT_EQ(only.values[0].result.metrics[0].mse[0], a.metrics[smo].mse[0]);
+}
+
+TEST(Sweep, AModelParameterIsSimulatedAgainPerValue) {
+  register_counted_decay();
+  const PreparedScenario prepared =
+      prepare_scenario(parse_scenario(decay_scenario(), "decay-test"));
+  const SweepRun sweep = run_sweep(prepared, "a", {0.5, 2.0});
+  EXPECT_TRUE(sweep.model_parameter);
+  EXPECT_TRUE(sweep.swept.empty());
+  ASSERT_EQ(sweep.values.size(), 2u);
+  // The faster decay is tracked from an initial error that vanishes sooner: lower MSE.
+  EXPECT_LT(sweep.values[1].result.metrics[0].mse[0], sweep.values[0].result.metrics[0].mse[0]);
+}
+
+TEST(Sweep, HostileSweepsAreRefusedNamingKeyAndValue) {
+  register_counted_decay();
+  const PreparedScenario prepared =
+      prepare_scenario(parse_scenario(decay_scenario(), "decay-test"));
+  const auto error_of = [&](const std::string& key, const std::vector<double>& values) {
+    try {
+      run_sweep(prepared, key, values);
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string("<no error>");
+  };
+  EXPECT_EQ(error_of("a", {}), "sweep a: no values");
+  EXPECT_EQ(error_of("a", {std::numeric_limits<double>::quiet_NaN()}),
+            "sweep a: the value nan is not finite");
+  const std::string unknown = error_of("no_such", {1.0});
+  EXPECT_EQ(unknown.rfind("sweep no_such = 1: ", 0), 0u) << unknown;
+  EXPECT_NE(unknown.find("or a parameter of its model"), std::string::npos) << unknown;
+  // A rate the model refuses, or a huge one whose simulation leaves the doubles: named.
+  EXPECT_EQ(error_of("a", {1e300}).rfind("sweep a = 1e+300: ", 0), 0u) << error_of("a", {1e300});
+
+  PreparedScenario recorded = prepared;
+  recorded.data.x.resize(0, 0);  // no truth
+  try {
+    run_sweep(recorded, "a", {1.0});
+    FAIL() << "swept";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "sweep needs simulated data (the truth)");
   }
 }
 

@@ -1,0 +1,118 @@
+#include "nlobs/runs/sweep.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+#include "nlobs/registry/observer_types.hpp"
+#include "nlobs/runs/run_metrics.hpp"
+
+namespace nlobs {
+namespace {
+
+std::string value_text(double v) {
+  std::ostringstream os;
+  os << v;  // as %g
+  return os.str();
+}
+
+}  // namespace
+
+SweepRun run_sweep(const PreparedScenario& prepared, const std::string& key,
+                   const std::vector<double>& values, const SweepSettings& settings) {
+  const Scenario& s = prepared.scenario;
+  const Measurements& data = prepared.data;
+  if (values.empty()) throw std::invalid_argument("sweep " + key + ": no values");
+  for (const double v : values) {
+    if (!std::isfinite(v)) {
+      throw std::invalid_argument("sweep " + key + ": the value " + value_text(v) +
+                                  " is not finite");
+    }
+  }
+  if (!data.has_truth()) throw std::invalid_argument("sweep needs simulated data (the truth)");
+
+  SweepRun sweep;
+  sweep.key = key;
+  const auto takes = [&](const ObserverSpec& o) { return has_key(o, key); };
+  sweep.model_parameter = std::none_of(s.observers.begin(), s.observers.end(), takes);
+  for (std::size_t i = 0; i < s.observers.size(); ++i) {
+    const ObserverSpec& o = s.observers[i];
+    const bool given = takes(o) && (key != "sample_period" ||
+                                    observer_spec_json(o).value("sample_period", 0.0) > 0.0);
+    if (given) sweep.swept.push_back(i);
+    if (given || !settings.only_swept_observers || sweep.model_parameter) sweep.run.push_back(i);
+  }
+  if (!sweep.model_parameter && sweep.swept.empty()) {
+    throw std::invalid_argument("sweep " + key +
+                                ": no observer of the scenario has it on (sample_period > 0)");
+  }
+  sweep.settle_index = std::max(prepared.settle_index, 0L);
+  if (key == "horizon" && data.steps() > 1) {
+    // Every value counts the same samples: those after the longest horizon has filled.
+    const double delta = data.t[1] - data.t[0];
+    const double longest = *std::max_element(values.begin(), values.end());
+    sweep.settle_index =
+        std::max(sweep.settle_index, static_cast<long>(std::ceil(longest / delta - 1e-9)));
+  }
+
+  for (const double value : values) {
+    const std::string which = "sweep " + key + " = " + value_text(value) + ": ";
+    const auto named = [&](auto&& build) {
+      try {
+        return build();
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(which + e.what());
+      }
+    };
+    Scenario run = s;
+    run.observers.clear();
+    for (const std::size_t i : sweep.run) run.observers.push_back(s.observers[i]);
+    Measurements simulated;
+    const Measurements* d = &data;
+    const ModelInstance* model = &prepared.model;
+    std::optional<ModelInstance> edited;
+    if (sweep.model_parameter) {
+      run.model["parameters"][key] = value;
+      edited = named([&] {
+        try {
+          return scenario_model(run);
+        } catch (const std::invalid_argument& e) {
+          throw std::invalid_argument(
+              std::string(e.what()) +
+              " (a sweep key is a key the scenario's observers take — theta, horizon, "
+              "sample_period, … — or a parameter of its model)");
+        }
+      });
+      model = &*edited;
+      simulated = simulate_scenario(run, edited->discrete);
+      if (!simulated.stop_message.empty()) {
+        throw std::runtime_error(which + "simulation " + simulated.stop_message);
+      }
+      d = &simulated;
+    } else {
+      for (std::size_t j = 0; j < sweep.run.size(); ++j) {
+        const std::size_t i = sweep.run[j];
+        if (std::find(sweep.swept.begin(), sweep.swept.end(), i) == sweep.swept.end()) continue;
+        run.observers[j] = named([&] {
+          return with_key(run.observers[j], key, value, *model,
+                          s.name + ".observers[" + std::to_string(i) + "]");
+        });
+      }
+    }
+    auto observers = named([&] { return make_observers(run, *model, false); });
+    SweepValue v;
+    v.value = value;
+    v.result = run_observers(*d, observers, sweep.settle_index);
+    make_names_unique(v.result);
+    add_coordinate_errors(*d, observers, v.result);
+    for (const auto& o : observers)
+      v.horizon_indices.push_back(static_cast<long>(o->info().window) - 1);
+    sweep.values.push_back(std::move(v));
+  }
+  return sweep;
+}
+
+}  // namespace nlobs
