@@ -20,8 +20,8 @@
 // to 1e-9).
 //
 // The solver (ProjectedGaussNewton, nlobs/solvers/least_squares/projected_gauss_newton.hpp, its
-// stop rules and Summary there): Gauss–Newton on V, this class giving the block-tridiagonal
-// linear algebra (HorizonProblem below), with a projected backtracking line search and, with
+// stop rules and Summary there): Gauss–Newton on V, its block-tridiagonal linear algebra
+// MheHorizonProblem's (horizon_problem.hpp), with a projected backtracking line search and, with
 // bounds, the projected Newton method of [Ber82]. Warm start: the previous solution shifted by
 // one sample, the new state predicted by the model. real_time_iteration takes one iteration per
 // sample ([DBS05]). A step whose V is not finite at the warm start keeps the last estimate. The
@@ -67,7 +67,7 @@
 #include "nlobs/observers/core/option_checks.hpp"
 #include "nlobs/observers/core/sample_clock.hpp"
 #include "nlobs/observers/mhe/arrival_cost.hpp"
-#include "nlobs/observers/mhe/block_tridiagonal.hpp"
+#include "nlobs/observers/mhe/horizon_problem.hpp"
 #include "nlobs/observers/mhe/mhe_options.hpp"
 #include "nlobs/solvers/least_squares/projected_gauss_newton.hpp"
 #include "nlobs/solvers/summary.hpp"
@@ -112,16 +112,8 @@ class MheEstimator final : public Observer {
 
     const auto h = static_cast<std::size_t>(options_.horizon);
     nodes_.reserve(h + 1);  // a late sample is inserted before the oldest leaves
-    diag_.assign(h, StateMatrix::Zero(n, n));
-    sub_.assign(h, StateMatrix::Zero(n, n));
-    grad_.assign(h, State::Zero(n));
-    direction_.assign(h, State::Zero(n));
-    trial_.assign(h, State::Zero(n));
-    f_jac_.assign(h, StateMatrix::Zero(n, n));
-    h_jac_.assign(h, OutputJacobian::Zero(p, n));
-    w_res_.assign(h, State::Zero(n));
-    y_res_.assign(h, Output::Zero(p));
-    solver_.reserve(options_.horizon, n);
+    problem_.emplace(q_inv_, lower_, upper_, h, n, p);
+    chain_states_.assign(h, State::Zero(n));
     missing_ = Eigen::VectorXd::Constant(p, kMissing);
 
     info_.name = options_.name;
@@ -194,17 +186,7 @@ class MheEstimator final : public Observer {
   }
 
  private:
-  struct Node {
-    long k = 0;
-    double t = 0.0;
-    Output y;            // the measured outputs; 0 where missing
-    Output measured;     // 1 where y was measured, 0 where missing
-    OutputMatrix r_inv;  // R⁻¹ of the outputs measured; zero rows and columns where missing
-    Input u;             // held from t to the next sample's time
-    ModelStep next;      // the model's move to the next sample (w weighted by next.weight)
-    State x;             // the horizon's current estimate of this sample's state
-    State filtered;      // x̂_{i|i}: the estimate from the samples up to this one
-  };
+  using Node = MheNode<Model>;
   static constexpr double kMissing = std::numeric_limits<double>::quiet_NaN();
   // The longest part of an interval a late sample may split into grid steps (each a node), in
   // sample times: beyond it the late sample is dropped, so that its cost stays bounded.
@@ -430,8 +412,6 @@ class MheEstimator final : public Observer {
     nodes_.back().filtered = estimate_;
   }
 
-  State predict(const Node& node) const { return advance(model_, node.x, node.u, node.next); }
-
   // A node of a gap while no node of the horizon holds a measurement: V's minimiser is then the
   // model's prediction from x̄ (V = 0 there) whenever it stays in the bounds and the domain, and
   // Gauss–Newton from the warm start would stop at it after one linearisation. It is taken
@@ -450,15 +430,16 @@ class MheEstimator final : public Observer {
     const std::size_t m = nodes_.size();
     const std::size_t first = chain_ && nodes_.front().x == arrival_.mean() ? m - 1 : 0;
     for (std::size_t i = first; i < m; ++i) {
-      trial_[i] = i == 0 ? arrival_.mean()
-                         : advance(model_, i == first ? nodes_[i - 1].x : trial_[i - 1],
-                                   nodes_[i - 1].u, nodes_[i - 1].next);
-      if (!usable(trial_[i])) {
+      chain_states_[i] = i == 0
+                             ? arrival_.mean()
+                             : advance(model_, i == first ? nodes_[i - 1].x : chain_states_[i - 1],
+                                       nodes_[i - 1].u, nodes_[i - 1].next);
+      if (!usable(chain_states_[i])) {
         chain_ = false;
         return false;
       }
     }
-    for (std::size_t i = first; i < m; ++i) nodes_[i].x = trial_[i];
+    for (std::size_t i = first; i < m; ++i) nodes_[i].x = chain_states_[i];
     chain_ = true;
     Summary summary;
     summary.engine = ProjectedGaussNewton::kName;
@@ -486,132 +467,12 @@ class MheEstimator final : public Observer {
 
   bool inside_domain(const State& x) const { return domain_violation_of(model_, x).empty(); }
 
-  // V at the states xs[0..M−1] of the problem's first M = active_ nodes (+inf when a term is not
-  // finite or a state leaves the model's domain).
-  double cost(const std::vector<State>& xs) const {
-    const std::size_t m = active_;
-    double v = arrival_.cost(xs[0]);
-    for (std::size_t i = 0; i < m; ++i) {
-      if (!inside_domain(xs[i])) return std::numeric_limits<double>::infinity();
-      const Output e = nodes_[i].y - Output(model_.h(xs[i]));
-      v += e.dot(nodes_[i].r_inv * e);
-      if (i + 1 < m) {
-        const State w = xs[i + 1] - advance(model_, xs[i], nodes_[i].u, nodes_[i].next);
-        v += w.dot(q_inv_ * w) / nodes_[i].next.weight;
-      }
-    }
-    return std::isfinite(v) ? v : std::numeric_limits<double>::infinity();
-  }
-
-  // The Gauss–Newton system at the current states: diag_, sub_ (H) and grad_ (∇(V/2)).
-  void linearise() {
-    const std::size_t m = active_;
-    for (std::size_t i = 0; i < m; ++i) {
-      const Node& node = nodes_[i];
-      if (i + 1 < m) state_jacobian(model_, node.x, node.u, node.next, f_jac_[i]);
-      output_jacobian(model_, node.x, h_jac_[i]);
-      y_res_[i] = node.y - Output(model_.h(node.x));
-      const Output ry = node.r_inv * y_res_[i];
-      diag_[i].noalias() = h_jac_[i].transpose() * (node.r_inv * h_jac_[i]);
-      grad_[i].noalias() = -h_jac_[i].transpose() * ry;
-    }
-    diag_[0] += arrival_.information();
-    grad_[0].noalias() += arrival_.information() * (nodes_[0].x - arrival_.mean());
-    for (std::size_t i = 0; i + 1 < m; ++i) {
-      // The move's noise is weight · Q (an interval off the grid): its inverse weighs the term.
-      const double scale = 1.0 / nodes_[i].next.weight;
-      w_res_[i] = nodes_[i + 1].x - predict(nodes_[i]);
-      const State qw = scale * (q_inv_ * w_res_[i]);
-      sub_[i].noalias() = -scale * (q_inv_ * f_jac_[i]);
-      diag_[i].noalias() -= f_jac_[i].transpose() * sub_[i];
-      diag_[i + 1] += scale * q_inv_;
-      grad_[i].noalias() -= f_jac_[i].transpose() * qw;
-      grad_[i + 1] += qw;
-    }
-  }
-
-  // Holds the states at a bound whose gradient points out of the box ([Ber82]): their rows and
-  // columns of H become the identity's, their gradient 0, so that the step leaves them. Returns
-  // the projected gradient's ‖·‖∞.
-  double hold_active_bounds() {
-    const std::size_t m = active_;
-    double projected = 0.0;
-    for (std::size_t i = 0; i < m; ++i) {
-      for (Eigen::Index c = 0; c < model_.states(); ++c) {
-        const double x = nodes_[i].x[c], g = grad_[i][c];
-        if ((x <= lower_[c] && g > 0.0) || (x >= upper_[c] && g < 0.0)) {
-          diag_[i].row(c).setZero();
-          diag_[i].col(c).setZero();
-          diag_[i](c, c) = 1.0;
-          grad_[i][c] = 0.0;
-          if (i + 1 < m) sub_[i].col(c).setZero();
-          if (i > 0) sub_[i - 1].row(c).setZero();
-        } else {
-          projected = std::max(projected, std::abs(g));
-        }
-      }
-    }
-    return projected;
-  }
-
-  // trial_ = Π(x + α d); returns ∇(V/2)ᵀ(trial − x) and the step's ‖·‖∞.
-  std::pair<double, double> project_step(double alpha) {
-    double slope = 0.0, step = 0.0;
-    for (std::size_t i = 0; i < active_; ++i) {
-      trial_[i] = (nodes_[i].x + alpha * direction_[i]).cwiseMax(lower_).cwiseMin(upper_);
-      const State s = trial_[i] - nodes_[i].x;
-      slope += grad_[i].dot(s);
-      step = std::max(step, s.cwiseAbs().maxCoeff());
-    }
-    return {slope, step};
-  }
-
-  double states_norm() const {
-    double norm = 0.0;
-    for (std::size_t i = 0; i < active_; ++i) {
-      norm = std::max(norm, nodes_[i].x.cwiseAbs().maxCoeff());
-    }
-    return norm;
-  }
-
-  // The horizon's problem for ProjectedGaussNewton: z = the states of the first active_ nodes.
-  struct HorizonProblem {
-    MheEstimator& mhe;
-    double start_cost() {
-      for (std::size_t i = 0; i < mhe.active_; ++i) mhe.trial_[i] = mhe.nodes_[i].x;
-      return mhe.cost(mhe.trial_);
-    }
-    double linearise() {
-      mhe.linearise();
-      return mhe.hold_active_bounds();
-    }
-    bool newton_direction() {
-      const std::size_t m = mhe.active_;
-      for (std::size_t i = 0; i < m; ++i) mhe.direction_[i] = -mhe.grad_[i];
-      if (!mhe.solver_.factor(mhe.diag_, mhe.sub_, m)) return false;
-      mhe.solver_.solve(mhe.direction_, m);
-      return true;
-    }
-    void gradient_direction() {
-      for (std::size_t i = 0; i < mhe.active_; ++i) {
-        mhe.direction_[i] = -mhe.grad_[i].cwiseQuotient(mhe.diag_[i].diagonal());
-      }
-    }
-    std::pair<double, double> project(double alpha) { return mhe.project_step(alpha); }
-    double trial_cost() { return mhe.cost(mhe.trial_); }
-    void accept() {
-      for (std::size_t i = 0; i < mhe.active_; ++i) mhe.nodes_[i].x = mhe.trial_[i];
-    }
-    double norm() const { return mhe.states_norm(); }
-  };
-
   // Minimises V over the first m nodes (their states left at the answer) and returns the
   // Summary, V in its objective; a V not finite at the warm start marks the step.
   Summary solve(long k, std::size_t m) {
-    active_ = m;
     chain_ = false;
-    HorizonProblem problem{*this};
-    Summary summary = gauss_newton_.minimise(problem);
+    problem_->bind(model_, nodes_, m, arrival_);
+    Summary summary = gauss_newton_.minimise(*problem_);
     if (summary.status == Status::kNonFinite) {
       std::ostringstream os;
       os << name() << ": the cost V at sample k = " << k << " is not finite at the warm start "
@@ -631,13 +492,9 @@ class MheEstimator final : public Observer {
   ArrivalCost<Model> arrival_;
   State estimate_;
   std::vector<Node> nodes_;  // the horizon's samples, oldest first
-  // Gauss–Newton workspace, one entry per sample of the horizon.
-  std::vector<StateMatrix> diag_, sub_, f_jac_;
-  std::vector<OutputJacobian> h_jac_;
-  std::vector<State> grad_, direction_, trial_, w_res_;
-  std::vector<Output> y_res_;
-  detail::BlockTridiagonalCholesky<Model::kStates> solver_;
-  std::size_t active_ = 0;  // the nodes of the problem being solved (the first active_)
+  // V over the horizon's nodes and its Gauss–Newton algebra (horizon_problem.hpp).
+  std::optional<MheHorizonProblem<Model>> problem_;
+  std::vector<State> chain_states_;  // predict_unmeasured_horizon()'s prediction chain
   // The nodes' states are the model's prediction chain from x̄ (predict_unmeasured_horizon()).
   bool chain_ = false;
   SampleClock clock_ = SampleClock::of(model_, "", true);
