@@ -1,9 +1,8 @@
-// Solves the modified-Chua window problem through the installed headers and libraries. The
-// window comes in through the previous release's flat path, a forwarding header that must stay
-// installed and compiling for one release (docs/observers.md, "Header layout").
+// Solves the modified-Chua window problem through the installed headers and libraries (the
+// grouped path of the window family: docs/observers.md, "Header layout").
 #include <cstdio>
 #include <nlobs/models/modified_chua.hpp>
-#include <nlobs/observers/window_problems.hpp>
+#include <nlobs/observers/window/window_problems.hpp>
 #include <nlobs/solvers/solvers.hpp>
 
 int main() {
