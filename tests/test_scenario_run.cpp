@@ -106,6 +106,11 @@ TEST(ScenarioRun, RecordedDataOfTheWrongShapeIsRefusedNamingIt) {
   no_times.y = Eigen::MatrixXd::Zero(1, 10);
   no_times.u = Eigen::MatrixXd::Zero(0, 10);
   EXPECT_EQ(error_of(no_times), "the data from mine.csv has not one time per sample");
+  Measurements nan_time = no_times;
+  nan_time.t = Eigen::VectorXd::LinSpaced(10, 0.0, 0.09);
+  nan_time.t[4] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(error_of(nan_time),
+            "the data from mine.csv has a time that is not a finite number at sample 4");
   Measurements empty;
   empty.y = Eigen::MatrixXd::Zero(1, 0);
   EXPECT_EQ(error_of(empty), "the data from mine.csv has no sample");

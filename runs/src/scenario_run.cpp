@@ -51,6 +51,11 @@ void check_data(const Measurements& data, const AnyModel& model, const std::stri
            std::to_string(model.outputs()));
   }
   if (data.t.size() != data.steps()) refuse("has not one time per sample");
+  for (Eigen::Index k = 0; k < data.t.size(); ++k) {
+    if (!std::isfinite(data.t[k])) {
+      refuse("has a time that is not a finite number at sample " + std::to_string(k));
+    }
+  }
   // (A model without inputs takes u of 0 rows, one column per sample, as a simulation gives.)
   if (data.u.rows() != model.inputs() || data.u.cols() != data.steps()) {
     refuse("has inputs u of " + std::to_string(data.u.rows()) + "x" +

@@ -54,8 +54,10 @@ SweepRun run_sweep(const PreparedScenario& prepared, const std::string& key,
     // Every value counts the same samples: those after the longest horizon has filled.
     const double delta = data.t[1] - data.t[0];
     const double longest = *std::max_element(values.begin(), values.end());
-    sweep.settle_index =
-        std::max(sweep.settle_index, static_cast<long>(std::ceil(longest / delta - 1e-9)));
+    // (At most the data's length: a horizon of 1e300 s is no index.)
+    const double filled =
+        std::min(std::ceil(longest / delta - 1e-9), static_cast<double>(data.steps()));
+    sweep.settle_index = std::max(sweep.settle_index, static_cast<long>(filled));
   }
 
   for (const double value : values) {
