@@ -29,8 +29,9 @@ struct RunSettings {
   bool trace_first_window = false;
   // Called with (observer steps done, total) as the run goes; empty: none.
   std::function<void(long done, long total)> progress{};
-  // Called with each warning once, as it is found (an observer type's report, an observer's
-  // own, the run's); they are also kept in the result.
+  // Called with each warning as it is found: those of the observer types' reports and the
+  // observers' own before the run (as they come, a repeated one repeated), then those the run
+  // finds (not one given before); they are also kept in the result, in that order.
   std::function<void(const std::string&)> warning{};
 };
 
