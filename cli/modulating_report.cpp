@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <iomanip>
 #include <ostream>
 #include <sstream>
@@ -41,7 +40,6 @@ void run_modulating_sweep(const PreparedScenario& prepared, const std::string& k
                           const std::vector<double>& values, const RunOptions& options,
                           std::ostream& out, std::ostream& err) {
   const Scenario& s = prepared.scenario;
-  const Measurements& data = prepared.data;
   const bool observer_key = key == "horizon" || key == "sample_period";
   if (observer_key && std::none_of(s.observers.begin(), s.observers.end(),
                                    [&](const ObserverSpec& o) { return has_key(o, key); })) {
@@ -56,8 +54,8 @@ void run_modulating_sweep(const PreparedScenario& prepared, const std::string& k
         "--sweep sample_period needs a modulating observer in sampled-data mode (sample_period "
         "> 0) in the scenario");
   }
-  if (!data.has_truth()) throw std::invalid_argument("--sweep needs simulated data (the truth)");
-  const SweepRun sweep = sweep_for_cli(prepared, key, values, {});
+  // (Data without the truth: the library's refusal, "--sweep needs simulated data (the truth)".)
+  const SweepRun sweep = run_sweep(prepared, key, values, {.label = "--sweep"});
   std::ostringstream csv;
   csv << std::setprecision(10) << csv_field(key)
       << ",observer,x_rms_after,x2_rms_after,eta_rms_after,max_eta_rel_error_after_horizon,"

@@ -4,13 +4,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <ostream>
-#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -25,11 +22,6 @@
 #include "run_support.hpp"
 
 namespace nlobs::cli {
-namespace {
-
-namespace fs = std::filesystem;
-
-}  // namespace
 
 std::string fmt(double v, const char* f) {
   if (!std::isfinite(v)) return "-";
@@ -155,21 +147,6 @@ bool have_gnuplot() {
   return find_gnuplot().has_value();
 }
 
-SweepRun sweep_for_cli(const PreparedScenario& prepared, const std::string& key,
-                       const std::vector<double>& values, const SweepSettings& settings) {
-  const auto flag = [](const std::exception& e) {
-    const std::string what = e.what();
-    return what.rfind("sweep ", 0) == 0 ? "--" + what : what;
-  };
-  try {
-    return run_sweep(prepared, key, values, settings);
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(flag(e));
-  } catch (const std::runtime_error& e) {
-    throw std::runtime_error(flag(e));
-  }
-}
-
 std::vector<double> parse_sweep_values(const std::string& key, const std::string& list,
                                        bool positive) {
   std::vector<double> values;
@@ -219,8 +196,9 @@ void run_sweep(const PreparedScenario& prepared, const RunOptions& options, std:
                    [](const ObserverSpec& o) { return has_key(o, "theta"); })) {
     throw std::invalid_argument("--sweep theta needs a high_gain observer in the scenario");
   }
-  if (!data.has_truth()) throw std::invalid_argument("--sweep needs simulated data (the truth)");
-  const SweepRun sweep = sweep_for_cli(prepared, key, values, {.only_swept_observers = true});
+  // (Data without the truth: the library's refusal, "--sweep needs simulated data (the truth)".)
+  const SweepRun sweep =
+      run_sweep(prepared, key, values, {.only_swept_observers = true, .label = "--sweep"});
   std::ostringstream csv;
   csv << std::setprecision(10)
       << "theta,observer,max_zhat_norm,z_rms_after,x_rms_after,time_to_z_1e-6,jumps,"

@@ -27,10 +27,6 @@ std::string fmt(double v, const char* f = "%.3e");  // "-" for non-finite values
 bool have_gnuplot();                                // on PATH (gnuplot.hpp)
 // RunOptions::plot_timeout as a duration (validated by run_scenario: > 0, at most a day).
 std::chrono::milliseconds plot_timeout(const RunOptions& options);
-// The library's sweep (nlobs/runs/sweep.hpp), its messages in the CLI's terms ("--sweep KEY = v:
-// …").
-SweepRun sweep_for_cli(const PreparedScenario& prepared, const std::string& key,
-                       const std::vector<double>& values, const SweepSettings& settings);
 // "v1,v2,…" of `--sweep key=…`: finite numbers (> 0 when `positive`), at least one.
 std::vector<double> parse_sweep_values(const std::string& key, const std::string& list,
                                        bool positive);

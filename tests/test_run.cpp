@@ -480,6 +480,12 @@ TEST(Run, RecordedDataWithMissingSamplesAndNoTruth) {
     EXPECT_FALSE(o.contains("mse")) << o.dump();  // no truth: no MSE
   }
   EXPECT_EQ(summary["observers"][0]["failures"]["missing_measurement"], 1);
+  // A sweep compares with the truth: recorded data is refused (the run layer's refusal, named
+  // with the CLI's flag).
+  const std::string no_truth =
+      error_of("chua-fp", {.data_file = data.string(), .sweep = "gamma=5,20"});
+  EXPECT_NE(no_truth.find("--sweep needs simulated data (the truth)"), std::string::npos)
+      << no_truth;
 
   write(data, "t,y1\n0,1.0\n0.05,abc\n");
   const std::string e = error_of("chua-fp", {.data_file = data.string()});

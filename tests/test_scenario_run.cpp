@@ -204,24 +204,30 @@ TEST(ScenarioRun, TheResultHoldsWhatSummaryJsonReports) {
       }
     }
   }
-  // The horizon index is each observer's window less one.
-  EXPECT_EQ(run.horizon_indices.size(), s.observers.size());
+  // The horizon index is each observer's window less one: ceres' window holds 6 samples; the
+  // Luenberger observer has none (window 0), so −1 (the metrics read it as 0).
+  ASSERT_EQ(run.horizon_indices.size(), s.observers.size());
+  EXPECT_EQ(run.result.metrics[5].name, "window:ceres,N=6");
+  EXPECT_EQ(run.horizon_indices[5], 5);
+  EXPECT_EQ(run.result.metrics[6].name, "luenberger");
+  EXPECT_EQ(run.horizon_indices[6], -1);
+}
+
+// Some observer of the built-in scenario `name`, run for `steps` samples, reports `key`.
+bool some_observer_reports(const std::string& name, long steps, const std::string& key) {
+  Scenario s = load_scenario(name);
+  s.steps = steps;
+  const nlohmann::json summary = summary_json(run_scenario(s));
+  for (const auto& o : summary["observers"]) {
+    if (o.contains(key)) return true;
+  }
+  return false;
 }
 
 TEST(ScenarioRun, EmbeddedAndCanonicalMetricsComeWithTheObserversThatPublishThem) {
-  Scenario hg = load_scenario("hg-duffing");
-  hg.steps = 2000;
-  const nlohmann::json h = summary_json(run_scenario(hg));
-  bool embedded = false;
-  for (const auto& o : h["observers"]) embedded |= o.contains("max_zhat_norm");
-  EXPECT_TRUE(embedded);
-
-  Scenario mf = load_scenario("mf-lti");
-  mf.steps = 801;
-  const nlohmann::json m = summary_json(run_scenario(mf));
-  bool canonical = false;
-  for (const auto& o : m["observers"]) canonical |= o.contains("max_eta_rel_error_after_horizon");
-  EXPECT_TRUE(canonical);
+  EXPECT_TRUE(some_observer_reports("hg-duffing", 2000, "max_zhat_norm"));
+  EXPECT_TRUE(some_observer_reports("mf-lti", 801, "max_eta_rel_error_after_horizon"));
+  EXPECT_FALSE(some_observer_reports("chua-fp", 60, "max_zhat_norm"));  // no high-gain observer
 }
 
 TEST(ScenarioRun, BuiltInScenariosAreTheirDataFilesReadAsAUsersFile) {

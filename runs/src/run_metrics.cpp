@@ -84,6 +84,19 @@ void add_coordinate_errors(const Measurements& data,
   }
 }
 
+RunResult measure_observers(const Measurements& data,
+                            std::vector<std::unique_ptr<Observer>>& observers, long settle_index,
+                            std::vector<long>& horizon_indices,
+                            const std::function<void(long done, long total)>& progress) {
+  RunResult r = run_observers(data, observers, settle_index, progress);
+  make_names_unique(r);
+  add_coordinate_errors(data, observers, r);
+  horizon_indices.clear();
+  for (const auto& o : observers)
+    horizon_indices.push_back(static_cast<long>(o->info().window) - 1);
+  return r;
+}
+
 std::optional<EmbeddedMetrics> embedded_metrics(const RunResult& r, std::size_t i) {
   const auto& info = r.signal_info[i];
   const auto error_row = signal_row(info, SignalKind::kEmbeddedError);

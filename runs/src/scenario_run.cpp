@@ -174,15 +174,11 @@ ScenarioRun run_prepared(PreparedScenario prepared, const RunSettings& settings)
   if (settings.warning) {
     for (const auto& w : run.warnings) settings.warning(w);
   }
-  run.result = run_observers(data, observers, run.prepared.settle_index, settings.progress);
-  make_names_unique(run.result);
+  run.result = measure_observers(data, observers, run.prepared.settle_index, run.horizon_indices,
+                                 settings.progress);
   // What the run itself found (a window map that does not contract, a singular guess).
   for (const auto& o : observers) {
     for (const auto& w : o->info().warnings) warn(w);
-  }
-  add_coordinate_errors(data, observers, run.result);
-  for (const auto& o : observers) {
-    run.horizon_indices.push_back(static_cast<long>(o->info().window) - 1);
   }
   return run;
 }

@@ -25,14 +25,15 @@ SweepRun run_sweep(const PreparedScenario& prepared, const std::string& key,
                    const std::vector<double>& values, const SweepSettings& settings) {
   const Scenario& s = prepared.scenario;
   const Measurements& data = prepared.data;
-  if (values.empty()) throw std::invalid_argument("sweep " + key + ": no values");
+  if (values.empty()) throw std::invalid_argument(settings.label + " " + key + ": no values");
   for (const double v : values) {
     if (!std::isfinite(v)) {
-      throw std::invalid_argument("sweep " + key + ": the value " + value_text(v) +
+      throw std::invalid_argument(settings.label + " " + key + ": the value " + value_text(v) +
                                   " is not finite");
     }
   }
-  if (!data.has_truth()) throw std::invalid_argument("sweep needs simulated data (the truth)");
+  if (!data.has_truth())
+    throw std::invalid_argument(settings.label + " needs simulated data (the truth)");
 
   SweepRun sweep;
   sweep.key = key;
@@ -46,7 +47,7 @@ SweepRun run_sweep(const PreparedScenario& prepared, const std::string& key,
     if (given || !settings.only_swept_observers || sweep.model_parameter) sweep.run.push_back(i);
   }
   if (!sweep.model_parameter && sweep.swept.empty()) {
-    throw std::invalid_argument("sweep " + key +
+    throw std::invalid_argument(settings.label + " " + key +
                                 ": no observer of the scenario has it on (sample_period > 0)");
   }
   sweep.settle_index = std::max(prepared.settle_index, 0L);
@@ -61,7 +62,7 @@ SweepRun run_sweep(const PreparedScenario& prepared, const std::string& key,
   }
 
   for (const double value : values) {
-    const std::string which = "sweep " + key + " = " + value_text(value) + ": ";
+    const std::string which = settings.label + " " + key + " = " + value_text(value) + ": ";
     const auto named = [&](auto&& build) {
       try {
         return build();
@@ -107,11 +108,7 @@ SweepRun run_sweep(const PreparedScenario& prepared, const std::string& key,
     auto observers = named([&] { return make_observers(run, *model, false); });
     SweepValue v;
     v.value = value;
-    v.result = run_observers(*d, observers, sweep.settle_index);
-    make_names_unique(v.result);
-    add_coordinate_errors(*d, observers, v.result);
-    for (const auto& o : observers)
-      v.horizon_indices.push_back(static_cast<long>(o->info().window) - 1);
+    v.result = measure_observers(*d, observers, sweep.settle_index, v.horizon_indices);
     sweep.values.push_back(std::move(v));
   }
   return sweep;

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -28,6 +29,14 @@ void make_names_unique(RunResult& r);
 // "eta_norm", kCanonicalNorm). A second call adds nothing.
 void add_coordinate_errors(const Measurements& data,
                            const std::vector<std::unique_ptr<Observer>>& observers, RunResult& r);
+
+// run_observers (simulation.hpp) and what the run layer adds to its result, for a run and for
+// each value of a sweep alike: names made unique, the coordinate errors above, and into
+// `horizon_indices` each observer's window less one (its first sample with a full window).
+RunResult measure_observers(const Measurements& data,
+                            std::vector<std::unique_ptr<Observer>>& observers, long settle_index,
+                            std::vector<long>& horizon_indices,
+                            const std::function<void(long done, long total)>& progress = {});
 
 // Per observer with an embedded error signal (kEmbeddedError, add_coordinate_errors): what
 // [HG-EMB23]'s figures show.

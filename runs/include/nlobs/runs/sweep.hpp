@@ -23,6 +23,8 @@ struct SweepSettings {
   // Run only the observers given the value (an observer key): the others' rows would repeat
   // for every value.
   bool only_swept_observers = false;
+  // How the messages name the sweep ("sweep theta = 0.1: …"; `nlobs run` says "--sweep").
+  std::string label = "sweep";
 };
 
 struct SweepValue {
@@ -40,7 +42,7 @@ struct SweepRun {
   std::vector<SweepValue> values;  // in the order given
 };
 
-// Throws std::invalid_argument naming the key (and the value, "sweep KEY = v: …", for what one
+// Throws std::invalid_argument naming the key (and the value, "LABEL KEY = v: …", for what one
 // value's run refuses): no values, a value that is not finite, data without the truth (a sweep
 // compares with it), a key that no observer takes and the model has no parameter of; and
 // std::runtime_error when a re-simulation leaves the model's domain.

@@ -13,6 +13,17 @@
 #include "nlobs/observers/core/model_step.hpp"
 
 namespace nlobs {
+namespace detail {
+
+// M⁻¹ of a symmetric positive definite M (validated covariances, or P⁻¹ + Hᵀ R⁻¹ H).
+template <typename Matrix>
+Matrix spd_inverse(const Matrix& m) {
+  Matrix out = Matrix::Identity(m.rows(), m.cols());
+  m.llt().solveInPlace(out);
+  return out;
+}
+
+}  // namespace detail
 
 template <DiscreteModel Model>
 class ArrivalCost {
@@ -42,9 +53,7 @@ class ArrivalCost {
     StateMatrix updated = covariance_;  // nothing measured: P⁺ = P
     if (measured) {
       output_jacobian(model, filtered, hj);
-      const StateMatrix information = information_ + hj.transpose() * r_inv * hj;
-      updated = StateMatrix::Identity(n, n);
-      information.llt().solveInPlace(updated);
+      updated = detail::spd_inverse(StateMatrix(information_ + hj.transpose() * r_inv * hj));
     }
     StateMatrix covariance = fj * updated * fj.transpose() + move.weight * q;
     covariance = 0.5 * (covariance + covariance.transpose());

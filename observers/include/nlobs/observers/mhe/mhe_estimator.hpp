@@ -99,9 +99,9 @@ class MheEstimator final : public Observer {
     p0_ = c.initial;
     q_ = c.process;
     r_ = c.measurement;
-    q_inv_ = inverse(q_);
-    r_inv_ = inverse(r_);
-    p0_inv_ = inverse(p0_);
+    q_inv_ = detail::spd_inverse(q_);
+    r_inv_ = detail::spd_inverse(r_);
+    p0_inv_ = detail::spd_inverse(p0_);
     const double inf = std::numeric_limits<double>::infinity();
     lower_ = options_.lower_bounds.size() ? State(options_.lower_bounds) : State::Constant(n, -inf);
     upper_ = options_.upper_bounds.size() ? State(options_.upper_bounds) : State::Constant(n, inf);
@@ -192,14 +192,6 @@ class MheEstimator final : public Observer {
   // sample times: beyond it the late sample is dropped, so that its cost stays bounded.
   static constexpr double kLongestLateSplit = 1e4;
 
-  // M⁻¹ of a symmetric positive definite M (validated options, or P = F P⁺ Fᵀ + Q).
-  template <typename Matrix>
-  static Matrix inverse(const Matrix& m) {
-    Matrix out = Matrix::Identity(m.rows(), m.cols());
-    m.llt().solveInPlace(out);
-    return out;
-  }
-
   // "The same instant" for sample times: within the rounding of recorded times.
   double same_instant() const {
     const double step = clock_.sample_time();
@@ -220,7 +212,7 @@ class MheEstimator final : public Observer {
     const std::vector<Eigen::Index> rows = measured_outputs(y);
     if (rows.empty()) return;
     const Eigen::MatrixXd r_measured = r_(rows, rows);
-    const Eigen::MatrixXd inv = inverse(r_measured);
+    const Eigen::MatrixXd inv = detail::spd_inverse(r_measured);
     node.r_inv(rows, rows) = inv;
   }
 
