@@ -110,11 +110,16 @@ void print_list(const std::string& what, std::ostream& out) {
     out << '\n';
     for (const auto& o : e.options)
       out << "      " << with_aliases(o) << ": " << o.description << '\n';
+    if (!e.without_common.empty()) {
+      out << "      not taken of the options of every engine:";
+      for (const auto& key : e.without_common) out << ' ' << key;
+      out << '\n';
+    }
     out << "      e.g.";
     for (const auto& x : e.examples) out << ' ' << x;
     out << '\n';
   }
-  out << "  options of every engine:";
+  out << "  options of every engine (unless an engine says otherwise):";
   for (const auto& o : EngineRegistry<Dynamic>::global().common_options()) {
     out << "\n      " << with_aliases(o) << ": " << o.description;
   }

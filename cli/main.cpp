@@ -19,6 +19,7 @@
 #include "nlobs/common/printable.hpp"
 #include "nlobs/common/version.hpp"
 #include "nlobs/reference/problem_suite.hpp"
+#include "nlobs/reference/reference_engines.hpp"
 #include "nlobs/registry/plugin.hpp"
 #include "nlobs/registry/problem_sets.hpp"
 #include "nlobs/runs/scenario.hpp"
@@ -235,8 +236,10 @@ int run_command_line(int argc, char** argv) {
   nlobs::cli::install_interrupt_cleanup();
 
   try {
-    // Plugins first: their models, engines, observer types and problem sets are then names like
-    // the built-ins' everywhere below. A refused plugin stops the run (kRunError).
+    // The reference engines (KINSOL, MINPACK, GSL, PETSc) are engines by name everywhere below;
+    // then plugins: their models, engines, observer types and problem sets are names like the
+    // built-ins'. A refused plugin stops the run (kRunError).
+    nlobs::reference::register_reference_engines();
     if (const char* path = std::getenv("NLOBS_PLUGIN_PATH"); path != nullptr && *path != '\0') {
       nlobs::load_plugin_path(path);
     }

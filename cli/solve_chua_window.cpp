@@ -9,7 +9,7 @@
 #include <stdexcept>
 
 #include "nlobs/common/printable.hpp"
-#include "nlobs/reference/kinsol_adapter.hpp"
+#include "nlobs/reference/reference_engines.hpp"
 #include "nlobs/reference/timing.hpp"
 #include "nlobs/registry/problem_sets/chua_window_set.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
@@ -17,25 +17,30 @@
 namespace nlobs::cli {
 namespace {
 
-using reference::KinsolStrategy;
-
-std::string kinsol_status(const reference::KinsolResult& r) {
-  if (r.flag_name == "KIN_MAXITER_REACHED") return "max_iterations";
-  std::string s = r.status();
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
-  return s;
+// `spec` as the row runs it: KINSOL (any kinsol engine) gets --tol as its fnormtol and
+// scsteptol, as the engines get it as their step and residual tolerances.
+std::string with_tolerance(const std::string& spec, double tol) {
+  if (spec.rfind("kinsol", 0) != 0 || spec.find("residual_tolerance") != std::string::npos) {
+    return spec;
+  }
+  char value[32];
+  std::snprintf(value, sizeof value, "%.17g", tol);
+  return spec + (spec.find(':') == std::string::npos ? ":" : ",") + "residual_tolerance=" + value;
 }
 
+// One row: any engine by name, KINSOL's among them (reference_engines.hpp), at size 3 (the
+// reference engines through the registry's Dynamic fallback).
 SolveRow run_engine(const std::string& name, const reference::ChuaWindowCase& c, double tol) {
   SolverOptions options;
   options.stop.step_tolerance = tol;      // KINSOL's scsteptol
   options.stop.residual_tolerance = tol;  // KINSOL's fnormtol
-  std::unique_ptr<Engine<3>> engine = EngineRegistry<3>::global().create(name, options);
-  Vector<3> x = c.initial_guess;
   try {
+    std::unique_ptr<Engine<3>> engine =
+        EngineRegistry<3>::global().create(with_tolerance(name, tol), options);
+    Vector<3> x = c.initial_guess;
     const Summary s = engine->solve(c.problem, x);
     SolveRow row{name,
-                 std::string(to_string(s.status)),
+                 s.library_status.empty() ? std::string(to_string(s.status)) : s.library_status,
                  s.iterations,
                  s.function_evaluations,
                  x,
@@ -65,32 +70,6 @@ SolveRow run_engine(const std::string& name, const reference::ChuaWindowCase& c,
   }
 }
 
-SolveRow run_kinsol(const std::string& name, const reference::ChuaWindowCase& c, double tol) {
-  reference::KinsolOptions options;
-  options.strategy =
-      reference::KinsolSolver::strategy(name).value_or(KinsolStrategy::kNewtonLineSearch);
-  options.tolerance = tol;
-  const auto solver = reference::make_kinsol_solver(c.problem, options);
-  Eigen::VectorXd x = c.initial_guess;
-  const reference::KinsolResult r = solver->solve(x);
-  SolveRow row{name,
-               kinsol_status(r),
-               r.iterations,
-               r.evaluations,
-               x,
-               (x - c.true_state).lpNorm<Eigen::Infinity>(),
-               0.0,
-               {}};
-  Eigen::VectorXd xr(3);
-  row.ns_per_solve = reference::mean_ns_per_call(
-      [&] {
-        xr = c.initial_guess;
-        solver->solve(xr);
-      },
-      2e7, 3);
-  return row;
-}
-
 std::string join(const std::vector<std::string>& v) {
   std::string s;
   for (const auto& e : v) s += (s.empty() ? "" : ", ") + e;
@@ -116,16 +95,14 @@ std::vector<SolveRow> solve_chua_window(const std::vector<std::string>& engines,
     throw std::invalid_argument("--tol " + std::to_string(tolerance) +
                                 " is invalid: must be finite and > 0");
   }
+  reference::register_reference_engines();
   const auto& refs = reference_names();
   std::vector<std::string> order;
   for (const std::string& e : engines) {
-    const bool reference = std::find(refs.begin(), refs.end(), e) != refs.end();
-    if (!reference) {
-      try {
-        (void)EngineRegistry<3>::global().create(e);  // validates name and options
-      } catch (const InvalidInput& error) {
-        throw std::invalid_argument(std::string(error.what()) + "; references: " + join(refs));
-      }
+    try {
+      (void)EngineRegistry<3>::global().create(with_tolerance(e, tolerance));  // name, options
+    } catch (const InvalidInput& error) {
+      throw std::invalid_argument(std::string(error.what()) + "; references: " + join(refs));
     }
     if (std::find(order.begin(), order.end(), e) == order.end()) order.push_back(e);
   }
@@ -137,8 +114,7 @@ std::vector<SolveRow> solve_chua_window(const std::vector<std::string>& engines,
   const reference::ChuaWindowCase c;
   std::vector<SolveRow> rows;
   for (const std::string& e : order) {
-    rows.push_back(e.rfind("kinsol:", 0) == 0 ? run_kinsol(e, c, tolerance)
-                                              : run_engine(e, c, tolerance));
+    rows.push_back(run_engine(e, c, tolerance));
   }
   return rows;
 }

@@ -24,6 +24,7 @@
 #include "bad_broyden_engine.hpp"
 #include "cli_test_files.hpp"
 #include "nlobs/common/printable.hpp"
+#include "nlobs/models/systems.hpp"
 #include "nlobs/reference/problem_suite.hpp"
 #include "nlobs/registry/plugin.hpp"
 #include "nlobs/runs/scenario.hpp"
@@ -69,7 +70,8 @@ TEST(Plugins, TheExamplePluginRegistersOneEntryOfEachKind) {
   EXPECT_EQ(loaded.models, std::vector<std::string>{"fitzhugh-nagumo"});
   EXPECT_EQ(loaded.engines, std::vector<std::string>{"bad-broyden"});
   EXPECT_EQ(loaded.problem_sets, std::vector<std::string>{"example"});
-  EXPECT_EQ(loaded.observer_types, std::vector<std::string>{"output_injection"});
+  EXPECT_EQ(loaded.observer_types,
+            (std::vector<std::string>{"output_injection", "fixed_size_ekf"}));
   EXPECT_EQ(observer_type_registry().source("output_injection"), kExample);
   EXPECT_EQ(model_registry().source("fitzhugh-nagumo"), kExample);
   EXPECT_EQ(problem_set_registry().source("example"), kExample);
@@ -92,7 +94,7 @@ TEST(Plugins, APluginModelRunsWithTheObserverTypesItAdmitsAndAPluginEngine) {
   const Measurements data = simulate_scenario(s, model.discrete);
   auto observers = make_observers(s, model, false);
   const RunResult r = run_observers(data, observers, 200);  // after 10 s, the settle time
-  ASSERT_EQ(r.metrics.size(), 6u);
+  ASSERT_EQ(r.metrics.size(), 7u);
   for (const ObserverMetrics& m : r.metrics) {
     SCOPED_TRACE(m.name);
     ASSERT_EQ(m.mse_after_window.size(), 2);
@@ -111,6 +113,11 @@ TEST(Plugins, APluginModelRunsWithTheObserverTypesItAdmitsAndAPluginEngine) {
   EXPECT_EQ(r.metrics[5].name, "output_injection");
   EXPECT_LT(r.metrics[5].mse_after_window.maxCoeff(), 2e-2);
   EXPECT_LT(r.metrics[5].mse_after_window.maxCoeff(), r.metrics[5].mse.maxCoeff());
+  // The plugin's model-typed EKF (fixed-size matrices, the model's own type) is the built-in
+  // EKF's arithmetic on the same covariances: the same estimates to rounding.
+  EXPECT_EQ(r.metrics[6].name, "fixed_size_ekf");
+  EXPECT_EQ(r.estimates[6].cols(), r.estimates[2].cols());
+  EXPECT_LT((r.estimates[6] - r.estimates[2]).cwiseAbs().maxCoeff(), 1e-9);
   // The modulating observer needs a canonical form the model does not supply: named.
   nlohmann::json modulating = json;
   modulating["observers"] = nlohmann::json::parse(R"([{"type": "modulating"}])");
@@ -120,6 +127,46 @@ TEST(Plugins, APluginModelRunsWithTheObserverTypesItAdmitsAndAPluginEngine) {
     ADD_FAILURE() << "the modulating observer accepted a model without a canonical form";
   } catch (const std::exception& e) {
     EXPECT_TRUE(contains(e.what(), "modulating on model 'fitzhugh-nagumo': no canonical form"))
+        << e.what();
+  }
+}
+
+// A model-typed observer type from a plugin reaches the model's C++ type for the types it was
+// built for — its own model and a built-in one — and is refused by name on any other.
+TEST(Plugins, APluginObserverTypeBuiltOnTheModelsOwnTypeTakesTheTypesItKnows) {
+  load_plugin(kExample);
+  const auto scenario = [](const std::string& model, int n) {
+    nlohmann::json j = {{"name", "typed"},
+                        {"model", {{"name", model}}},
+                        {"x0", std::vector<double>(n, 1.0)},
+                        {"initial_guess", std::vector<double>(n, 0.5)},
+                        {"steps", 300},
+                        {"observers", nlohmann::json::array()}};
+    j["observers"].push_back({{"type", "ekf"}, {"process_covariance", 1e-6}});
+    j["observers"].push_back({{"type", "fixed_size_ekf"}, {"process_covariance", 1e-6}});
+    return parse_scenario(j, "typed " + model);
+  };
+  const Scenario lorenz = scenario("lorenz", 3);
+  const ModelInstance model = scenario_model(lorenz);
+  ASSERT_NE(model.model_as<Lorenz>(), nullptr);
+  EXPECT_EQ(model.model_as<Duffing>(), nullptr);
+  const Measurements data = simulate_scenario(lorenz, model.discrete);
+  auto observers = make_observers(lorenz, model, false);
+  const RunResult r = run_observers(data, observers);
+  ASSERT_EQ(r.estimates.size(), 2u);
+  ASSERT_TRUE(r.estimates[1].allFinite());
+  // A chaotic system: the two filters agree to rounding only over the first hundred samples.
+  const Eigen::Index head = 100;
+  EXPECT_LT((r.estimates[1].leftCols(head) - r.estimates[0].leftCols(head)).cwiseAbs().maxCoeff(),
+            1e-6);
+  try {
+    const Scenario duffing = scenario("duffing", 2);
+    make_observers(duffing, scenario_model(duffing), false);
+    ADD_FAILURE() << "fixed_size_ekf accepted a model type it was not built for";
+  } catch (const std::exception& e) {  // the scenario's refusal, naming the observer's place
+    EXPECT_TRUE(contains(e.what(),
+                         "fixed_size_ekf on model 'duffing': it is built for "
+                         "fitzhugh-nagumo and lorenz only"))
         << e.what();
   }
 }

@@ -5,6 +5,7 @@
 #include <limits>
 #include <string>
 
+#include "message_of.hpp"
 #include "nlobs/models/model.hpp"
 #include "nlobs/solvers/solvers.hpp"
 
@@ -36,17 +37,6 @@ inline FixedPointProblem<3> diagonal_linear_problem(const Eigen::Vector3d& rates
 inline const std::array<std::string, 8> kJacobianEngineSpecs = {
     "newton",  "newton:linesearch=1", "newton:trustregion=1", "dogleg",
     "broyden", "levenberg-marquardt", "pseudo-transient",     "auto"};
-
-// The message of the InvalidInput that f throws, or "<no exception>".
-template <typename F>
-std::string message_of(F&& f) {
-  try {
-    f();
-  } catch (const InvalidInput& e) {
-    return e.what();
-  }
-  return "<no exception>";
-}
 
 inline SolverOptions tolerance(double step) {
   SolverOptions o;

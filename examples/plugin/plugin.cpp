@@ -1,6 +1,7 @@
 // The example plugin's entry point: `nlobs --plugin libnlobs_example_plugin.so list` shows a
 // model (fitzhugh-nagumo), an engine (bad-broyden, Broyden's second method), an observer type
-// (output_injection) and a problem set (example) beside the built-ins.
+// (output_injection), an observer type built on the model's own C++ type (fixed_size_ekf) and a
+// problem set (example) beside the built-ins.
 #include "example_plugin.hpp"
 
 namespace {
@@ -10,6 +11,7 @@ void register_example_plugin(nlobs::PluginRegistrar& registrar) {
   example::add_bad_broyden(registrar);
   example::add_example_problems(registrar);
   example::add_output_injection(registrar);
+  example::add_fixed_size_ekf(registrar);
 }
 
 }  // namespace

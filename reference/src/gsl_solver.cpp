@@ -96,6 +96,7 @@ ReferenceResult solve_gsl(const std::string& method, const RootProblem<Dynamic>&
   } else {
     while (c.f_evals < c.cap) {
       status = gsl_multiroot_fdfsolver_iterate(s.get());
+      ++result.iterations;
       if (status != GSL_SUCCESS) {
         result.status = c.refused ? "max_evaluations" : status_name(status);
         break;

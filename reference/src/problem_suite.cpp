@@ -12,15 +12,11 @@
 #include <utility>
 
 #include "nlobs/common/printable.hpp"
-#include "nlobs/reference/kinsol_solver.hpp"
 #include "nlobs/reference/petsc_solver.hpp"
-#include "nlobs/reference/root_reference.hpp"
+#include "nlobs/reference/reference_engines.hpp"
 #include "nlobs/reference/timing.hpp"
 #include "nlobs/solvers/engine_registry.hpp"
 #include "nlobs/solvers/root_adapter.hpp"
-#include "nlobs/solvers/sparse/pattern_bandwidths.hpp"
-#include "nlobs/solvers/sparse/sparse_jacobian.hpp"
-#include "nlobs/solvers/sparse/sparsity_pattern.hpp"
 #include "petsc_option_rules.hpp"
 
 namespace nlobs::reference {
@@ -65,12 +61,6 @@ struct Outcome {
 // suite stays a few seconds.
 constexpr double kTimingNs = 1e6;
 constexpr long kMaxTimedCalls = 201;
-
-bool is_reference(const std::string& s) {
-  if (PetscSnesSolver::is_name(s)) return true;  // any petsc:TYPE[:-key=value...]
-  const auto refs = all_reference_solvers();
-  return std::find(refs.begin(), refs.end(), s) != refs.end();
-}
 
 // A fall of ‖F‖ counts when it goes below (1 − this) × the value at the fall before it, as the
 // engines' progress window has it (ProgressWindow): rounding-level jitter near a root is none.
@@ -150,63 +140,49 @@ struct Meter {
   }
 };
 
-// Thrown from G into our engines (never into the C libraries) when one keeps asking for
-// evaluations past the time limit: it would otherwise hold the suite.
+// Thrown from G into the engines when one keeps asking for evaluations past the time limit: it
+// would otherwise hold the suite. (A reference engine keeps it while its C library stops, and
+// throws it then: nothing unwinds through C.)
 struct TimeLimitStop {};
 constexpr int kLateCallsBeforeStop = 10;
 
-// The C libraries (MINPACK, GSL, KINSOL) must never see an exception unwind through them: their
-// copies of a user's F, ∂F and G turn one into NaN, a non-finite evaluation they report. With a
-// meter, an evaluation beyond its budget is NaN too (the references stop before, each counting
-// its own: the meter is the backstop).
-RootProblem<Dynamic> guarded(const RootProblem<Dynamic>& f, Meter* meter) {
-  const RootProblem<Dynamic>* p = &f;
-  return RootProblem<Dynamic>::with_jacobian(
-      [p, meter](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
-        if (meter && !meter->take()) {
-          out.setConstant(p->residual_size(), std::numeric_limits<double>::quiet_NaN());
-          return;
-        }
-        try {
-          p->evaluate(x, out);
-        } catch (...) {
-          out.setConstant(p->residual_size(), std::numeric_limits<double>::quiet_NaN());
-        }
-        if (meter) meter->saw(out);
-      },
-      [p, meter](const Eigen::VectorXd& x, Eigen::MatrixXd& jac) {
-        if (meter && meter->late()) {
-          jac.setConstant(p->residual_size(), x.size(), std::numeric_limits<double>::quiet_NaN());
-          return;
-        }
-        try {
-          p->jacobian(x, jac);
-        } catch (...) {
-          jac.setConstant(p->residual_size(), x.size(), std::numeric_limits<double>::quiet_NaN());
-        }
-      },
-      f.size(), f.residual_size(), f.jacobian_source());
-}
-FixedPointProblem<Dynamic> guarded(const FixedPointProblem<Dynamic>& g, Meter* meter) {
-  const FixedPointProblem<Dynamic>* p = &g;
-  return FixedPointProblem<Dynamic>::from_map(
-      [p, meter](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
-        if (meter && !meter->take()) {
-          out.setConstant(p->size(), std::numeric_limits<double>::quiet_NaN());
-          return;
-        }
-        try {
-          p->evaluate(x, out);
-        } catch (...) {
-          out.setConstant(p->size(), std::numeric_limits<double>::quiet_NaN());
-        }
-        if (meter) meter->saw_fixed_point(x, out);
-      },
-      g.size());
+// Ends the timing of a solve its engine refused (Status::kInvalidInput): one attempt, no answer.
+struct RefusedSolve {};
+
+// G with the problem's own F (TestProblem::residual, its Jacobian and sparse pattern) attached
+// as its residual form, for a problem posed as x = G(x); G itself otherwise (to_fixed_point
+// attached F already).
+FixedPointProblem<Dynamic> with_own_residual(const TestProblem& p,
+                                             const FixedPointProblem<Dynamic>& g) {
+  if (!p.fixed_point || (g.has_jacobian() && !p.residual.has_jacobian())) return g;
+  const RootProblem<Dynamic>* f = &p.residual;
+  FixedPointProblem<Dynamic> out = g.with_residual(
+      [f](const Eigen::VectorXd& x, Eigen::VectorXd& value) { f->evaluate(x, value); },
+      g.has_jacobian()
+          ? FixedPointProblem<Dynamic>::JacobianMap(
+                [f](const Eigen::VectorXd& x, Eigen::MatrixXd& jac) { f->jacobian(x, jac); })
+          : FixedPointProblem<Dynamic>::JacobianMap());
+  if (p.residual.sparse_jacobian_state()) {
+    out = out.with_sparse_jacobian_state(p.residual.sparse_jacobian_state());
+  }
+  return out;
 }
 
-// G for our engines (a user's among them): metered, its Jacobian kept, its exceptions left to
-// the engine (an engine that throws is a row, engine_threw).
+// F as the suite judges an answer by it: an exception F throws is a value that is not finite
+// (never solved).
+void judged_residual(const RootProblem<Dynamic>& f, const Eigen::VectorXd& x,
+                     Eigen::VectorXd& out) {
+  try {
+    f.evaluate(x, out);
+  } catch (...) {
+    out.setConstant(f.residual_size(), std::numeric_limits<double>::quiet_NaN());
+  }
+}
+
+// G for the engines (a user's and the reference engines among them): metered, its Jacobian kept,
+// its exceptions left to the engine (an engine that throws is a row, engine_threw; a reference
+// engine keeps the exception while its C library stops, then throws it). The result refers to
+// `g`, which must outlive it.
 FixedPointProblem<Dynamic> metered(const FixedPointProblem<Dynamic>& g, Meter& meter) {
   const FixedPointProblem<Dynamic>* p = &g;
   auto map = [p, &meter](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
@@ -257,65 +233,6 @@ FixedPointProblem<Dynamic> metered(const FixedPointProblem<Dynamic>& g, Meter& m
       }));
 }
 
-// ∂F for kinsol:newton-klu: the problem's sparse Jacobian (declared or detected at x), its values
-// copied in the pattern's row order. std::invalid_argument (an invalid_input row) without one.
-KinsolSparseJacobian kinsol_sparse_jacobian(const TestProblem& problem, const Eigen::VectorXd& x) {
-  const SparseJacobianSource* source = problem.residual.sparse_jacobian(x);
-  if (!source) {
-    throw std::invalid_argument("kinsol:newton-klu needs a sparse Jacobian, and F has none (" +
-                                problem.residual.sparse_jacobian_note() + ")");
-  }
-  const SparsityPattern& pattern = *source->pattern;
-  KinsolSparseJacobian out;
-  out.row_starts.assign(pattern.row_start.begin(), pattern.row_start.end());
-  out.columns.assign(pattern.columns.begin(), pattern.columns.end());
-  // Through the problem's state: its lock guards the workspace the problem's copies share.
-  std::shared_ptr<detail::SparseJacobianState> state = problem.residual.sparse_jacobian_state();
-  auto jac = std::make_shared<SparseJacobian>();
-  const auto nonzeros = static_cast<Eigen::Index>(out.columns.size());
-  out.values = [state, jac, nonzeros](const Eigen::VectorXd& at, const Eigen::VectorXd& f,
-                                      double* values) {
-    state->evaluate(at, f, *jac);
-    if (jac->nonZeros() != nonzeros) {  // the callback makes this KINSOL's Jacobian failure
-      throw std::logic_error("the sparse Jacobian's structure is not its pattern's");
-    }
-    std::copy(jac->valuePtr(), jac->valuePtr() + nonzeros, values);
-  };
-  return out;
-}
-
-// PETSc SNES as its drivers run it with -snes_fd_color: PETSc's coloured differences on F's
-// pattern (declared or detected; a dense pattern without one, n ≤ kMaxProblemDimension), its
-// defaults otherwise (newtonls: bt line search, GMRES + ILU(0)); converged at ‖F‖₂ ≤ 1e-10 as
-// KINSOL at ‖F‖∞ ≤ 1e-10. PETSc takes neither the problem's scaling nor its box.
-Outcome run_petsc(const std::string& solver, const TestProblem& problem,
-                  const RootProblem<Dynamic>& residual, Eigen::VectorXd& x, long budget) {
-  PetscSnesOptions o = PetscSnesSolver::parse_name(solver);
-  o.absolute_tolerance = 1e-10;
-  o.max_iterations = std::min<long>(budget, std::numeric_limits<int>::max());
-  o.max_evaluations = budget;
-  PetscPattern pattern;
-  if (const SparseJacobianSource* source = problem.residual.sparse_jacobian(x)) {
-    pattern.row_starts.assign(source->pattern->row_start.begin(), source->pattern->row_start.end());
-    pattern.columns.assign(source->pattern->columns.begin(), source->pattern->columns.end());
-  } else if (residual.size() > kMaxProblemDimension) {
-    throw std::invalid_argument(
-        solver + " needs F's sparse pattern at n = " + std::to_string(residual.size()) + " (" +
-        problem.residual.sparse_jacobian_note() + ")");
-  }
-  const RootProblem<Dynamic>* f = &residual;
-  PetscSnesSolver snes(
-      static_cast<int>(residual.size()), std::move(o),
-      [f](const Eigen::VectorXd& v, Eigen::VectorXd& out) { f->evaluate(v, out); },
-      std::move(pattern));
-  const PetscSnesResult r = snes.solve(x);
-  std::string message = r.error.empty() ? r.reason_text : r.error;
-  if (!r.reason_name.empty() && !r.success) {
-    message = r.reason_name + (message.empty() ? "" : ": " + message);
-  }
-  return {r.status(), r.evaluations, r.jacobian_evaluations, message};
-}
-
 // MPI's start and PETSc's first use of each of its types (their registration, ~10 ms) happen
 // here, untimed: one solve of a 2-unknown system with the name's type and options (its printing
 // viewers left out). A failure here is the row's to report.
@@ -331,91 +248,6 @@ void warm_up_petsc(const std::string& name) {
     (void)snes.solve(x);
   } catch (...) {
   }
-}
-
-// The references that keep dense n×n matrices: not run above kMaxProblemDimension.
-bool dense_reference(const std::string& solver) {
-  return solver == "minpack:hybrj" || solver == "gsl:hybridsj" || solver == "gsl:gnewton" ||
-         solver == "kinsol:newton";
-}
-
-// KINSOL's options and set-up may refuse (std::invalid_argument): the caller makes that row
-// invalid_input. `budget` counts every evaluation, the references' checks of their answers
-// included.
-Outcome run_reference(const std::string& solver, const TestProblem& problem,
-                      const RootProblem<Dynamic>& residual, const FixedPointProblem<Dynamic>& g,
-                      Eigen::VectorXd& x, long budget) {
-  if (dense_reference(solver) && residual.size() > kMaxProblemDimension) {
-    throw std::invalid_argument(
-        solver + " keeps dense n x n matrices: not run at n = " + std::to_string(residual.size()) +
-        ", above " + std::to_string(kMaxProblemDimension) +
-        " (kinsol:newton-band, -klu and -spgmr are KINSOL's sparse forms)");
-  }
-  if (PetscSnesSolver::is_name(solver)) return run_petsc(solver, problem, residual, x, budget);
-  ReferenceOptions o;
-  o.max_evaluations = budget;
-  if (solver == "minpack:hybrj") {
-    const ReferenceResult r = solve_minpack_hybrj(residual, x, o);
-    return {r.status, r.f_evals, r.j_evals, {}};
-  }
-  if (solver == "gsl:hybridsj" || solver == "gsl:gnewton") {
-    const ReferenceResult r = solve_gsl(solver.substr(4), residual, x, o);
-    return {r.status, r.f_evals, r.j_evals, {}};
-  }
-  KinsolOptions ko;
-  ko.strategy = KinsolSolver::strategy(solver).value_or(KinsolStrategy::kNewtonLineSearch);
-  ko.tolerance = 1e-10;
-  // The problem's scaling, as KINSOL's own drivers give it (MINPACK and GSL take none: hybrj
-  // scales its variables itself, as MINPACK's driver runs it).
-  ko.u_scale = problem.u_scale;
-  ko.f_scale = problem.f_scale;
-  // KINSOL counts iterations (each at least one evaluation); max_evaluations bounds the
-  // evaluations its line search and the final check add.
-  ko.max_iterations = budget;
-  ko.max_evaluations = budget;
-  // KINSOL's own maximum step, 1000 ‖u₀‖₂, collapses to 1 at u₀ = 0 (Watson's start, a
-  // user's zero start): the same rule measured from 1 instead (docs/solvers.md); ‖u₀‖₂ without
-  // overflow and the product at most the largest double (a start of 1e308).
-  ko.max_newton_step = std::min(std::numeric_limits<double>::max(),
-                                1000.0 * std::max(1.0, x.allFinite() ? x.stableNorm() : 1.0));
-  const int n = static_cast<int>(residual.size());
-  std::unique_ptr<KinsolSolver> k;
-  if (ko.strategy == KinsolStrategy::kNewtonLineSearch) {
-    ko.linear_solver = KinsolSolver::linear_solver(solver).value_or(KinsolLinearSolver::kDense);
-    KinsolSolver::Jacobian dense;
-    KinsolSparseJacobian sparse;
-    const RootProblem<Dynamic>* f = &residual;
-    switch (ko.linear_solver) {
-      case KinsolLinearSolver::kDense:  // exact Newton on our Jacobian, as in the small sets
-        dense = [f](const Eigen::VectorXd& v, Eigen::MatrixXd& j) { f->jacobian(v, j); };
-        break;
-      case KinsolLinearSolver::kBand: {  // the widths of F's pattern; the full band without one
-        const SparseJacobianSource* source = problem.residual.sparse_jacobian(x);
-        const PatternBandwidths band =
-            source ? pattern_bandwidths(*source->pattern) : PatternBandwidths{n - 1, n - 1};
-        ko.lower_bandwidth = band.lower;
-        ko.upper_bandwidth = band.upper;
-        ko.max_setup_calls = 0;  // KINSOL's default: modified Newton
-        break;
-      }
-      case KinsolLinearSolver::kKlu:
-        sparse = kinsol_sparse_jacobian(problem, x);
-        ko.max_setup_calls = 0;
-        break;
-      case KinsolLinearSolver::kSpgmr:
-        ko.max_setup_calls = 0;
-        break;
-    }
-    k = std::make_unique<KinsolSolver>(
-        n, ko, [f](const Eigen::VectorXd& v, Eigen::VectorXd& out) { f->evaluate(v, out); },
-        std::move(dense), std::move(sparse));
-  } else {
-    const FixedPointProblem<Dynamic>* gp = &g;
-    k = std::make_unique<KinsolSolver>(
-        n, ko, [gp](const Eigen::VectorXd& v, Eigen::VectorXd& out) { gp->evaluate(v, out); });
-  }
-  const KinsolResult r = k->solve(x);
-  return {r.status(), r.evaluations, r.jacobian_evaluations, r.reason};
 }
 
 double distance_to_solutions(const TestProblem& p, const Eigen::VectorXd& x) {
@@ -526,18 +358,13 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
     throw InvalidInput("the time limit per solve must be > 0 seconds (+inf: none), got " +
                        std::to_string(options.time_limit_s));
   }
+  register_reference_engines();
   auto& registry = EngineRegistry<Dynamic>::global();
   SolverOptions base;
   base.stop.step_tolerance = 1e-12;
   base.stop.residual_tolerance = 1e-10;
   // Validate every name and start label before running anything.
   for (const std::string& s : solvers) {
-    if (PetscSnesSolver::is_name(s)) {
-      (void)PetscSnesSolver::parse_name(s);  // its syntax now; PETSc's own refusals in its row
-      if (petsc_available()) warm_up_petsc(s);
-      continue;
-    }
-    if (is_reference(s)) continue;
     try {
       (void)registry.create(s, base);
     } catch (const InvalidInput& e) {
@@ -545,6 +372,8 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
       for (const auto& r : all_reference_solvers()) refs += ", " + r;
       throw std::invalid_argument(std::string(e.what()) + "; references" + refs);
     }
+    // PETSc's own refusals (a build without it included) in its rows.
+    if (PetscSnesSolver::is_name(s) && petsc_available()) warm_up_petsc(s);
   }
   std::set<std::string> labels;
   for (const TestProblem& p : problems) {
@@ -571,10 +400,13 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
                             : options.evaluations_per_dimension * static_cast<long>(n + 1);
     const FixedPointProblem<Dynamic> g =
         p.fixed_point ? *p.fixed_point : to_fixed_point<Dynamic>(p.residual);
-    const RootProblem<Dynamic> judge_f = guarded(p.residual, nullptr);  // the suite's own look
-    const RootProblem<Dynamic> safe_f = guarded(p.residual, &meter);
-    const FixedPointProblem<Dynamic> safe_g = guarded(g, &meter);
     const FixedPointProblem<Dynamic> engine_g = metered(g, meter);
+    // The reference engines solve the problem's F itself (TestProblem::residual, with its
+    // Jacobian and sparse pattern) as their drivers do; KINSOL's fixed-point strategies iterate
+    // G. A problem posed as x = G(x) gets its F attached for them.
+    // (metered() refers to the problem it is given: kept here for the loop's life.)
+    const FixedPointProblem<Dynamic> g_with_f = with_own_residual(p, g);
+    const FixedPointProblem<Dynamic> reference_g = metered(g_with_f, meter);
     meter.f_scale = &p.f_scale;
     // The pattern of a with_autodiff F is detected once per problem (at the first start), here
     // and untimed: the first solver of the list would otherwise be timed with it. What it
@@ -611,16 +443,7 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
               .count();
         };
         try {
-          if (is_reference(s)) {
-            row.ns = mean_ns_per_call(
-                [&] {
-                  attempt_started = std::chrono::steady_clock::now();
-                  x = start.x;
-                  meter.reset(budget, options.time_limit_s);
-                  outcome = run_reference(s, p, safe_f, safe_g, x, budget);
-                },
-                kTimingNs, 1, kMaxTimedCalls);
-          } else {
+          {
             SolverOptions o = base;
             o.stop.max_evaluations = static_cast<int>(std::min<long>(budget, 1L << 30));
             const std::string problem_start = p.name + "/" + start.label;
@@ -631,6 +454,7 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
               };
             }
             auto engine = registry.create(s, o);
+            const bool reference = is_reference_engine(s);
             // The problem's box reaches the engines that take bounds (its strict sides those
             // that take them; Ceres and NLopt the closed box inside it); the others run
             // unbounded and are judged alike (outside_bounds). levenberg-marquardt:geodesic=1
@@ -648,14 +472,23 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
                   attempt_started = std::chrono::steady_clock::now();
                   x = start.x;
                   meter.reset(budget, options.time_limit_s);
-                  const Summary sum = solve_or_report(*engine, engine_g, x);
-                  // The metered count: every evaluation of G the engine made.
-                  outcome = {std::string(to_string(sum.status)), meter.count,
-                             sum.jacobian_evaluations, sum.message};
+                  const Summary sum =
+                      solve_or_report(*engine, reference ? reference_g : engine_g, x);
+                  // The metered count: every evaluation of G the engine made. A reference
+                  // engine's row shows its library's own account (Summary::library_status).
+                  outcome = {sum.library_status.empty() ? std::string(to_string(sum.status))
+                                                        : sum.library_status,
+                             meter.count, sum.jacobian_evaluations, sum.message};
+                  // Refused (the problem's size, its Jacobian, the library's set-up): a row
+                  // without an answer, timed once.
+                  if (sum.status == Status::kInvalidInput) throw RefusedSolve{};
                 },
                 kTimingNs, 1, options.monitor ? 1 : kMaxTimedCalls);
           }
           if (meter.timed_out) row.ns = attempt_ns();
+        } catch (const RefusedSolve&) {
+          row.ns = attempt_ns();
+          x.resize(0);  // the refusal's outcome is set: no answer
         } catch (const TimeLimitStop&) {
           row.ns = attempt_ns();
           outcome = {"time_limit", meter.count, 0, ""};
@@ -666,7 +499,7 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
           x.resize(0);
         } catch (...) {
           row.ns = attempt_ns();
-          const bool refused_input = (setting_up || is_reference(s)) && [] {
+          const bool refused_input = setting_up && [] {
             try {
               throw;
             } catch (const std::invalid_argument&) {  // InvalidInput is one
@@ -683,7 +516,7 @@ std::vector<SuiteRow> run_suite(const ProblemSetEntry& set,
         row.residual = row.scaled_residual = std::numeric_limits<double>::infinity();
         if (x.size() == n && x.allFinite()) {
           Eigen::VectorXd f(n);
-          judge_f.evaluate(x, f);
+          judged_residual(p.residual, x, f);
           if (f.allFinite()) {
             row.residual = f.norm();
             row.scaled_residual = p.f_scale.size() ? p.scaled_norm(f) : row.residual;

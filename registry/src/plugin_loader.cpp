@@ -7,7 +7,7 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
-#include <optional>
+#include <mutex>
 #include <set>
 #include <string>
 #include <system_error>
@@ -29,82 +29,61 @@ namespace {
 // (PATH_MAX) that two plugins never share one.
 constexpr std::size_t kSourceLimit = 4096;
 
-// Every name the staged registration adds, checked before anything is added: the registry's
-// name rule, not taken (by whom), not twice in the same registration.
-template <typename Entry, typename Taken>
-void check_names(const std::vector<Entry>& staged, const std::string& kind,
-                 const std::string& source, Taken taken_by) {
+// Each staged entry as its registry's add() would take it (NamedRegistry::refusal: the name
+// rule, a complete entry, a name not taken), and no name twice in the same registration: checked
+// for the whole registration before anything is added.
+template <typename Entry, typename Refusal>
+void check_entries(const std::vector<Entry>& staged, const std::string& kind,
+                   const std::string& source, Refusal refusal) {
   std::set<std::string> seen;
   for (const Entry& e : staged) {
+    if (std::string why = refusal(e); !why.empty()) throw InvalidInput(why);
     if (!seen.insert(e.name).second) {
       throw InvalidInput(kind + " '" + e.name + "' is registered twice by " + source);
     }
-    if (const std::optional<std::string> other = taken_by(e.name)) {
-      throw InvalidInput(kind + " '" + e.name + "' from " + source + " is already registered by " +
-                         (other->empty() ? std::string("an unnamed source") : *other));
-    }
   }
 }
 
-template <typename Entry>
-void check_registry_names(const std::vector<Entry>& staged, const NamedRegistry<Entry>& registry,
-                          const std::string& source) {
-  for (const Entry& e : staged) {
-    if (!is_registry_name(e.name)) {
-      throw InvalidInput(registry_name_refusal(registry.kind(), e.name, source));
-    }
-  }
-  check_names(staged, registry.kind(), source,
-              [&registry](const std::string& name) -> std::optional<std::string> {
-                if (!registry.contains(name)) return std::nullopt;
-                return registry.source(name);
-              });
+template <typename Registry, typename Entry>
+void check_registry(const std::vector<Entry>& staged, const Registry& registry,
+                    const std::string& source) {
+  check_entries(staged, registry.kind(), source,
+                [&](const Entry& e) { return registry.refusal(e, source); });
 }
 
-// The source that has an engine of this name at any size the library serves (an entry at a
-// fixed size would shadow the plugin's Dynamic entry there); none when the name is free.
-std::optional<std::string> engine_source(const std::string& name) {
-  if (EngineRegistry<Dynamic>::global().has_entry(name)) {
-    return EngineRegistry<Dynamic>::global().source(name);
+// An engine is refused as EngineRegistry<Dynamic>::add refuses it, and also when an entry at a
+// fixed size the library serves has its name (it would shadow the plugin's Dynamic entry there).
+std::string engine_refusal(const EngineRegistry<Dynamic>::Entry& e, const std::string& source) {
+  if (std::string why = EngineRegistry<Dynamic>::global().refusal(e, source); !why.empty()) {
+    return why;
   }
-  std::optional<std::string> source;
-#define NLOBS_ENGINE_SOURCE_AT(n)                                                 \
-  if (!source && (n) != Dynamic && EngineRegistry<n>::global().has_entry(name)) { \
-    source = EngineRegistry<n>::global().source(name) + " (at size " #n ")";      \
+  std::string holder;
+#define NLOBS_ENGINE_SOURCE_AT(n)                                                          \
+  if (holder.empty() && (n) != Dynamic && EngineRegistry<n>::global().has_entry(e.name)) { \
+    holder = EngineRegistry<n>::global().source(e.name) + " (at size " #n ")";             \
   }
   NLOBS_FOR_EACH_LIBRARY_SIZE(NLOBS_ENGINE_SOURCE_AT)
 #undef NLOBS_ENGINE_SOURCE_AT
-  return source;
+  if (holder.empty()) return {};
+  return "engine '" + e.name + "' from " + printable(source) + " is already registered by " +
+         printable(holder);
 }
 
 void check_staged(const PluginRegistrar& staged, const std::string& source) {
-  check_registry_names(staged.models(), model_registry(), source);
-  check_registry_names(staged.observer_types(), observer_type_registry(), source);
-  check_registry_names(staged.problem_sets(), problem_set_registry(), source);
-  for (const auto& e : staged.engines()) {
-    if (!is_registry_name(e.name)) {
-      throw InvalidInput(registry_name_refusal("engine", e.name, source));
-    }
-    if (!e.make) throw InvalidInput("engine '" + e.name + "' from " + source + " has no factory");
-  }
-  check_names(staged.engines(), "engine", source, engine_source);
-  for (const auto& e : staged.problem_sets()) {
-    if (!e.problems) {
-      throw InvalidInput("problem set '" + e.name + "' from " + source + " has no problems()");
-    }
-  }
-  for (const auto& e : staged.models()) {
-    if (!e.make) throw InvalidInput("model '" + e.name + "' from " + source + " has no make");
-  }
-  for (const auto& e : staged.observer_types()) {
-    if (!e.parse || !e.write || !e.build) {
-      throw InvalidInput("observer type '" + e.name + "' from " + source +
-                         " needs parse, write and build");
-    }
-  }
+  check_registry(staged.models(), model_registry(), source);
+  check_registry(staged.observer_types(), observer_type_registry(), source);
+  check_registry(staged.problem_sets(), problem_set_registry(), source);
+  check_entries(staged.engines(), "engine", source,
+                [&source](const auto& e) { return engine_refusal(e, source); });
 }
 
+// One registration at a time, checked and committed under one lock: two plugins loaded on two
+// threads cannot both pass the check with the same name. (A program that adds to a registry
+// directly while a plugin loads can still take a name between the check and the commit; the
+// commit then fails part-way, naming it.)
 LoadedPlugin commit(const PluginRegistrar& staged, const std::string& source) {
+  static std::mutex loading;
+  std::lock_guard<std::mutex> lock(loading);
   check_staged(staged, source);
   LoadedPlugin loaded{source, {}, {}, {}, {}};
   for (const auto& e : staged.models()) {

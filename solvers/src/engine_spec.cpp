@@ -169,6 +169,20 @@ std::optional<std::string> EngineSpecReader::word(const std::vector<std::string>
   return w;
 }
 
+std::string EngineSpecReader::rest() {
+  std::string out;
+  if (!word_used_) {
+    for (const auto& w : spec_.words) out += (out.empty() ? "" : ",") + w;
+    word_used_ = true;
+  }
+  for (size_t i = 0; i < spec_.values.size(); ++i) {
+    if (used_values_[i]) continue;
+    out += (out.empty() ? "" : ",") + spec_.values[i].first + "=" + spec_.values[i].second;
+    used_values_[i] = true;
+  }
+  return out;
+}
+
 void EngineSpecReader::finish() const {
   std::string unknown;
   for (size_t i = 0; i < spec_.values.size(); ++i) {

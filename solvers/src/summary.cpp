@@ -93,6 +93,7 @@ std::string Summary::full_report() const {
   if (!engine.empty()) os << "  engine                 " << engine << '\n';
   if (!stage.empty()) os << "  answer from stage      " << stage << '\n';
   os << "  status                 " << to_string(status) << '\n';
+  if (!library_status.empty()) os << "  library status         " << library_status << '\n';
   if (!message.empty()) os << "  message                " << message << '\n';
   os << "  iterations             " << iterations << '\n'
      << "  function evaluations   " << function_evaluations << '\n'

@@ -28,7 +28,7 @@ set(nlobs ${prefix}/bin/nlobs)
 set(plugin ${WORK_DIR}/build/libnlobs_example_plugin.so)
 
 # The scenario: the windows (one with the plugin's engine) reconstruct the state; every
-# observer, the plugin's observer type included, gives a finite estimate.
+# observer, the plugin's two observer types included, gives a finite estimate.
 execute_process(COMMAND ${nlobs} --plugin ${plugin} run ${PLUGIN_SOURCE_DIR}/fitzhugh_nagumo.json
                         --out ${WORK_DIR}/run
                 OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
@@ -37,8 +37,8 @@ if(rc)
 endif()
 file(READ ${WORK_DIR}/run/summary.json summary)
 string(JSON observers LENGTH "${summary}" observers)
-if(NOT observers EQUAL 6)
-  message(FATAL_ERROR "summary.json has ${observers} observers, the scenario 6:\n${summary}")
+if(NOT observers EQUAL 7)
+  message(FATAL_ERROR "summary.json has ${observers} observers, the scenario 7:\n${summary}")
 endif()
 math(EXPR last "${observers} - 1")
 foreach(i RANGE ${last})

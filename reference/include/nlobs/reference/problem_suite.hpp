@@ -1,6 +1,7 @@
 #pragma once
-// `nlobs suite SET` and `nlobs solve SET/NAME`: every listed solver — engines of the registry
-// (any spec, a user's engine too) and the reference solvers — on every (problem, start) of a
+// `nlobs suite SET` and `nlobs solve SET/NAME`: every listed solver — an engine of the registry
+// (any spec, a user's engine too, the reference engines of reference_engines.hpp: KINSOL,
+// MINPACK, GSL, PETSc) — on every (problem, start) of a
 // problem set, judged the same way for all: solved when the returned point is finite, inside
 // the problem's bounds and ‖D_f F(x)‖₂ ≤ the threshold (1e-8 unless the set or the caller says
 // otherwise; D_f the problem's f_scale, the identity without one), within the budget and the

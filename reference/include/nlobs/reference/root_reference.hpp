@@ -15,6 +15,10 @@ struct ReferenceResult {
   std::string status;  // "converged" or the solver's own reason
   long f_evals = 0;
   long j_evals = 0;
+  long iterations = 0;  // GSL: the calls of its iterate(); MINPACK's hybrj does not say (0)
+  // ‖F‖∞ at the returned x, from check_answer's evaluation: inf where F is not finite there; NaN
+  // when x itself is not finite (no evaluation).
+  double residual = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct ReferenceOptions {
@@ -45,6 +49,8 @@ inline void check_answer(const RootProblem<Dynamic>& problem, const Eigen::Vecto
   Eigen::VectorXd f(problem.residual_size());
   problem.evaluate(x, f);
   ++result.f_evals;
+  result.residual =
+      f.allFinite() ? f.lpNorm<Eigen::Infinity>() : std::numeric_limits<double>::infinity();
   if (result.status != "converged") return;
   if (!f.allFinite()) {
     result.status = "non_finite";

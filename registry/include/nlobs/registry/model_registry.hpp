@@ -10,12 +10,22 @@
 // register_model.hpp, which derives everything here from the model type and a short
 // definition. This header is light (no observer is included): it is what the CLI's scenario
 // code includes.
+//
+// An observer type that needs the model's own C++ type and is not one of the families above (a
+// plugin's, say: a fixed-size filter, a form only some models have) reaches it through
+// ModelInstance::model_as<Model>() or build_on_model<Models...>() below, for the model types it
+// knows: its own and the built-in ones, whose headers are installed (examples/plugin shows one).
 #include <Eigen/Core>
+#include <any>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
+#include "nlobs/common/named_registry.hpp"
 #include "nlobs/models/discretization.hpp"
 #include "nlobs/observers/core/any_model.hpp"
 #include "nlobs/observers/core/observer.hpp"
@@ -23,7 +33,6 @@
 #include "nlobs/registry/high_gain_spec.hpp"
 #include "nlobs/registry/json_reader.hpp"
 #include "nlobs/registry/modulating_spec.hpp"
-#include "nlobs/registry/named_registry.hpp"
 
 namespace nlobs {
 
@@ -45,12 +54,45 @@ struct ModelHook {
 struct ModelInstance {
   std::string name;  // the registry's name
   AnyModel discrete;
+  // The continuous model, as the C++ type it was registered with (a copy of the one `discrete`
+  // integrates), and how `discrete` integrates it over discrete.sample_time(): enough to build
+  // Discretized<Model>(*model_as<Model>(), discrete.sample_time(), scheme) again.
+  std::any continuous{};
+  Scheme scheme = Scheme::kRk4;
   // MvtOptions::sample_time is the discrete model's.
   ModelHook<const MvtOptions&> mvt;
   // (spec, initial estimate, sample time)
   ModelHook<const HighGainSpec&, const Eigen::VectorXd&, double> high_gain;
   ModelHook<const ModulatingSpec&, const Eigen::VectorXd&, double> modulating;
+
+  // The continuous model if it is a `Model` (the exact type model_entry<Model>() registered),
+  // else null.
+  template <typename Model>
+  const Model* model_as() const {
+    return std::any_cast<Model>(&continuous);
+  }
 };
+
+// An observer type's build for the model types it is written for: calls build(model) with the
+// instance's continuous model as the first of `Models` it is, and returns what build returns.
+// Throws InvalidInput "<family> on model '<name>': <unmet>" when it is none of them, `unmet`
+// saying which models the type takes.
+template <typename... Models, typename Build>
+auto build_on_model(const ModelInstance& instance, const std::string& family,
+                    const std::string& unmet, Build&& build)
+    -> decltype(build(std::declval<const std::tuple_element_t<0, std::tuple<Models...>>&>())) {
+  static_assert(sizeof...(Models) > 0, "build_on_model needs at least one model type");
+  using Result =
+      decltype(build(std::declval<const std::tuple_element_t<0, std::tuple<Models...>>&>()));
+  std::optional<Result> built;
+  // The first matching type builds; the fold stops there.
+  (void)((instance.model_as<Models>() != nullptr
+              ? (built.emplace(build(*instance.model_as<Models>())), true)
+              : false) ||
+         ...);
+  if (!built) throw InvalidInput(family + " on model '" + instance.name + "': " + unmet);
+  return std::move(*built);
+}
 
 struct ModelEntry {
   std::string name;
@@ -66,6 +108,11 @@ struct ModelEntry {
   // model refuses fails naming the parameters object) and discretises with (step, scheme).
   std::function<ModelInstance(JsonReader& parameters, double step, Scheme scheme)> make;
 };
+
+// NamedRegistry refuses a model without make.
+inline std::string missing_part(const ModelEntry& e) {
+  return e.make ? std::string() : std::string("has no make");
+}
 
 using ModelRegistry = NamedRegistry<ModelEntry>;
 

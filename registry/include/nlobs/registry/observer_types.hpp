@@ -18,10 +18,10 @@
 #include <string>
 #include <vector>
 
+#include "nlobs/common/named_registry.hpp"
 #include "nlobs/observers/core/observer.hpp"
 #include "nlobs/registry/json_reader.hpp"
 #include "nlobs/registry/model_registry.hpp"
-#include "nlobs/registry/named_registry.hpp"
 
 namespace nlobs {
 
@@ -50,6 +50,12 @@ struct ObserverTypeEntry {
   // key "bounds"); warnings are appended.
   std::function<nlohmann::json(const std::any& spec, std::vector<std::string>* warnings)> report;
 };
+
+// NamedRegistry refuses an observer type without parse, write or build.
+inline std::string missing_part(const ObserverTypeEntry& e) {
+  return e.parse && e.write && e.build ? std::string()
+                                       : std::string("needs parse, write and build");
+}
 
 using ObserverTypeRegistry = NamedRegistry<ObserverTypeEntry>;
 

@@ -67,7 +67,10 @@ inline constexpr std::uint32_t kPluginMagic = 0x6e6c6f62;  // "nlob"
 // option keys' change): a plugin built against layout 1 would misread both.
 // 3: SolverOptions gained iteration_callback (an engine factory takes SolverOptions by value)
 // and Status gained kStoppedByCallback.
-inline constexpr std::uint32_t kPluginLayout = 3;
+// 4: ModelInstance gained the continuous model and its scheme (model-typed observer types), and
+// the registries a plugin's entries enter became one NamedRegistry with its own lock.
+// 5: Summary gained library_status and an engine entry without_common.
+inline constexpr std::uint32_t kPluginLayout = 5;
 inline constexpr const char* kPluginSymbol = "nlobs_plugin_info";
 
 #define NLOBS_PLUGIN_STRINGIFY_(x) #x

@@ -14,7 +14,7 @@
 #include <utility>
 #include <vector>
 
-#include "nlobs/registry/named_registry.hpp"
+#include "nlobs/common/named_registry.hpp"
 #include "nlobs/solvers/box_bounds.hpp"
 #include "nlobs/solvers/problem.hpp"
 
@@ -139,6 +139,11 @@ struct ProblemSetEntry {
   // reference::default_suite_solvers()).
   std::vector<std::string> default_solvers{};
 };
+
+// NamedRegistry refuses a set without problems().
+inline std::string missing_part(const ProblemSetEntry& e) {
+  return e.problems ? std::string() : std::string("has no problems()");
+}
 
 NamedRegistry<ProblemSetEntry>& problem_set_registry();
 

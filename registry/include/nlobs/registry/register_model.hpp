@@ -86,7 +86,8 @@ constexpr bool kHighGainFits = kFixedSizes<Model>&& Model::kOutputs == 1 && Mode
 template <typename Model>
 ModelInstance model_instance(const std::string& name, Model model, double step, Scheme scheme) {
   ModelInstance out{
-      name, AnyModel(name, Discretized<Model>(model, step, scheme), step), {}, {}, {}};
+      name, AnyModel(name, Discretized<Model>(model, step, scheme), step), model, scheme, {}, {},
+      {}};
   if constexpr (kMvtFits<Model>) {
     out.mvt.make = [model](const MvtOptions& options) -> std::unique_ptr<Observer> {
       return std::make_unique<MvtObserver<Model>>(model, options);

@@ -22,6 +22,8 @@ namespace detail {
 // "newton, dogleg, …": the registered engines that accept bounds (strict: strict ones), asked of
 // the engines themselves; defined with the registry, in the library.
 std::string engines_taking_bounds(bool strict);
+// "newton, dogleg, …, kinsol": the registered engines that accept a scaling, likewise.
+std::string engines_taking_scaling();
 }  // namespace detail
 
 // One completed iteration as an iteration callback sees it: what the trace records (before a
@@ -130,9 +132,10 @@ class Engine {
 
   // KINSOL's scaling for the solves that follow (nlobs/solvers/scaling.hpp: the engine works in
   // x̃ = D_u x on D_f F; its tolerances and Summary norms are the scaled ones). Accepted by the
-  // Newton-type engines (newton, dogleg, levenberg-marquardt, broyden, pseudo-transient, auto);
-  // the others throw InvalidInput here, as do entries that are not finite and > 0. A scale of
-  // another size than the problem's is refused by solve(). Empty scales remove the scaling.
+  // Newton-type engines (newton, dogleg, levenberg-marquardt, broyden, pseudo-transient, auto)
+  // and kinsol, which hands it to KINSOL; the others throw InvalidInput here, as do entries that
+  // are not finite and > 0. A scale of another size than the problem's is refused by solve(). Empty
+  // scales remove the scaling.
   virtual bool accepts_scaling() const { return false; }
   // Whether solve() takes the sparse path (J assembled sparse, steps by the linear-solver layer)
   // for a problem that carries a sparse Jacobian, declared or detected: newton with a line search
@@ -145,9 +148,8 @@ class Engine {
       throw InvalidInput(std::string(name()) + ": set_scaling during a scaled solve");
     }
     if (!scaling.empty() && !accepts_scaling()) {
-      throw InvalidInput(std::string(name()) +
-                         " does not accept a scaling; engines that do: newton, dogleg, "
-                         "levenberg-marquardt, broyden, pseudo-transient, auto");
+      throw InvalidInput(std::string(name()) + " does not accept a scaling; engines that do: " +
+                         detail::engines_taking_scaling());
     }
     detail::validate_scaling(name(), scaling);
     Scaling previous = std::move(scaling_);

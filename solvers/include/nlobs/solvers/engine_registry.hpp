@@ -15,19 +15,22 @@
 // other sizes they come through the fallback, or as fixed-size engines after
 // add_builtin_engines<N>(EngineRegistry<N>::global()) from builtin_engines.hpp.
 //
+// The registry is a NamedRegistry (nlobs/common/named_registry.hpp), as every registry of nlobs
+// is: its name rule, its error type (InvalidInput) and its thread rule (any member from any
+// thread, add() included; create() builds a new engine each call) are that one's.
+//
 // This header names no engine: the engines are compiled once, in the solvers library.
 #include <algorithm>
 #include <functional>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "nlobs/common/named_registry.hpp"
 #include "nlobs/common/printable.hpp"
-#include "nlobs/common/registry_name.hpp"
 #include "nlobs/solvers/dynamic_size_engine.hpp"
 #include "nlobs/solvers/engine.hpp"
 #include "nlobs/solvers/engine_spec.hpp"
@@ -54,15 +57,19 @@ class EngineRegistry {
     std::vector<EngineOptionInfo> options{};  // engine-specific; the common ones are added
     std::vector<std::string> examples{};      // spec strings shown by `nlobs list engines`
     Factory make{};
+    // Common options the engine does not take (EngineDescription::without_common): refused in a
+    // spec as unknown options.
+    std::vector<std::string> without_common{};
+
+    // NamedRegistry refuses an entry without a factory.
+    friend std::string missing_part(const Entry& e) {
+      return e.make ? std::string() : std::string("has no factory");
+    }
   };
 
   // The process-wide registry, with every built-in engine.
   static EngineRegistry& global() {
-    static EngineRegistry registry = [] {
-      EngineRegistry r;
-      if constexpr (is_library_size(N)) add_builtin_engines<N>(r);
-      return r;
-    }();
+    static EngineRegistry registry(WithBuiltins{});
     return registry;
   }
 
@@ -81,22 +88,21 @@ class EngineRegistry {
   // Throws InvalidInput if the name breaks the registry name rule (registry_name.hpp), is taken
   // (naming both sources), or the factory is empty. `source` says who registered it: "built-in", a
   // plugin's path, a program.
-  void add(Entry entry, std::string source = "built-in");
+  void add(Entry entry, std::string source = "built-in") {
+    store_.add(std::move(entry), std::move(source));
+  }
+  // add()'s message for `entry`, empty when add() would take it (NamedRegistry::refusal).
+  std::string refusal(const Entry& entry, const std::string& source) const {
+    return store_.refusal(entry, source);
+  }
 
   // The source that registered `name` in this registry (empty when none did).
-  std::string source(const std::string& name) const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    auto it = sources_.find(name);
-    return it == sources_.end() ? std::string() : it->second;
-  }
+  std::string source(const std::string& name) const { return store_.source(name); }
 
   // Whether create() knows the name (here or, for a fixed N, at Dynamic).
   bool contains(const std::string& name) const { return find(name).has_value(); }
   // Whether this registry has an entry of its own under the name (add() would refuse it).
-  bool has_entry(const std::string& name) const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return entries_.count(name) > 0;
-  }
+  bool has_entry(const std::string& name) const { return store_.contains(name); }
 
   // This registry's entries and, for a fixed N, those of EngineRegistry<Dynamic> it does not
   // shadow (their factories adapt the Dynamic engine); sorted by name.
@@ -117,7 +123,9 @@ class EngineRegistry {
   template <typename DynamicEntry>
   static Entry adapt(DynamicEntry e) {
     auto make = std::move(e.make);
-    return {std::move(e.name), std::move(e.description), std::move(e.options),
+    return {std::move(e.name),
+            std::move(e.description),
+            std::move(e.options),
             std::move(e.examples),
             [make = std::move(make)](EngineSpecReader& s,
                                      SolverOptions o) -> std::unique_ptr<Engine<N>> {
@@ -133,16 +141,16 @@ class EngineRegistry {
               }
               if (!engine) return nullptr;
               return std::make_unique<DynamicSizeEngine<N>>(std::move(engine));
-            }};
+            },
+            std::move(e.without_common)};
   }
 
-  EngineRegistry() = default;
-  EngineRegistry(EngineRegistry&& other) noexcept
-      : entries_(std::move(other.entries_)), sources_(std::move(other.sources_)) {}
+  struct WithBuiltins {};
+  explicit EngineRegistry(WithBuiltins) {
+    if constexpr (is_library_size(N)) add_builtin_engines<N>(*this);
+  }
 
-  mutable std::mutex mutex_;
-  std::map<std::string, Entry> entries_;
-  std::map<std::string, std::string> sources_;
+  NamedRegistry<Entry> store_{"engine"};
 };
 
 // The entry of an engine type E (an Engine<N>) built as the built-ins are: E(options, solver
@@ -157,39 +165,28 @@ typename EngineRegistry<N>::Entry engine_entry() {
   if constexpr (requires { typename E::Options; }) {
     using Options = typename E::Options;
     EngineDescription d = Options::describe();
-    return {std::move(d.name), std::move(d.description), std::move(d.options),
-            std::move(d.examples), [](EngineSpecReader& spec, SolverOptions solver) {
+    return {std::move(d.name),
+            std::move(d.description),
+            std::move(d.options),
+            std::move(d.examples),
+            [](EngineSpecReader& spec, SolverOptions solver) {
               Options options;
               options.read(spec);
               return std::unique_ptr<Engine<N>>(
                   std::make_unique<E>(std::move(options), std::move(solver)));
-            }};
+            },
+            std::move(d.without_common)};
   } else {
     EngineDescription d = E::describe();
-    return {std::move(d.name), std::move(d.description), std::move(d.options),
-            std::move(d.examples), [](EngineSpecReader&, SolverOptions solver) {
+    return {std::move(d.name),
+            std::move(d.description),
+            std::move(d.options),
+            std::move(d.examples),
+            [](EngineSpecReader&, SolverOptions solver) {
               return std::unique_ptr<Engine<N>>(std::make_unique<E>(std::move(solver)));
-            }};
+            },
+            std::move(d.without_common)};
   }
-}
-
-template <int N>
-void EngineRegistry<N>::add(Entry entry, std::string source) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  // The rule of every registry (registry_name.hpp): no ':' ',' '=' (they delimit a spec), and
-  // nothing that cannot be typed or printed.
-  if (!is_registry_name(entry.name)) {
-    throw InvalidInput(registry_name_refusal("engine", entry.name, source));
-  }
-  if (auto it = sources_.find(entry.name); it != sources_.end()) {
-    throw InvalidInput("engine '" + entry.name + "' from " + printable(source) +
-                       " is already registered by " + printable(it->second));
-  }
-  if (!entry.make)
-    throw InvalidInput("engine '" + entry.name + "' from " + source + " has no factory");
-  const std::string name = entry.name;
-  entries_.emplace(name, std::move(entry));
-  sources_.emplace(name, std::move(source));
 }
 
 template <int N>
@@ -201,10 +198,7 @@ auto EngineRegistry<N>::entries() const -> std::vector<Entry> {
       all.emplace(std::move(name), adapt(std::move(e)));
     }
   }
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    for (const auto& [name, e] : entries_) all.insert_or_assign(name, e);
-  }
+  for (const Entry* e : store_.entries()) all.insert_or_assign(e->name, *e);
   std::vector<Entry> out;
   for (auto& [name, e] : all) out.push_back(std::move(e));
   return out;
@@ -225,7 +219,7 @@ std::unique_ptr<Engine<N>> EngineRegistry<N>::create(std::string_view spec_text,
   if (!entry) {
     std::string list;
     for (const auto& name : names()) list += (list.empty() ? "" : ", ") + name;
-    throw InvalidInput("unknown engine " + quoted_excerpt(spec.name) + "; valid engines: " + list);
+    throw InvalidInput(store_.unknown_refusal(spec.name, list));
   }
   std::vector<EngineOptionInfo> valid = entry->options;
   const auto engine_names = [&entry](const std::string& name) {
@@ -236,8 +230,10 @@ std::unique_ptr<Engine<N>> EngineRegistry<N>::create(std::string_view spec_text,
     return false;
   };
   std::vector<std::string> common_keys;  // those the engine leaves to the common options
+  const auto& without = entry->without_common;
   for (EngineOptionInfo common : common_options()) {
     if (engine_names(common.key)) continue;
+    if (std::find(without.begin(), without.end(), common.key) != without.end()) continue;
     std::erase_if(common.aliases, engine_names);
     common_keys.push_back(common.key);
     valid.push_back(std::move(common));
@@ -280,10 +276,7 @@ std::unique_ptr<Engine<N>> EngineRegistry<N>::create(std::string_view spec_text,
 
 template <int N>
 auto EngineRegistry<N>::find(const std::string& name) const -> std::optional<Entry> {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (auto it = entries_.find(name); it != entries_.end()) return it->second;
-  }
+  if (const Entry* own = store_.find(name)) return *own;
   if constexpr (N != Dynamic) {
     for (auto& e : EngineRegistry<Dynamic>::global().entries()) {
       if (e.name == name) return adapt(std::move(e));

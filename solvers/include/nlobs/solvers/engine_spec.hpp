@@ -39,6 +39,10 @@ struct EngineDescription {
   std::string description{};
   std::vector<EngineOptionInfo> options{};
   std::vector<std::string> examples{};
+  // Common options (EngineRegistry::common_options) this engine does not take, by key: a spec
+  // that gives one is refused as an unknown option instead of being ignored. An engine whose
+  // library has stop tests of its own (the reference engines) lists those it does not map.
+  std::vector<std::string> without_common{};
 };
 
 class EngineSpecReader {
@@ -59,6 +63,10 @@ class EngineSpecReader {
                                     const std::vector<std::string>& allowed);
   // The single bare word, if any, which must be one of `allowed` (empty: any).
   std::optional<std::string> word(const std::vector<std::string>& allowed = {});
+  // For an engine with a syntax of its own after its name (petsc:TYPE:-key=value:-flag): the
+  // items no read took, as the spec wrote them — bare words, then key=value items, in order,
+  // joined by ',' — all marked read. Empty when none is left.
+  std::string rest();
   // Throws InvalidInput naming every item not consumed and listing the valid options.
   void finish() const;
 

@@ -50,6 +50,11 @@ struct Summary {
   // Minimisation engines (NLopt): the objective at the returned x.
   std::optional<double> objective;
   std::string message;  // detail for kInvalidInput, kSingularJacobian, kSolverFailure, backends
+  // An engine that runs another library (the reference engines: KINSOL, MINPACK, GSL, PETSc):
+  // that library's own account of the run, as nlobs names it ("xtol_too_small",
+  // "kin_linesearch_nonconv", "diverged_line_search"), of which `status` is the nearest Status.
+  // What `nlobs suite` shows as the row's status. Empty for nlobs' own engines.
+  std::string library_status;
   // A polyalgorithm (auto): the label of the engine whose answer this is; empty otherwise.
   std::string stage;
   std::vector<TraceEntry> trace;
