@@ -13,12 +13,12 @@
 #include "run_support.hpp"
 
 namespace nlobs::cli {
-void print_modulating_metrics(const RunResult& r, const std::vector<long>& horizon_indices,
-                              std::ostream& out) {
+void print_modulating_metrics(const ScenarioRun& run, std::ostream& out) {
+  const RunResult& r = run.result;
   bool header = false;
   char line[256];
   for (size_t i = 0; i < r.metrics.size(); ++i) {
-    const auto m = modulating_metrics(r, i, horizon_indices[i]);
+    const auto& m = run.figures[i].modulating;
     if (!m) continue;
     if (!header) {
       out << "canonical state (||eta - etahat||_2): max relative error from one horizon on, over "

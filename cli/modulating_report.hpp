@@ -17,8 +17,8 @@
 
 namespace nlobs::cli {
 
-void print_modulating_metrics(const RunResult& r, const std::vector<long>& horizon_indices,
-                              std::ostream& out);
+// The canonical-state figures run_prepared computed (ScenarioRun::figures).
+void print_modulating_metrics(const ScenarioRun& run, std::ostream& out);
 
 // --sweep horizon=…, sample_period=… (the modulating observers' keys) or PARAMETER=… (the
 // model's, re-simulating the data per value). Writes sweep.csv, sweep.dat, sweep.png with --out.

@@ -32,8 +32,12 @@ std::string fmt(double v, const char* f) {
 
 namespace {
 
-void print_table(const Scenario& s, const Measurements& data, const RunResult& r,
-                 std::ostream& out) {
+// The run's tables: what it measured and the figures run_prepared computed (nothing computed
+// here).
+void print_table(const ScenarioRun& run, std::ostream& out) {
+  const Scenario& s = run.prepared.scenario;
+  const Measurements& data = run.prepared.data;
+  const RunResult& r = run.result;
   char line[512];
   out << "scenario " << s.name << ": " << data.steps() << " samples, noise sigma " << s.noise;
   if (s.process_noise > 0.0) out << ", process noise sigma " << s.process_noise;
@@ -82,22 +86,23 @@ void print_table(const Scenario& s, const Measurements& data, const RunResult& r
   }
   if (data.has_truth()) {
     out << "time from which ||x - xhat||_2 < 1e-3 to the end";
-    bool any_residual = false;
-    for (size_t i = 0; i < r.metrics.size(); ++i)
-      any_residual |= max_beta_residual(r, i).has_value();
+    const bool any_residual =
+        std::any_of(run.figures.begin(), run.figures.end(),
+                    [](const ObserverFigures& f) { return f.max_beta_residual.has_value(); });
     out << (any_residual ? "; MVT: largest ||X(beta)||_2 over the run" : "") << ":\n";
     for (size_t i = 0; i < r.metrics.size(); ++i) {
-      const long k = first_index_staying_below(data.x, r.estimates[i], 1e-3);
+      const ObserverFigures& f = run.figures[i];
+      const long k = f.time_index_below_1e3;
       std::snprintf(line, sizeof line, "  %-24s %s", r.metrics[i].name.c_str(),
                     k >= 0 ? ("t = " + fmt(data.t[k], "%.3f") + " s").c_str() : "never");
       out << line;
-      if (const auto residual = max_beta_residual(r, i)) out << "   ||X|| " << fmt(*residual);
+      if (f.max_beta_residual) out << "   ||X|| " << fmt(*f.max_beta_residual);
       out << '\n';
     }
   }
   bool header = false;
   for (size_t i = 0; i < r.metrics.size(); ++i) {
-    const auto em = embedded_metrics(r, i);
+    const auto& em = run.figures[i].embedded;
     if (!em) continue;
     if (!header) {
       out << "embedded coordinates (||z - zhat||_2, z = q_N(x)): max ||zhat|| (peaking), below "
@@ -352,8 +357,8 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
   if (printed) err << '\n';
   const Scenario& sc = run.prepared.scenario;
   const Measurements& data = run.prepared.data;
-  print_table(sc, data, run.result, out);
-  print_modulating_metrics(run.result, run.horizon_indices, out);
+  print_table(run, out);
+  print_modulating_metrics(run, out);
   print_bounds(run.observer_reports, out);
 
   if (!options.out_dir.empty()) {

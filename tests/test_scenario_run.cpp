@@ -230,6 +230,39 @@ TEST(ScenarioRun, EmbeddedAndCanonicalMetricsComeWithTheObserversThatPublishThem
   EXPECT_FALSE(some_observer_reports("chua-fp", 60, "max_zhat_norm"));  // no high-gain observer
 }
 
+// The papers' figures are computed once, into ScenarioRun::figures, and summary.json (like
+// `nlobs run`'s tables) reads them: one per observer, the same numbers.
+TEST(ScenarioRun, TheFiguresAreComputedOnceAndSummaryJsonReadsThem) {
+  for (const auto& [name, steps] : {std::pair<std::string, long>{"hg-duffing", 2000},
+                                    std::pair<std::string, long>{"mf-lti", 801},
+                                    std::pair<std::string, long>{"mvt-chaotic", 400}}) {
+    SCOPED_TRACE(name);
+    Scenario s = load_scenario(name);
+    s.steps = steps;
+    const ScenarioRun run = run_scenario(s);
+    ASSERT_EQ(run.figures.size(), run.result.metrics.size());
+    const nlohmann::json j = summary_json(run);
+    bool any = false;
+    for (std::size_t i = 0; i < run.figures.size(); ++i) {
+      const ObserverFigures& f = run.figures[i];
+      const nlohmann::json& o = j["observers"][i];
+      if (f.time_index_below_1e3 >= 0) {
+        EXPECT_EQ(o["time_to_1e-3"].get<double>(), run.prepared.data.t[f.time_index_below_1e3]);
+      } else {
+        EXPECT_TRUE(o["time_to_1e-3"].is_null());
+      }
+      EXPECT_EQ(o.contains("max_beta_residual"), f.max_beta_residual.has_value());
+      EXPECT_EQ(o.contains("max_zhat_norm"), f.embedded.has_value());
+      EXPECT_EQ(o.contains("eta_rms_after"), f.modulating.has_value());
+      if (f.embedded && std::isfinite(f.embedded->max_zhat_norm)) {
+        EXPECT_EQ(o["max_zhat_norm"].get<double>(), f.embedded->max_zhat_norm);
+      }
+      any |= f.max_beta_residual || f.embedded || f.modulating;
+    }
+    EXPECT_TRUE(any);  // each scenario has an observer the figures are for
+  }
+}
+
 TEST(ScenarioRun, BuiltInScenariosAreTheirDataFilesReadAsAUsersFile) {
   // Each built-in is runs/scenarios/NAME.json: its name inside is its file's, and the same file
   // given by path reads to the same scenario.

@@ -167,4 +167,18 @@ std::optional<ModulatingMetrics> modulating_metrics(const RunResult& r, std::siz
   return m;
 }
 
+std::vector<ObserverFigures> observer_figures(const Measurements& data, const RunResult& r,
+                                              const std::vector<long>& horizon_indices) {
+  std::vector<ObserverFigures> out(r.metrics.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    ObserverFigures& f = out[i];
+    if (data.has_truth())
+      f.time_index_below_1e3 = first_index_staying_below(data.x, r.estimates[i], 1e-3);
+    f.max_beta_residual = max_beta_residual(r, i);
+    f.embedded = embedded_metrics(r, i);
+    f.modulating = modulating_metrics(r, i, i < horizon_indices.size() ? horizon_indices[i] : -1);
+  }
+  return out;
+}
+
 }  // namespace nlobs

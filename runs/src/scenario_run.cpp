@@ -22,8 +22,7 @@ nlohmann::json vector_or_null(const Eigen::VectorXd& v) {
   return a;
 }
 
-void add_modulating_json(const RunResult& r, std::size_t i, long horizon_index, nlohmann::json& o) {
-  const auto m = modulating_metrics(r, i, horizon_index);
+void add_modulating_json(const std::optional<ModulatingMetrics>& m, nlohmann::json& o) {
   if (!m) return;
   o["max_eta_rel_error_after_horizon"] = number_or_null(m->rel_after_horizon);
   o["max_eta_error_after_horizon"] = number_or_null(m->abs_after_horizon);
@@ -78,7 +77,11 @@ nlohmann::json summary_json(const ScenarioRun& run) {
   const RunResult& r = run.result;
   const nlohmann::json& bounds = run.observer_reports;
   const std::vector<std::string>& warnings = run.warnings;
-  const std::vector<long>& horizon_indices = run.horizon_indices;
+  // run_prepared fills the figures; a ScenarioRun put together otherwise gets them here.
+  const std::vector<ObserverFigures> computed =
+      run.figures.size() == r.metrics.size() ? std::vector<ObserverFigures>()
+                                             : observer_figures(data, r, run.horizon_indices);
+  const std::vector<ObserverFigures>& figures = computed.empty() ? run.figures : computed;
   nlohmann::json observers = nlohmann::json::array();
   for (const ObserverMetrics& m : r.metrics) {
     nlohmann::json o{{"name", m.name},
@@ -95,13 +98,13 @@ nlohmann::json summary_json(const ScenarioRun& run) {
       o["max_error_after"] = vector_or_null(m.max_error_after);
     }
     if (!m.first_failure.empty()) o["first_failure"] = m.first_failure;
-    const size_t i = observers.size();
+    const ObserverFigures& f = figures[observers.size()];
     if (data.has_truth()) {
-      const long k = first_index_staying_below(data.x, r.estimates[i], 1e-3);
+      const long k = f.time_index_below_1e3;
       o["time_to_1e-3"] = k >= 0 ? nlohmann::json(data.t[k]) : nlohmann::json(nullptr);
     }
-    if (const auto residual = max_beta_residual(r, i)) o["max_beta_residual"] = *residual;
-    if (const auto em = embedded_metrics(r, i)) {
+    if (f.max_beta_residual) o["max_beta_residual"] = *f.max_beta_residual;
+    if (const auto& em = f.embedded) {
       o["max_zhat_norm"] = number_or_null(em->max_zhat_norm);
       o["time_to_z_1e-6"] = em->time_index_below >= 0 ? nlohmann::json(data.t[em->time_index_below])
                                                       : nlohmann::json(nullptr);
@@ -110,7 +113,7 @@ nlohmann::json summary_json(const ScenarioRun& run) {
       o["max_projection_residual_after"] = number_or_null(em->max_residual_after);
       o["projection_jumps"] = em->jumps;
     }
-    add_modulating_json(r, i, horizon_indices[i], o);
+    add_modulating_json(f.modulating, o);
     observers.push_back(o);
   }
   nlohmann::json j{{"scenario", s.name},           {"steps", data.steps()},
@@ -149,7 +152,7 @@ ScenarioRun run_prepared(PreparedScenario prepared, const RunSettings& settings)
                                   ? std::string()
                                   : " (" + prepared.data.stop_message + ")"));
   }
-  ScenarioRun run{std::move(prepared), {}, nlohmann::json::array(), {}, {}};
+  ScenarioRun run{std::move(prepared), {}, nlohmann::json::array(), {}, {}, {}};
   const Scenario& s = run.prepared.scenario;
   const Measurements& data = run.prepared.data;
   auto observers = make_observers(s, run.prepared.model, settings.trace_first_window);
@@ -176,6 +179,7 @@ ScenarioRun run_prepared(PreparedScenario prepared, const RunSettings& settings)
   }
   run.result = measure_observers(data, observers, run.prepared.settle_index, run.horizon_indices,
                                  settings.progress);
+  run.figures = observer_figures(data, run.result, run.horizon_indices);
   // What the run itself found (a window map that does not contract, a singular guess).
   for (const auto& o : observers) {
     for (const auto& w : o->info().warnings) warn(w);

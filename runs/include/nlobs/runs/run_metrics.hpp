@@ -66,4 +66,17 @@ std::optional<ModulatingMetrics> modulating_metrics(const RunResult& r, std::siz
 // largest finite value over the run; nothing for other observers.
 std::optional<double> max_beta_residual(const RunResult& r, std::size_t i);
 
+// Every figure above for one observer of a run, computed once (run_prepared does): what
+// summary.json and `nlobs run`'s tables read, so that printing computes nothing.
+struct ObserverFigures {
+  // The first sample from which ‖x − x̂‖₂ < 1e-3 to the end; −1: never, or no truth.
+  long time_index_below_1e3 = -1;
+  std::optional<double> max_beta_residual{};
+  std::optional<EmbeddedMetrics> embedded{};
+  std::optional<ModulatingMetrics> modulating{};
+};
+// One per observer of `r` (its metrics' order); `horizon_indices` as measure_observers gives them.
+std::vector<ObserverFigures> observer_figures(const Measurements& data, const RunResult& r,
+                                              const std::vector<long>& horizon_indices);
+
 }  // namespace nlobs

@@ -16,6 +16,7 @@
 #include "nlobs/observers/core/observer.hpp"
 #include "nlobs/observers/core/simulation.hpp"
 #include "nlobs/registry/model_registry.hpp"
+#include "nlobs/runs/run_metrics.hpp"
 #include "nlobs/runs/scenario.hpp"
 
 namespace nlobs {
@@ -60,6 +61,9 @@ struct ScenarioRun {
   nlohmann::json observer_reports = nlohmann::json::array();
   std::vector<std::string> warnings;
   std::vector<long> horizon_indices;  // per observer, the first sample with a full window
+  // Per observer, the papers' figures (run_metrics.hpp: time to 1e-3, the MVT's residual, the
+  // embedded and canonical coordinates' errors), computed once by run_prepared.
+  std::vector<ObserverFigures> figures{};
 };
 
 // Runs every observer of the scenario on the prepared data. Throws std::runtime_error when the
