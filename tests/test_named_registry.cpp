@@ -9,7 +9,7 @@
 #include <thread>
 #include <vector>
 
-#include "message_of.hpp"
+#include "invalid_argument_message.hpp"
 #include "nlobs/common/named_registry.hpp"
 #include "nlobs/registry/model_registry.hpp"
 #include "nlobs/registry/observer_types.hpp"

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "message_of.hpp"
+#include "invalid_argument_message.hpp"
 #include "nlobs/reference/kinsol_solver.hpp"
 #include "nlobs/reference/petsc_solver.hpp"
 #include "nlobs/reference/reference_engines.hpp"

@@ -5,7 +5,7 @@
 #include <limits>
 #include <string>
 
-#include "message_of.hpp"
+#include "invalid_argument_message.hpp"
 #include "nlobs/models/model.hpp"
 #include "nlobs/solvers/solvers.hpp"
 

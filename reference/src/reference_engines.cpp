@@ -600,17 +600,31 @@ class PetscEngine final : public LibraryEngine {
 
 }  // namespace
 
+namespace {
+
+// The one list of the reference engines: what add_reference_engines adds and
+// is_reference_engine knows. petsc too in a build without PETSc: its set-up then refuses, saying
+// so (invalid_input rows).
+std::vector<EngineRegistry<Dynamic>::Entry> reference_entries() {
+  return {KinsolEngine::entry(), MinpackEngine::entry(), GslEngine::entry(), PetscEngine::entry()};
+}
+
+}  // namespace
+
 void add_reference_engines(EngineRegistry<Dynamic>& registry) {
-  // petsc too in a build without PETSc: its set-up then refuses, saying so (invalid_input rows).
-  for (auto& e :
-       {KinsolEngine::entry(), MinpackEngine::entry(), GslEngine::entry(), PetscEngine::entry()}) {
-    if (!registry.has_entry(e.name)) registry.add(e, "built-in");
+  for (auto& e : reference_entries()) {
+    if (!registry.has_entry(e.name)) registry.add(std::move(e), "built-in");
   }
 }
 
 bool is_reference_engine(std::string_view spec) {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const auto& e : reference_entries()) out.push_back(e.name);
+    return out;
+  }();
   const std::string_view name = spec.substr(0, spec.find(':'));
-  return name == "kinsol" || name == "minpack" || name == "gsl" || name == "petsc";
+  return std::find(names.begin(), names.end(), name) != names.end();
 }
 
 void register_reference_engines() {
