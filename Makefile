@@ -57,10 +57,10 @@ fuzz:
 	./scripts/run-fuzz build-fuzz $(FUZZ_SECONDS)
 
 format: deps
-	find common solvers observers models registry runs reference bench cli tests examples -name '*.hpp' -o -name '*.cpp' | xargs clang-format -i
+	find common solvers observers models registry runs reference bench cli tests examples -name '*.hpp' -o -name '*.cpp' -o -name '*.inc' | xargs clang-format -i
 
 format-check: deps
-	find common solvers observers models registry runs reference bench cli tests examples -name '*.hpp' -o -name '*.cpp' | xargs clang-format --dry-run --Werror
+	find common solvers observers models registry runs reference bench cli tests examples -name '*.hpp' -o -name '*.cpp' -o -name '*.inc' | xargs clang-format --dry-run --Werror
 
 # Per-translation-unit wall time and peak memory of a from-scratch build (docs/architecture.md).
 compile-cost: deps

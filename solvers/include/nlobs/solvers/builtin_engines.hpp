@@ -7,7 +7,8 @@
 //
 // Each engine owns its entry (engine_entry, engine_registry.hpp): its options type describes it,
 // reads its spec and validates itself (NewtonOptions::describe/read/validate, in src/options/).
-// Adding a built-in engine is its header, its source and one line below.
+// Adding a built-in engine is its header (with its extern declarations at the library sizes),
+// its source, one line below and one in src/instances/engines_at_size.inc (its instantiation).
 #include <memory>
 #include <string>
 #include <utility>

@@ -1,8 +1,6 @@
-// The registry and its built-in entries at the library's sizes (nlobs/solvers/library_sizes.hpp):
-// the only place that names every engine, so that engine_registry.hpp names none.
+// The engines that take bounds or scaling, for the refusals of Engine::set_bounds and
+// Engine::set_scaling: read from the registry, so that they follow it.
 #include "nlobs/solvers/engine_registry.hpp"
-
-#include "nlobs/solvers/builtin_engines.hpp"
 
 namespace nlobs {
 
@@ -48,12 +46,5 @@ std::string engines_taking_scaling() {
 }
 
 }  // namespace detail
-
-#define NLOBS_INSTANTIATE(n)           \
-  template class EngineRegistry<n>;    \
-  template class DynamicSizeEngine<n>; \
-  template void add_builtin_engines<n>(EngineRegistry<n>&);
-NLOBS_FOR_EACH_LIBRARY_SIZE(NLOBS_INSTANTIATE)
-#undef NLOBS_INSTANTIATE
 
 }  // namespace nlobs

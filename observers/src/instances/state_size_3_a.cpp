@@ -1,0 +1,5 @@
+// One unit of the catalogue's observer instances (the files included below, one per model):
+// grouped by state size, which the models' observers share most of (the fixed-size Eigen types
+// of the Taylor maps' orders, the high-gain and MVT machinery). observers/CMakeLists.txt says why.
+#include "cubic_chua.inc"
+#include "modified_chua.inc"
