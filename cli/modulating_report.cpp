@@ -82,7 +82,7 @@ void run_modulating_sweep(const PreparedScenario& prepared, const std::string& k
     const RunResult& r = v.result;
     for (size_t i = 0; i < r.metrics.size(); ++i) {
       const ObserverMetrics& m = r.metrics[i];
-      const auto mm = modulating_metrics(r, i, v.horizon_indices[i]);
+      const std::optional<ModulatingMetrics>& mm = v.figures[i].modulating;
       const double x_rms =
           m.mse_after_window.size() ? std::sqrt(m.mse_after_window.sum()) : std::nan("");
       const double x2_rms =

@@ -226,7 +226,7 @@ void run_sweep(const PreparedScenario& prepared, const RunOptions& options, std:
     const double theta = v.value;
     const RunResult& r = v.result;
     for (size_t i = 0; i < r.metrics.size(); ++i) {
-      const auto em = embedded_metrics(r, i);
+      const std::optional<EmbeddedMetrics>& em = v.figures[i].embedded;
       const ObserverMetrics& m = r.metrics[i];
       // RMS of ‖x − x̂‖₂: the per-state mean squares summed over the states.
       const double x_rms =

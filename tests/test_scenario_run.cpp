@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -298,6 +299,46 @@ TEST(Sweep, AnyObserverKeyIsSweptOnTheSameData) {
   const SweepRun only = run_sweep(prepared, "gamma", {5.0}, {.only_swept_observers = true});
   ASSERT_EQ(only.values[0].result.metrics.size(), 1u);
   EXPECT_EQ(only.values[0].result.metrics[0].mse[0], a.metrics[smo].mse[0]);
+}
+
+// Each value of a sweep carries the papers' figures of its own run, computed with it (the CLI's
+// sweep tables read them): the high-gain peaking grows as θ shrinks ([HG-EMB23]), and the
+// canonical errors follow the modulating horizon.
+TEST(Sweep, EachValueCarriesTheFiguresOfItsRun) {
+  const auto same = [](double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); };
+  Scenario hg = load_scenario("hg-duffing");
+  hg.steps = 2000;
+  const SweepRun theta =
+      run_sweep(prepare_scenario(hg), "theta", {0.05, 0.1}, {.only_swept_observers = true});
+  ASSERT_EQ(theta.values.size(), 2u);
+  for (const SweepValue& v : theta.values) {
+    ASSERT_EQ(v.figures.size(), v.result.metrics.size());
+    ASSERT_TRUE(v.figures[0].embedded.has_value());
+    const std::optional<EmbeddedMetrics> again = embedded_metrics(v.result, 0);
+    ASSERT_TRUE(again.has_value());
+    EXPECT_TRUE(same(v.figures[0].embedded->max_zhat_norm, again->max_zhat_norm));
+    EXPECT_TRUE(same(v.figures[0].embedded->z_rms_after, again->z_rms_after));
+  }
+  EXPECT_GT(theta.values[0].figures[0].embedded->max_zhat_norm,
+            theta.values[1].figures[0].embedded->max_zhat_norm);
+
+  Scenario mf = load_scenario("mf-lti");
+  mf.steps = 801;
+  const SweepRun horizon = run_sweep(prepare_scenario(mf), "horizon", {0.5, 1.0});
+  bool any = false;
+  for (const SweepValue& v : horizon.values) {
+    ASSERT_EQ(v.figures.size(), v.result.metrics.size());
+    for (std::size_t i = 0; i < v.figures.size(); ++i) {
+      const std::optional<ModulatingMetrics> again =
+          modulating_metrics(v.result, i, v.horizon_indices[i]);
+      ASSERT_EQ(v.figures[i].modulating.has_value(), again.has_value()) << i;
+      if (!again) continue;
+      any = true;
+      EXPECT_TRUE(same(v.figures[i].modulating->final_rel, again->final_rel));
+      EXPECT_TRUE(same(v.figures[i].modulating->max_bound, again->max_bound));
+    }
+  }
+  EXPECT_TRUE(any);  // mf-lti has modulating observers
 }
 
 TEST(Sweep, AModelParameterIsSimulatedAgainPerValue) {

@@ -109,6 +109,7 @@ SweepRun run_sweep(const PreparedScenario& prepared, const std::string& key,
     SweepValue v;
     v.value = value;
     v.result = measure_observers(*d, observers, sweep.settle_index, v.horizon_indices);
+    v.figures = observer_figures(*d, v.result, v.horizon_indices);
     sweep.values.push_back(std::move(v));
   }
   return sweep;

@@ -31,6 +31,9 @@ struct SweepValue {
   double value = 0.0;
   RunResult result;  // names made unique, coordinate errors added (run_metrics.hpp)
   std::vector<long> horizon_indices;  // per observer run, its window less one
+  // The papers' figures of each observer run (run_metrics.hpp: the embedded and canonical
+  // errors, the MVT's residual), computed once with the run: a table reads them.
+  std::vector<ObserverFigures> figures;
 };
 
 struct SweepRun {
