@@ -1,5 +1,12 @@
-// One unit of the catalogue's observer instances (the files included below, one per model):
-// grouped by state size, which the models' observers share most of (the fixed-size Eigen types
-// of the Taylor maps' orders, the high-gain and MVT machinery). observers/CMakeLists.txt says why.
-#include "cubic_chua.inc"
-#include "modified_chua.inc"
+// The catalogue's observers of one state size, compiled once (instantiate_*.hpp): one unit per
+// state size (two for the larger groups), because the models of one size share most of what
+// their observers instantiate (the Taylor maps' fixed-size orders, the high-gain and MVT
+// machinery). observers/CMakeLists.txt gives the measurement.
+#include "instantiate_high_gain.hpp"
+
+namespace nlobs {
+
+NLOBS_INSTANTIATE_HIGH_GAIN_MODEL(ModifiedChua, 3)
+NLOBS_INSTANTIATE_HIGH_GAIN_MODEL(CubicChua, 3)
+
+}  // namespace nlobs

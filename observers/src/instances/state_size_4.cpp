@@ -1,5 +1,12 @@
-// One unit of the catalogue's observer instances (the files included below, one per model):
-// grouped by state size, which the models' observers share most of (the fixed-size Eigen types
-// of the Taylor maps' orders, the high-gain and MVT machinery). observers/CMakeLists.txt says why.
-#include "lander_immersed.inc"
-#include "robot.inc"
+// The catalogue's observers of one state size, compiled once (instantiate_*.hpp): one unit per
+// state size (two for the larger groups), because the models of one size share most of what
+// their observers instantiate (the Taylor maps' fixed-size orders, the high-gain and MVT
+// machinery). observers/CMakeLists.txt gives the measurement.
+#include "instantiate_mvt.hpp"
+
+namespace nlobs {
+
+NLOBS_INSTANTIATE_MVT_MODEL(FlexibleJointRobot)
+NLOBS_INSTANTIATE_MVT_MODEL(LunarLanderImmersed)
+
+}  // namespace nlobs

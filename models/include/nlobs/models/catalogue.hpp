@@ -2,9 +2,9 @@
 // The catalogue's continuous models as C++ types, listed once for the explicit instantiations
 // of the observers library (observers/src/instances/): the observers the CLI builds for these
 // models are compiled there, once, and their headers declare them extern. A model added here
-// needs its file in observers/src/instances/ (one <model>.inc per model, included by the unit of
-// its state size, state_size_<n>_*.cpp; the static_asserts there check the lists), or its users
-// fail to link.
+// needs its line in observers/src/instances/, in the unit of its state size (state_size_<n>*.cpp:
+// NLOBS_INSTANTIATE_HIGH_GAIN_MODEL or _MVT_MODEL, whose static_asserts check the lists), or its
+// users fail to link.
 #include "nlobs/models/modified_chua.hpp"
 #include "nlobs/models/systems.hpp"
 
