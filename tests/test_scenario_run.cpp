@@ -351,6 +351,20 @@ TEST(Sweep, AModelParameterIsSimulatedAgainPerValue) {
   ASSERT_EQ(sweep.values.size(), 2u);
   // The faster decay is tracked from an initial error that vanishes sooner: lower MSE.
   EXPECT_LT(sweep.values[1].result.metrics[0].mse[0], sweep.values[0].result.metrics[0].mse[0]);
+  // Each value's figures are read against its own simulation, not the prepared one: the same
+  // as a run of the scenario with that parameter (a user's model, which nlobs does not ship).
+  Scenario faster = prepared.scenario;
+  faster.model["parameters"]["a"] = 2.0;
+  const ScenarioRun alone = run_scenario(faster);
+  ASSERT_EQ(sweep.values[1].figures.size(), alone.figures.size());
+  bool settles = false;
+  for (std::size_t i = 0; i < alone.figures.size(); ++i) {
+    EXPECT_EQ(sweep.values[1].figures[i].time_index_below_1e3,
+              alone.figures[i].time_index_below_1e3)
+        << i;
+    settles |= alone.figures[i].time_index_below_1e3 >= 0;
+  }
+  EXPECT_TRUE(settles);  // a figure that tells the two simulations apart
 }
 
 TEST(Sweep, HostileSweepsAreRefusedNamingKeyAndValue) {
