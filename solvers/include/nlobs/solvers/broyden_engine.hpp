@@ -212,10 +212,7 @@ bool BroydenEngine<N>::search(const Vector<N>& d, double t0, bool armijo) {
 
 template <int N>
 Summary BroydenEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
-  if (std::optional<Summary> scaled =
-          this->solve_scaled(problem, x, [this](const FixedPointProblem<N>& p, Vector<N>& y) {
-            return BroydenEngine<N>::solve(p, y);
-          })) {
+  if (std::optional<Summary> scaled = this->solve_scaled(*this, problem, x)) {
     return std::move(*scaled);
   }
   const StopCriteria& stop = this->options_.stop;

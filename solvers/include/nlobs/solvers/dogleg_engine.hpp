@@ -177,10 +177,7 @@ void DoglegEngine<N>::rank_one_update() {
 
 template <int N>
 Summary DoglegEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
-  if (std::optional<Summary> scaled =
-          this->solve_scaled(problem, x, [this](const FixedPointProblem<N>& p, Vector<N>& y) {
-            return DoglegEngine<N>::solve(p, y);
-          })) {
+  if (std::optional<Summary> scaled = this->solve_scaled(*this, problem, x)) {
     return std::move(*scaled);
   }
   StopCriteria stop = this->options_.stop;

@@ -185,13 +185,14 @@ class Engine {
   virtual void on_set_scaling() {}
   // For an engine that applies a scaling itself, first thing in solve(): with a scaling set (and
   // not already inside this call), checks x and the box in the problem's terms, solves the
-  // scaled problem by `unscaled(problem, x)` — the engine's own solve, called non-virtually — with
-  // the box in scaled variables, and returns its summary with x and the trace's points in the
+  // scaled problem by self.Self::solve — the engine's own solve, called non-virtually — with the
+  // box in scaled variables, and returns its summary with x and the trace's points in the
   // problem's variables (inside its box); nullopt otherwise. A scaled solve allocates (the scaled
   // problem, the box), at fixed N too: once per solve, not per evaluation.
-  template <typename Solve>
-  std::optional<Summary> solve_scaled(const FixedPointProblem<N>& problem, Vector<N>& x,
-                                      Solve&& unscaled);
+  //   if (auto scaled = this->solve_scaled(*this, problem, x)) return std::move(*scaled);
+  template <typename Self>
+  std::optional<Summary> solve_scaled(Self& self, const FixedPointProblem<N>& problem,
+                                      Vector<N>& x);
   SolverOptions options_;
   BoxBounds bounds_;
   Scaling scaling_;
@@ -304,9 +305,9 @@ void check_initial_guess(std::string_view engine, const FixedPointProblem<N>& pr
 }  // namespace detail
 
 template <int N>
-template <typename Solve>
-std::optional<Summary> Engine<N>::solve_scaled(const FixedPointProblem<N>& problem, Vector<N>& x,
-                                               Solve&& unscaled) {
+template <typename Self>
+std::optional<Summary> Engine<N>::solve_scaled(Self& self, const FixedPointProblem<N>& problem,
+                                               Vector<N>& x) {
   if (scaling_.empty() || scaled_solve_running_) return std::nullopt;
   // Checked in the problem's own terms before anything is scaled.
   detail::check_initial_guess<N>(name(), problem.size(), x);
@@ -330,7 +331,7 @@ std::optional<Summary> Engine<N>::solve_scaled(const FixedPointProblem<N>& probl
       engine->scaled_solve_running_ = false;
     }
   } restore{this, &original};
-  Summary s = unscaled(scaled, xs);
+  Summary s = self.Self::solve(scaled, xs);
   // Back in the problem's variables, as the scaled map evaluated it: inside the box. (Component
   // by component: GCC 12 warns of Eigen's packet loads at N = 1.)
   detail::Box<N> box;

@@ -141,8 +141,7 @@ class LevenbergMarquardtEngine : public Engine<N> {
   detail::LmQrModel<N> dense_;
   Matrix<N, N> square_jacobian_;  // ∂G or ∂F of a fixed-size square problem, before J
   FiniteDifferenceWorkspace<N> fd_;
-  detail::Box<N> box_;
-  ProgressWindow progress_;
+  detail::SolveLedger<N> ledger_;  // counts, budget, progress window, box
 };
 
 template <int N>
@@ -207,17 +206,13 @@ Summary LevenbergMarquardtEngine<N>::run(Model& model, Residual&& residual, Jaco
   Summary summary;
   summary.engine = name();
   StopMonitor monitor(stop, x.template lpNorm<Eigen::Infinity>(), /*estimate_lipschitz=*/false);
-  int evaluations = 0, jacobians = 0;
   const double eps = std::numeric_limits<double>::epsilon();
-  // A least-squares minimum has ‖F‖ > 0 and a warm start may sit at it: no window there (its
-  // stop is function_tolerance's, a convergence).
-  progress_.start(least_squares ? 0 : stop.progress_window);
   auto evaluate = [&](const Vector<N>& at, ResidualVector& out) {
-    ++evaluations;
     const bool finite = residual(at, out);
-    progress_.saw(finite ? out.stableNorm() : std::numeric_limits<double>::infinity());
+    ledger_.count_evaluation(finite ? out.stableNorm() : std::numeric_limits<double>::infinity());
     return finite;
   };
+  const detail::Box<N>& box = ledger_.box();
 
   x_ = x;
   std::optional<Status> status;
@@ -231,9 +226,9 @@ Summary LevenbergMarquardtEngine<N>::run(Model& model, Residual&& residual, Jaco
   bool accepted_any = false;  // until the first accepted step Δ ≤ ‖Dp‖ (MINPACK's iter = 1)
   // A square system stuck where a bound holds x against −∇(½‖F‖²) = −Jᵀ F is blocked.
   auto stagnate = [&](std::string why) {
-    if (const std::optional<Index> i = box_.blocking(x_, gradient_, detail::BoxMove::kDirection)) {
-      summary.message = box_.blocked_message(*i, x_, f_.template lpNorm<Eigen::Infinity>(),
-                                             "the descent direction");
+    if (const std::optional<Index> i = box.blocking(x_, gradient_, detail::BoxMove::kDirection)) {
+      summary.message = box.blocked_message(*i, x_, f_.template lpNorm<Eigen::Infinity>(),
+                                            "the descent direction");
       status = Status::kBlockedByBound;
       return;
     }
@@ -241,32 +236,23 @@ Summary LevenbergMarquardtEngine<N>::run(Model& model, Residual&& residual, Jaco
     status = Status::kStagnated;
   };
   // The budget is spent, or the progress window passed without progress (stagnated, or blocked
-  // where a bound holds x against the descent direction): status set.
+  // where a bound holds x against the descent direction −Jᵀ F, unless ‖F‖∞ is already usable):
+  // status set.
   auto spent = [&] {
-    if (evaluations >= stop.max_evaluations) {
-      status = Status::kMaxEvaluations;
-    } else if (progress_.expired()) {
-      // (where ‖F‖∞ is already usable, stagnated: a blocked answer is never usable)
-      const double usable =
-          std::max(stop.residual_tolerance.value_or(0.0), stop.acceptance_tolerance);
-      if (f_.template lpNorm<Eigen::Infinity>() <= usable) {
-        summary.message = progress_.message();
-        status = Status::kStagnated;
-      } else {
-        stagnate(progress_.message());
-      }
+    if (ledger_.budget_spent()) {
+      status = ledger_.spent_status(summary.message, x_, gradient_,
+                                    f_.template lpNorm<Eigen::Infinity>());
     }
     return status.has_value();
   };
 
   while (!status) {
     if (spent()) break;
-    if (evaluations + jacobian_cost > stop.max_evaluations) {
+    if (!ledger_.affords(jacobian_cost)) {
       status = Status::kMaxEvaluations;  // the differences would overrun the budget
       break;
     }
-    evaluations += jacobian(x_, f_, model.jacobian());
-    ++jacobians;
+    ledger_.count_jacobian(jacobian(x_, f_, model.jacobian()));
     if (!model.finite()) {
       summary.message = "the Jacobian of F is not finite";
       status = Status::kNonFinite;
@@ -277,9 +263,9 @@ Summary LevenbergMarquardtEngine<N>::run(Model& model, Residual&& residual, Jaco
     // are). A strict bound is never reached: its steps are cut short by the projection instead.
     model.gradient(f_, gradient_);
     frozen_.setConstant(false);
-    if (box_.active()) {
+    if (box.active()) {
       for (Index k = 0; k < n; ++k)
-        frozen_[k] = box_.on_closed_bound_against(k, x_[k], gradient_[k]);
+        frozen_[k] = box.on_closed_bound_against(k, x_[k], gradient_[k]);
     }
     const bool bound_held = frozen_.any();
     model.freeze(frozen_);
@@ -290,7 +276,7 @@ Summary LevenbergMarquardtEngine<N>::run(Model& model, Residual&& residual, Jaco
       status = Status::kNonFinite;
       break;
     }
-    if (jacobians == 1) {
+    if (ledger_.jacobians() == 1) {
       if (lm_.scale_by_jacobian_columns) {
         for (Index j = 0; j < n; ++j) diag_[j] = column_norms_[j] == 0.0 ? 1.0 : column_norms_[j];
       } else {
@@ -333,8 +319,7 @@ Summary LevenbergMarquardtEngine<N>::run(Model& model, Residual&& residual, Jaco
         xt_ = x_ + h * v_;
         // A probe for F'', not a point of the path: it counts towards the progress window but
         // is never progress.
-        ++evaluations;
-        progress_.saw(std::numeric_limits<double>::infinity());
+        ledger_.count_evaluation(std::numeric_limits<double>::infinity());
         if (residual(xt_, fh_)) {
           model.multiply(v_, work_m_);
           work_m_ = (2.0 / h) * ((fh_ - f_) / h - work_m_);
@@ -350,7 +335,7 @@ Summary LevenbergMarquardtEngine<N>::run(Model& model, Residual&& residual, Jaco
       // nothing against the model (near a strict bound each cut is 99 % of the room left).
       const double model_pnorm = diag_.cwiseProduct(p_).norm();
       xt_ = x_ + p_;
-      const bool projected = box_.project(xt_, x_);
+      const bool projected = box.project(xt_, x_);
       if (projected) p_ = xt_ - x_;
       const double pnorm = diag_.cwiseProduct(p_).norm();
       if (projected && pnorm == 0.0) {
@@ -435,26 +420,18 @@ Summary LevenbergMarquardtEngine<N>::run(Model& model, Residual&& residual, Jaco
   }
 
   x = x_;
-  summary.status = *status;
-  summary.function_evaluations = evaluations;
-  summary.jacobian_evaluations = jacobians;
+  ledger_.finish(summary, *status, monitor, x, f_, this->options_.stop, least_squares);
   model.report(summary);
-  monitor.fill(summary, f_.allFinite() ? f_.template lpNorm<Eigen::Infinity>()
-                                       : std::numeric_limits<double>::infinity());
-  summary.record_answer(x, this->options_.stop, least_squares);
   return summary;
 }
 
 template <int N>
 Summary LevenbergMarquardtEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x) {
-  if (std::optional<Summary> scaled =
-          this->solve_scaled(problem, x, [this](const FixedPointProblem<N>& p, Vector<N>& y) {
-            return LevenbergMarquardtEngine<N>::solve(p, y);
-          })) {
+  if (std::optional<Summary> scaled = this->solve_scaled(*this, problem, x)) {
     return std::move(*scaled);
   }
   detail::check_initial_guess(name(), problem, x);
-  box_.start(name(), this->bounds_, x);
+  ledger_.start(name(), this->bounds_, x, this->options_.stop);
   const Index n = x.size();
   auto residual = [&](const Vector<N>& at, ResidualVector& f) {
     if (problem.has_residual()) {  // F itself, not G − x (problem.hpp)
@@ -490,8 +467,8 @@ Summary LevenbergMarquardtEngine<N>::solve(const FixedPointProblem<N>& problem, 
         problem.jacobian(at, square);
       } else {
         xt_ = f + at;  // G(x)
-        spent =
-            finite_difference_jacobian(problem, at, xt_, square, lm_.finite_difference, fd_, &box_);
+        spent = finite_difference_jacobian(problem, at, xt_, square, lm_.finite_difference, fd_,
+                                           &ledger_.box());
       }
       square.diagonal().array() -= 1.0;
     }
@@ -517,8 +494,11 @@ Summary LevenbergMarquardtEngine<N>::solve_least_squares(const RootProblem<N, Dy
     throw InvalidInput(os.str());
   }
   detail::check_initial_guess<N>(name(), problem.size(), x);
-  box_.start(name(), this->bounds_, x);
   const Index m = problem.residual_size();
+  // A least-squares minimum has ‖F‖ > 0 and a warm start may sit at it: no progress window there
+  // (its stop is function_tolerance's, a convergence).
+  ledger_.start(name(), this->bounds_, x, this->options_.stop,
+                /*progress_window=*/m == problem.size());
   if (m < problem.size()) {
     std::ostringstream os;
     os << name() << ": F maps R^" << problem.size() << " to R^" << m
@@ -545,7 +525,7 @@ Summary LevenbergMarquardtEngine<N>::solve_least_squares(const RootProblem<N, Dy
     }
     return finite_difference_jacobian<N, Dynamic>(
         [&problem](const Vector<N>& p, ResidualVector& out) { problem.evaluate(p, out); }, at, f,
-        jac, lm_.finite_difference, fd_, fp_, fm_, &box_);
+        jac, lm_.finite_difference, fd_, fp_, fm_, &ledger_.box());
   };
   const int cost =
       problem.has_jacobian() ? 0 : finite_difference_cost(lm_.finite_difference, problem.size());

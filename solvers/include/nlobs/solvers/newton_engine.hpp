@@ -223,10 +223,7 @@ Summary NewtonEngine<N>::solve(const FixedPointProblem<N>& problem, Vector<N>& x
     s.engine = name();
     return s;
   }
-  if (std::optional<Summary> scaled =
-          this->solve_scaled(problem, x, [this](const FixedPointProblem<N>& p, Vector<N>& y) {
-            return NewtonEngine<N>::solve(p, y);
-          })) {
+  if (std::optional<Summary> scaled = this->solve_scaled(*this, problem, x)) {
     return std::move(*scaled);
   }
   const StopCriteria& stop = this->options_.stop;

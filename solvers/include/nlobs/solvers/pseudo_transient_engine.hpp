@@ -141,10 +141,7 @@ Summary PseudoTransientEngine<N>::solve(const FixedPointProblem<N>& problem, Vec
   detail::refuse_dense_path_for_declared(
       name(), problem, ptc_.linear_solver, dense_reason(),
       "PseudoTransientOptions::linear_solver = \"dense\" for a small problem");
-  if (std::optional<Summary> scaled =
-          this->solve_scaled(problem, x, [this](const FixedPointProblem<N>& p, Vector<N>& y) {
-            return PseudoTransientEngine<N>::solve(p, y);
-          })) {
+  if (std::optional<Summary> scaled = this->solve_scaled(*this, problem, x)) {
     return std::move(*scaled);
   }
   StopCriteria stop = this->options_.stop;

@@ -1,8 +1,9 @@
 #pragma once
 // F(x) = G(x) − x and J_F = ∂G − I of a fixed-point problem, for the engines that solve it as a
-// square root problem (Newton, dogleg, Levenberg–Marquardt, Broyden, pseudo-transient): the one
-// place that counts evaluations, checks G's size, keeps a difference Jacobian inside the
-// evaluation budget and the box, and fills the Summary at the end.
+// square root problem (Newton, dogleg, Broyden, pseudo-transient; Levenberg–Marquardt, whose F
+// may be m×n, keeps its accounts in the same SolveLedger): the one place that counts
+// evaluations, checks G's size, keeps a difference Jacobian inside the evaluation budget and the
+// box, and fills the Summary at the end.
 #include <algorithm>
 #include <limits>
 #include <optional>
@@ -44,97 +45,38 @@ bool solved_at_start(const Vector<N>& f, const StopCriteria& stop) {
   return largest == 0.0 || (stop.residual_tolerance && largest <= *stop.residual_tolerance);
 }
 
+// The accounts of one run of an engine on F, square or m×n (the SquareSystem engines,
+// Levenberg–Marquardt's least squares): evaluations and Jacobians against
+// StopCriteria::max_evaluations, the progress window, the box, and the Summary they end in.
 template <int N>
-class SquareSystem {
+class SolveLedger {
  public:
-  // A new solve of `problem` from x0 (checked: size, finite, inside `bounds`). Sizes the
-  // workspace (at a fixed N nothing allocates).
-  // stop: its max_evaluations and progress_window.
-  void start(std::string_view engine, const FixedPointProblem<N>& problem, const Vector<N>& x0,
-             const BoxBounds& bounds, FiniteDifference scheme, const StopCriteria& stop) {
-    check_initial_guess(engine, problem, x0);
+  // A new run from x0 (checked inside `bounds`): nothing counted yet. stop: its max_evaluations,
+  // progress_window (none when !progress_window: a least-squares minimum has ‖F‖ > 0 and a warm
+  // start may sit at it), and what makes ‖F‖∞ usable.
+  void start(std::string_view engine, const BoxBounds& bounds, const Vector<N>& x0,
+             const StopCriteria& stop, bool progress_window = true) {
     box_.start(engine, bounds, x0);
-    problem_ = &problem;
-    scheme_ = scheme;
     max_evaluations_ = stop.max_evaluations;
     usable_residual_ = std::max(stop.residual_tolerance.value_or(0.0), stop.acceptance_tolerance);
-    progress_.start(stop.progress_window);
+    progress_.start(progress_window ? stop.progress_window : 0);
     evaluations_ = jacobians_ = 0;
-    if constexpr (N == Dynamic) g_.resize(x0.size()), fd_.resize(x0.size());
   }
 
-  // The run's first residual, f = F(x0): kNonFinite when it is not finite, kConverged when x0
-  // already solves F (solved_at_start), nullopt when the engine is to iterate.
-  std::optional<Status> first_residual(const Vector<N>& x0, Vector<N>& f,
-                                       const StopCriteria& stop) {
-    if (!residual(x0, f)) return Status::kNonFinite;
-    if (solved_at_start(f, stop)) return Status::kConverged;
-    return std::nullopt;
-  }
-
-  // f = F(x) = G(x) − x (the problem's own F when it has one); false when a value is not finite.
-  bool residual(const Vector<N>& x, Vector<N>& f) {
+  // For an evaluation of F at a point of the path, ‖F‖₂ there (inf when F is not finite; a
+  // probe that is no point of the path, such as a second difference, passes inf: counted, never
+  // progress).
+  void count_evaluation(double residual_norm) {
     ++evaluations_;
-    if (problem_->has_residual()) {
-      problem_->residual(x, f);
-      check_output_size(*problem_, f);
-    } else {
-      problem_->evaluate(x, g_);
-      check_output_size(*problem_, g_);
-      f = g_ - x;
-    }
-    const bool finite = f.allFinite();
-    progress_.saw(finite ? f.stableNorm() : std::numeric_limits<double>::infinity());
-    return finite;
+    progress_.saw(residual_norm);
   }
-
-  // jac = J_F(x) where f = F(x): the problem's ∂G (user or AD) or differences, minus I. nullopt,
-  // or the status to stop with: kMaxEvaluations when the differences would overrun the budget,
-  // kNonFinite (message set) when J is not finite.
-  std::optional<Status> jacobian(const Vector<N>& x, const Vector<N>& f, Matrix<N, N>& jac,
-                                 std::string& message) {
-    if (!problem_->has_jacobian() &&
-        evaluations_ + finite_difference_cost(scheme_, x.size()) > max_evaluations_) {
-      return Status::kMaxEvaluations;
-    }
-    if (problem_->has_jacobian() && problem_->has_residual()) {
-      problem_->residual_jacobian(x, jac);  // ∂F itself
-    } else {
-      if (problem_->has_jacobian()) {
-        problem_->jacobian(x, jac);
-      } else {
-        g_ = f + x;
-        evaluations_ += finite_difference_jacobian(*problem_, x, g_, jac, scheme_, fd_, &box_);
-      }
-      jac.diagonal().array() -= 1.0;
-    }
+  // After a Jacobian that spent `evaluations` of F (differences; 0 when the problem has one).
+  void count_jacobian(int evaluations) {
+    evaluations_ += evaluations;
     ++jacobians_;
-    if (!jac.allFinite()) {
-      message = "the Jacobian of F is not finite";
-      return Status::kNonFinite;
-    }
-    return std::nullopt;
   }
-
-  // jac = J_F(x) from the problem's sparse residual Jacobian (run-time size; the caller checked
-  // problem().sparse_residual_jacobian()), f = F(x). As jacobian(): nullopt or the status. A J of
-  // another structure than the source's pattern (a user's evaluate) is refused: the engines
-  // address its entries through the pattern.
-  std::optional<Status> sparse_jacobian(const Vector<N>& x, const Vector<N>& f, SparseJacobian& jac,
-                                        std::string& message) {
-    SparseJacobianState& state = *problem_->sparse_jacobian_state();
-    const SparseJacobianSource& sparse = *state.get();
-    if (evaluations_ + sparse.evaluations_per_jacobian > max_evaluations_) {
-      return Status::kMaxEvaluations;
-    }
-    evaluations_ += evaluate_sparse_jacobian(state, x, f, jac);
-    ++jacobians_;
-    if (detail::first_non_finite_row(jac) >= 0) {
-      message = "the Jacobian of F is not finite";
-      return Status::kNonFinite;
-    }
-    return std::nullopt;
-  }
+  // `evaluations` more stay within the budget.
+  bool affords(int evaluations) const { return evaluations_ + evaluations <= max_evaluations_; }
 
   // The evaluation budget is spent, or the progress window has passed without progress: the run
   // ends with spent_status().
@@ -164,12 +106,13 @@ class SquareSystem {
   int evaluations() const { return evaluations_; }
   int jacobians() const { return jacobians_; }
   const Box<N>& box() const { return box_; }
-  const FixedPointProblem<N>& problem() const { return *problem_; }
 
-  // The summary of a run that ended with `status` at x where f = F(x): counts, the monitor's
-  // figures, ‖F‖∞ (inf when f is not finite), the answer for usable().
+  // The summary of a run that ended with `status` at x where f = F(x) (n or m entries): counts,
+  // the monitor's figures, ‖F‖∞ (inf when f is not finite), the answer for usable() judged by
+  // `given`, the criteria the user gave (minimised: a least-squares answer, ‖F‖ need not be 0).
+  template <typename Residual>
   void finish(Summary& s, Status status, const StopMonitor& monitor, const Vector<N>& x,
-              const Vector<N>& f, const StopCriteria& given, bool minimised = false) const {
+              const Residual& f, const StopCriteria& given, bool minimised = false) const {
     s.status = status;
     s.function_evaluations = evaluations_;
     s.jacobian_evaluations = jacobians_;
@@ -179,14 +122,107 @@ class SquareSystem {
   }
 
  private:
-  const FixedPointProblem<N>* problem_ = nullptr;
-  FiniteDifference scheme_ = FiniteDifference::kCentral;
   int max_evaluations_ = 0, evaluations_ = 0, jacobians_ = 0;
   double usable_residual_ = 0.0;  // max(residual_tolerance, acceptance_tolerance)
   ProgressWindow progress_;
+  Box<N> box_;
+};
+
+// F = G − x (or the problem's own F) and J_F of a square problem, evaluated and counted in a
+// SolveLedger. The engines keep their loops in solve() itself, between start()/first_residual()
+// and finish(): wrapped in a lambda that a shared run() calls, the loop cost Newton and Broyden
+// 4–6 % more instructions at n = 2 (callgrind; the SSE stores of fixed-size Eigen code may alias
+// the closure, so every captured local is reloaded after them).
+template <int N>
+class SquareSystem : public SolveLedger<N> {
+ public:
+  // A new solve of `problem` from x0 (checked: size, finite, inside `bounds`). Sizes the
+  // workspace (at a fixed N nothing allocates). stop: as SolveLedger::start's.
+  void start(std::string_view engine, const FixedPointProblem<N>& problem, const Vector<N>& x0,
+             const BoxBounds& bounds, FiniteDifference scheme, const StopCriteria& stop) {
+    check_initial_guess(engine, problem, x0);
+    SolveLedger<N>::start(engine, bounds, x0, stop);
+    problem_ = &problem;
+    scheme_ = scheme;
+    if constexpr (N == Dynamic) g_.resize(x0.size()), fd_.resize(x0.size());
+  }
+
+  // The run's first residual, f = F(x0): kNonFinite when it is not finite, kConverged when x0
+  // already solves F (solved_at_start), nullopt when the engine is to iterate.
+  std::optional<Status> first_residual(const Vector<N>& x0, Vector<N>& f,
+                                       const StopCriteria& stop) {
+    if (!residual(x0, f)) return Status::kNonFinite;
+    if (solved_at_start(f, stop)) return Status::kConverged;
+    return std::nullopt;
+  }
+
+  // f = F(x) = G(x) − x (the problem's own F when it has one); false when a value is not finite.
+  bool residual(const Vector<N>& x, Vector<N>& f) {
+    if (problem_->has_residual()) {
+      problem_->residual(x, f);
+      check_output_size(*problem_, f);
+    } else {
+      problem_->evaluate(x, g_);
+      check_output_size(*problem_, g_);
+      f = g_ - x;
+    }
+    const bool finite = f.allFinite();
+    this->count_evaluation(finite ? f.stableNorm() : std::numeric_limits<double>::infinity());
+    return finite;
+  }
+
+  // jac = J_F(x) where f = F(x): the problem's ∂G (user or AD) or differences, minus I. nullopt,
+  // or the status to stop with: kMaxEvaluations when the differences would overrun the budget,
+  // kNonFinite (message set) when J is not finite.
+  std::optional<Status> jacobian(const Vector<N>& x, const Vector<N>& f, Matrix<N, N>& jac,
+                                 std::string& message) {
+    if (!problem_->has_jacobian() && !this->affords(finite_difference_cost(scheme_, x.size()))) {
+      return Status::kMaxEvaluations;
+    }
+    int spent = 0;
+    if (problem_->has_jacobian() && problem_->has_residual()) {
+      problem_->residual_jacobian(x, jac);  // ∂F itself
+    } else {
+      if (problem_->has_jacobian()) {
+        problem_->jacobian(x, jac);
+      } else {
+        g_ = f + x;
+        spent = finite_difference_jacobian(*problem_, x, g_, jac, scheme_, fd_, &this->box());
+      }
+      jac.diagonal().array() -= 1.0;
+    }
+    this->count_jacobian(spent);
+    if (!jac.allFinite()) {
+      message = "the Jacobian of F is not finite";
+      return Status::kNonFinite;
+    }
+    return std::nullopt;
+  }
+
+  // jac = J_F(x) from the problem's sparse residual Jacobian (run-time size; the caller checked
+  // problem().sparse_residual_jacobian()), f = F(x). As jacobian(): nullopt or the status. A J of
+  // another structure than the source's pattern (a user's evaluate) is refused: the engines
+  // address its entries through the pattern.
+  std::optional<Status> sparse_jacobian(const Vector<N>& x, const Vector<N>& f, SparseJacobian& jac,
+                                        std::string& message) {
+    SparseJacobianState& state = *problem_->sparse_jacobian_state();
+    const SparseJacobianSource& sparse = *state.get();
+    if (!this->affords(sparse.evaluations_per_jacobian)) return Status::kMaxEvaluations;
+    this->count_jacobian(evaluate_sparse_jacobian(state, x, f, jac));
+    if (detail::first_non_finite_row(jac) >= 0) {
+      message = "the Jacobian of F is not finite";
+      return Status::kNonFinite;
+    }
+    return std::nullopt;
+  }
+
+  const FixedPointProblem<N>& problem() const { return *problem_; }
+
+ private:
+  const FixedPointProblem<N>* problem_ = nullptr;
+  FiniteDifference scheme_ = FiniteDifference::kCentral;
   Vector<N> g_ = zero_vector<N>();
   FiniteDifferenceWorkspace<N> fd_;
-  Box<N> box_;
 };
 
 // The path of the engines on F for LineSearch (line_search.hpp): x(t) = P(x + t d), projected
