@@ -11,7 +11,6 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "data_file.hpp"
 #include "gnuplot.hpp"
 #include "modulating_report.hpp"
 #include "nlobs/observers/core/simulation.hpp"
@@ -285,54 +284,42 @@ void run_sweep(const PreparedScenario& prepared, const RunOptions& options, std:
 
 void run_scenario(const std::string& name, const RunOptions& options, std::ostream& out,
                   std::ostream& err) {
-  Scenario s = load_scenario(name);
-  if (options.steps) {
-    if (*options.steps < 1 || *options.steps > kMaxScenarioSteps) {
-      throw std::invalid_argument("--steps " + std::to_string(*options.steps) +
-                                  " is out of range: must be in 1.." +
-                                  std::to_string(kMaxScenarioSteps));
-    }
-    s.steps = *options.steps;
-  }
-  if (options.noise) {
-    if (!(*options.noise >= 0.0) || !std::isfinite(*options.noise)) {
-      std::ostringstream os;
-      os << "--noise " << *options.noise << " is not a finite number >= 0";
-      throw std::invalid_argument(os.str());
-    }
-    s.noise = *options.noise;
-  }
-  if (options.seed) s.seed = *options.seed;
   if (!(options.plot_timeout > 0.0 && options.plot_timeout <= 86400.0)) {
     std::ostringstream os;
     os << "plot timeout " << options.plot_timeout << " s is out of range: must be in (0, 86400]";
     throw std::invalid_argument(os.str());
   }
-  // Before any computation: a second run into the same --out fails now, not after its work.
+  const ScenarioRequest request{.scenario = name,
+                                .steps = options.steps,
+                                .noise = options.noise,
+                                .seed = options.seed,
+                                .data_file = options.data_file,
+                                .allow_late = options.allow_late};
+  // Before any computation, once the scenario is known to be valid: a second run into the same
+  // --out fails now, not after its work; a bad scenario leaves no directory behind.
   std::optional<OutputDirectoryLock> out_lock;
-  if (!options.out_dir.empty()) out_lock.emplace(options.out_dir);
-
+  std::string scenario_name = name;
   RunSettings settings;
-  settings.trace_first_window = !options.out_dir.empty();
-  if (!options.data_file.empty()) {
-    const AnyModel model = scenario_model(s).discrete;  // the scenario's own, not built again
-    settings.data = read_measurements_csv(options.data_file, model.outputs(), model.inputs(),
-                                          options.allow_late);
-    settings.data_source = options.data_file;
-  }
-  PreparedScenario prepared = prepare_scenario(std::move(s), std::move(settings));
-  if (!prepared.data.stop_message.empty()) {
-    err << "nlobs: simulation " << prepared.data.stop_message << '\n';
-  }
-  if (prepared.data.steps() == 0) throw std::runtime_error("the simulation produced no samples");
-  settings = RunSettings{};
-  settings.trace_first_window = !options.out_dir.empty();
+  settings.parsed = [&](const Scenario& s) {
+    scenario_name = s.name;
+    if (!options.out_dir.empty()) out_lock.emplace(options.out_dir);
+  };
+  // (Reported before the run, which may then fail for want of samples.)
+  const auto report_early_end = [&err](const PreparedScenario& prepared) {
+    if (!prepared.data.stop_message.empty()) {
+      err << "nlobs: simulation " << prepared.data.stop_message << '\n';
+    }
+  };
   if (!options.sweep.empty()) {
+    const PreparedScenario prepared = prepare_request(request, std::move(settings));
+    report_early_end(prepared);
+    if (prepared.data.steps() == 0) throw std::runtime_error("the simulation produced no samples");
     run_sweep(prepared, options, out, err);
     return;
   }
 
-  const std::string scenario_name = prepared.scenario.name;
+  settings.trace_first_window = !options.out_dir.empty();
+  settings.prepared = report_early_end;
   const auto start = std::chrono::steady_clock::now();
   auto last = start;
   bool printed = false;
@@ -353,7 +340,7 @@ void run_scenario(const std::string& name, const RunOptions& options, std::ostre
     printed = false;
     err << "nlobs: warning: " << w << '\n';
   };
-  ScenarioRun run = run_prepared(std::move(prepared), settings);
+  ScenarioRun run = run_request(request, settings);  // the one call into the run layer
   if (printed) err << '\n';
   const Scenario& sc = run.prepared.scenario;
   const Measurements& data = run.prepared.data;

@@ -11,9 +11,9 @@
 #include <sstream>
 #include <string>
 
-#include "data_file.hpp"
 #include "nlobs/registry/json_reader.hpp"
 #include "nlobs/runs/input_file.hpp"
+#include "nlobs/runs/measurements_file.hpp"
 #include "nlobs/runs/scenario.hpp"
 
 namespace nlobs::cli {

@@ -355,10 +355,9 @@ TEST(RunSafety, OutOfRangeIntegersNameTheKeyAndTheRange) {
   EXPECT_NE(e.find("must be in 1..10000000"), std::string::npos) << e;
   e = error_with([](nlohmann::json& j) { j["seed"] = -1; });
   EXPECT_NE(e.find("'seed' = -1 is out of range"), std::string::npos) << e;
-  EXPECT_NE(error_of("chua-fp", {.steps = 100000000000L})
-                .find("--steps 100000000000 is out of "
-                      "range"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of("chua-fp", {.steps = 100000000000L}).find("'steps' = 100000000000 is out of range"),
+      std::string::npos);
 }
 
 // Plots are best-effort: a gnuplot that fails costs the PNGs and a warning, not the run's data.
@@ -506,6 +505,29 @@ TEST(Run, LanderScenarioStopsAtTheDomainBoundary) {
   run_scenario(f.string(), {}, out, err);
   EXPECT_NE(err.str().find("mass x3"), std::string::npos) << err.str();
   EXPECT_NE(err.str().find("leaves its domain"), std::string::npos) << err.str();
+}
+
+// What fails before the run starts leaves nothing behind: a bad scenario creates no --out
+// directory; a simulation without a sample still says why it stopped, before the error.
+TEST(RunSafety, AFailureBeforeTheRunLeavesNoDirectoryAndSaysWhy) {
+  const fs::path out = scratch("never_created") / "out";
+  fs::remove_all(out.parent_path());
+  EXPECT_NE(error_of("no-such-scenario", {.out_dir = out.string()}).find("no-such-scenario"),
+            std::string::npos);
+  EXPECT_FALSE(fs::exists(out.parent_path())) << "a bad scenario created " << out;
+  const fs::path broken = scratch("broken.json");
+  write(broken, R"({"name": "broken", "steps": 0})");
+  error_of(broken.string(), {.out_dir = out.string()});
+  EXPECT_FALSE(fs::exists(out.parent_path())) << "a bad scenario file created " << out;
+
+  nlohmann::json j = to_json(load_scenario("pi-lander"));
+  j["x0"][2] = -1.0;  // no mass: the model leaves its domain at the first sample
+  const fs::path lander = scratch("massless.json");
+  write(lander, j.dump());
+  std::ostringstream out_text, err;
+  EXPECT_THROW(run_scenario(lander.string(), {}, out_text, err), std::runtime_error);
+  EXPECT_NE(err.str().find("nlobs: simulation stopped at sample 0"), std::string::npos)
+      << err.str();
 }
 
 // Runs a built-in scenario into a scratch directory and returns summary.json.

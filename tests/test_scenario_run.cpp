@@ -1,17 +1,27 @@
 // The run layer (nlobs/runs/): a scenario parsed, prepared and run below the CLI. Its model is
 // built once (a model nlobs does not ship counts its builds); recorded data of the wrong shape is
 // refused naming what is wrong; warnings arrive once and in order; a run's result holds the
-// metrics summary.json reports; and `nlobs run` (the CLI) reports what the library returns.
+// metrics summary.json reports; a ScenarioRequest (name or file, overrides, a data file that
+// may be a link or a FIFO) is the scenario as edited by hand, its bad values named; and `nlobs
+// run` (the CLI) reports what the library returns.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <Eigen/Core>
 #include <atomic>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "nlobs/registry/register_model.hpp"
@@ -396,6 +406,187 @@ TEST(Sweep, HostileSweepsAreRefusedNamingKeyAndValue) {
   } catch (const std::invalid_argument& e) {
     EXPECT_EQ(std::string(e.what()), "sweep needs simulated data (the truth)");
   }
+}
+
+// A scenario file of a model nlobs does not ship, at `dir`/decay.json.
+std::filesystem::path write_decay_file(const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path file = dir / "decay.json";
+  std::ofstream(file) << decay_scenario().dump();
+  return file;
+}
+
+std::filesystem::path scratch_dir(const std::string& name) {
+  return std::filesystem::temp_directory_path() /
+         ("nlobs_test_scenario_run_" + std::to_string(::getpid())) / name;
+}
+
+// Equal sizes and entries (Eigen's == asserts equal sizes).
+bool same(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() && a == b;
+}
+
+// The data file `nlobs run --data` reads: t, y1 of the first `steps` samples.
+std::string csv_of(const Measurements& data, long steps) {
+  std::ostringstream os;
+  os << std::setprecision(17) << "t,y1\n";
+  for (long k = 0; k < steps; ++k) os << data.t[k] << ',' << data.y(0, k) << '\n';
+  return os.str();
+}
+
+TEST(ScenarioRequest, IsTheScenarioWithItsOverridesBuiltOnce) {
+  register_counted_decay();
+  const std::filesystem::path file = write_decay_file(scratch_dir("overrides"));
+  const int before = decay_builds;
+  const ScenarioRun asked =
+      run_request({.scenario = file.string(), .steps = 120, .noise = 0.004, .seed = 9});
+  EXPECT_EQ(decay_builds - before, 1) << "parse, prepare and run build the model once";
+
+  // The same by hand: the file parsed, its fields edited, run.
+  Scenario s = load_scenario(file.string());
+  s.steps = 120, s.noise = 0.004, s.seed = 9;
+  const ScenarioRun by_hand = run_scenario(s);
+  ASSERT_EQ(asked.prepared.data.steps(), 120);
+  EXPECT_TRUE(same(asked.prepared.data.y, by_hand.prepared.data.y));  // the same noise draw
+  ASSERT_EQ(asked.result.estimates.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_TRUE(same(asked.result.estimates[i], by_hand.result.estimates[i])) << i;
+  }
+  // Another seed is another draw: the override reached the simulation.
+  const ScenarioRun other =
+      run_request({.scenario = file.string(), .steps = 120, .noise = 0.004, .seed = 10});
+  EXPECT_FALSE(same(other.prepared.data.y, asked.prepared.data.y));
+}
+
+TEST(ScenarioRequest, ReadsItsDataFileForTheScenariosOwnModelFromALinkOrAFifo) {
+  register_counted_decay();
+  const std::filesystem::path dir = scratch_dir("data");
+  const std::filesystem::path file = write_decay_file(dir);
+  const PreparedScenario simulated = prepare_request({.scenario = file.string()});
+  const std::string csv = csv_of(simulated.data, 200);
+  const std::filesystem::path data = dir / "y.csv";
+  std::ofstream(data) << csv;
+
+  const int before = decay_builds;
+  const ScenarioRun from_file =
+      run_request({.scenario = file.string(), .data_file = data.string()});
+  EXPECT_EQ(decay_builds - before, 1) << "the data's shape comes from the scenario's own model";
+  EXPECT_EQ(from_file.prepared.source, data.string());
+  EXPECT_FALSE(from_file.prepared.data.has_truth());
+  ASSERT_EQ(from_file.prepared.data.steps(), 200);
+  // What the file holds, read back to the last digit, gives the run given those measurements.
+  Measurements given = simulated.data;
+  given.t.conservativeResize(200);
+  given.y.conservativeResize(Eigen::NoChange, 200);
+  given.u.conservativeResize(Eigen::NoChange, 200);
+  given.x.resize(0, 0);
+  EXPECT_TRUE(same(from_file.prepared.data.y, given.y));
+  const ScenarioRun from_memory =
+      run_scenario(load_scenario(file.string()), {.data = given, .data_source = "memory"});
+  EXPECT_TRUE(same(from_file.result.estimates[0], from_memory.result.estimates[0]));
+
+  // A symbolic link to the file reads the file.
+  const std::filesystem::path link = dir / "link.csv";
+  std::filesystem::remove(link);
+  std::filesystem::create_symlink(data, link);
+  EXPECT_TRUE(
+      same(run_request({.scenario = file.string(), .data_file = link.string()}).result.estimates[0],
+           from_file.result.estimates[0]));
+
+  // A FIFO (a shell's <(generate), a sensor's pipe) is read as it is written.
+  const std::filesystem::path fifo = dir / "pipe.csv";
+  std::filesystem::remove(fifo);
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::thread writer([&] { std::ofstream(fifo) << csv; });
+  std::optional<ScenarioRun> from_fifo;
+  try {
+    from_fifo = run_request({.scenario = file.string(), .data_file = fifo.string()});
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << e.what();
+    const int release = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);  // the writer's open returns
+    writer.join();
+    ::close(release);
+    return;
+  }
+  writer.join();
+  ASSERT_TRUE(from_fifo);
+  EXPECT_TRUE(same(from_fifo->result.estimates[0], from_file.result.estimates[0]));
+}
+
+TEST(ScenarioRequest, BadOverridesAndFilesAreNamedAndNothingRuns) {
+  register_counted_decay();
+  const std::filesystem::path dir = scratch_dir("bad");
+  const std::filesystem::path file = write_decay_file(dir);
+  // Nothing of a refused request runs: it is refused before the scenario counts as parsed (the
+  // CLI's --out lock), or before any data or observer step.
+  int parsed = 0, steps = 0;
+  const auto error_of = [&](const ScenarioRequest& request, RunSettings settings = {}) {
+    settings.progress = [&steps](long, long) { ++steps; };
+    if (!settings.parsed) settings.parsed = [&parsed](const Scenario&) { ++parsed; };
+    try {
+      run_request(request, std::move(settings));
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("<no error>");
+  };
+  const std::string f = file.string();
+  EXPECT_EQ(error_of({.scenario = f, .steps = 0}),
+            "'steps' = 0 is out of range: must be in 1..10000000");
+  EXPECT_EQ(error_of({.scenario = f, .steps = 100'000'000'000L}),
+            "'steps' = 100000000000 is out of range: must be in 1..10000000");
+  EXPECT_EQ(error_of({.scenario = f, .noise = std::numeric_limits<double>::quiet_NaN()}),
+            "'noise' = nan is not a finite number >= 0");
+  EXPECT_EQ(error_of({.scenario = f, .noise = -1.0}), "'noise' = -1 is not a finite number >= 0");
+  EXPECT_EQ(error_of({.scenario = f, .noise = std::numeric_limits<double>::infinity()}),
+            "'noise' = inf is not a finite number >= 0");
+  EXPECT_EQ(parsed, 0) << "a bad override is refused before the scenario counts as parsed";
+  EXPECT_EQ(error_of({.scenario = f, .allow_late = true}),
+            "'allow_late' applies to a data file ('data_file'): a simulation's times always "
+            "increase");
+  EXPECT_EQ(error_of({.scenario = f, .data_file = (dir / "absent.csv").string()}),
+            "data file '" + (dir / "absent.csv").string() + "' does not exist");
+  EXPECT_EQ(error_of({.scenario = f, .data_file = dir.string()}),
+            "data file '" + dir.string() + "' is a directory, not a file");
+  std::ofstream(dir / "y.csv") << "t,y1\n0,1\n0.01,0.99\n";
+  Measurements given;
+  given.t = Eigen::VectorXd::LinSpaced(3, 0.0, 0.02);
+  given.y = Eigen::MatrixXd::Ones(1, 3);
+  given.u = Eigen::MatrixXd::Zero(0, 3);
+  const std::string both = error_of({.scenario = f, .data_file = (dir / "y.csv").string()},
+                                    {.data = given, .data_source = "memory"});
+  EXPECT_NE(both.find("measurements were given as well"), std::string::npos) << both;
+  // A data file of another model's shape: the file and line named.
+  std::ofstream(dir / "wide.csv") << "0,1,2\n";
+  const std::string wide = error_of({.scenario = f, .data_file = (dir / "wide.csv").string()});
+  EXPECT_NE(wide.find("wide.csv:1"), std::string::npos) << wide;
+  EXPECT_NE(error_of({.scenario = "no-such-scenario"}).find("no-such-scenario"), std::string::npos);
+  EXPECT_EQ(steps, 0) << "an observer ran";
+  // `parsed` comes before the data file is opened: a program's refusal there (its output
+  // directory is taken) stops the request before a missing file is even noticed.
+  const std::string taken = error_of(
+      {.scenario = f, .data_file = (dir / "absent.csv").string()},
+      {.parsed = [](const Scenario& s) { throw std::invalid_argument(s.name + ": taken"); }});
+  EXPECT_EQ(taken, "decay-test: taken");
+}
+
+TEST(ScenarioRequest, ASimulationThatStopsEarlyIsReportedBeforeTheRunFails) {
+  // The lander's mass x3 starts below zero: the model leaves its domain at the first sample.
+  nlohmann::json j = to_json(load_scenario("pi-lander"));
+  j["x0"][2] = -1.0;
+  const std::filesystem::path dir = scratch_dir("early_end");
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "lander.json") << j.dump();
+  std::string seen;
+  try {
+    run_request({.scenario = (dir / "lander.json").string()},
+                {.prepared = [&seen](const PreparedScenario& p) { seen = p.data.stop_message; }});
+    FAIL() << "ran";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("the simulation produced no samples"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_NE(seen.find("stopped at sample 0"), std::string::npos) << seen;
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "nlobs/runs/measurements_file.hpp"
 #include "nlobs/runs/run_metrics.hpp"
 
 namespace nlobs {
@@ -187,13 +188,67 @@ ScenarioRun run_prepared(PreparedScenario prepared, const RunSettings& settings)
   return run;
 }
 
-ScenarioRun run_scenario(Scenario scenario, RunSettings settings) {
-  // The data, if any, moves into the prepared scenario; the callbacks stay for the run.
+namespace {
+
+// The data, if any, moves into the prepared scenario; the callbacks stay for the run.
+RunSettings data_part(RunSettings& settings) {
   RunSettings prepare;
   prepare.data = std::move(settings.data);
   prepare.data_source = settings.data_source;
   settings.data.reset();
+  return prepare;
+}
+
+}  // namespace
+
+ScenarioRun run_scenario(Scenario scenario, RunSettings settings) {
+  RunSettings prepare = data_part(settings);
   return run_prepared(prepare_scenario(std::move(scenario), std::move(prepare)), settings);
+}
+
+PreparedScenario prepare_request(const ScenarioRequest& request, RunSettings settings) {
+  Scenario s = load_scenario(request.scenario);
+  if (request.steps) {
+    if (*request.steps < 1 || *request.steps > kMaxScenarioSteps) {
+      throw std::invalid_argument("'steps' = " + std::to_string(*request.steps) +
+                                  " is out of range: must be in 1.." +
+                                  std::to_string(kMaxScenarioSteps));
+    }
+    s.steps = *request.steps;
+  }
+  if (request.noise) {
+    if (!(*request.noise >= 0.0) || !std::isfinite(*request.noise)) {
+      std::ostringstream os;
+      os << "'noise' = " << *request.noise << " is not a finite number >= 0";
+      throw std::invalid_argument(os.str());
+    }
+    s.noise = *request.noise;
+  }
+  if (request.seed) s.seed = *request.seed;
+  if (settings.parsed) settings.parsed(s);
+  if (!request.data_file.empty()) {
+    if (settings.data) {
+      throw std::invalid_argument("'data_file' = " + request.data_file +
+                                  ": measurements were given as well (RunSettings::data); give "
+                                  "one of them");
+    }
+    const AnyModel model = scenario_model(s).discrete;  // the scenario's own, not built again
+    settings.data = read_measurements_csv(request.data_file, model.outputs(), model.inputs(),
+                                          request.allow_late);
+    settings.data_source = request.data_file;
+  } else if (request.allow_late) {
+    throw std::invalid_argument(
+        "'allow_late' applies to a data file ('data_file'): a simulation's times always increase");
+  }
+  return prepare_scenario(std::move(s), std::move(settings));
+}
+
+ScenarioRun run_request(const ScenarioRequest& request, RunSettings settings) {
+  RunSettings prepare = data_part(settings);
+  prepare.parsed = settings.parsed;
+  PreparedScenario prepared = prepare_request(request, std::move(prepare));
+  if (settings.prepared) settings.prepared(prepared);
+  return run_prepared(std::move(prepared), settings);
 }
 
 }  // namespace nlobs

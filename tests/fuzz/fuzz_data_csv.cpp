@@ -1,6 +1,6 @@
-// libFuzzer target: the `--data` CSV reader (cli/data_file.hpp) on arbitrary bytes, for three
-// model shapes, with and without late rows (--allow-late). Either it refuses the input with
-// std::invalid_argument, or what it returns keeps the documented invariants; anything else (a
+// libFuzzer target: the `--data` CSV reader (nlobs/runs/measurements_file.hpp) on arbitrary bytes,
+// for three model shapes, with and without late rows (--allow-late). Either it refuses the input
+// with std::invalid_argument, or what it returns keeps the documented invariants; anything else (a
 // crash, another exception, a broken invariant) is a finding. `make fuzz` runs it; docs/fuzzing.md
 // says what it found.
 #include <cmath>
@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "data_file.hpp"
+#include "nlobs/runs/measurements_file.hpp"
 
 namespace {
 
@@ -29,7 +29,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t siz
       std::istringstream in(text);
       try {
         const nlobs::Measurements m =
-            nlobs::cli::parse_measurements_csv(in, "fuzz.csv", shape[0], shape[1], late_rows);
+            nlobs::parse_measurements_csv(in, "fuzz.csv", shape[0], shape[1], late_rows);
         check(m.steps() >= 1 && m.t.size() == m.steps() && m.y.rows() == shape[0] &&
               m.u.rows() == shape[1] && m.u.cols() == m.steps() && !m.has_truth());
         for (Eigen::Index k = 0; k < m.steps(); ++k) {

@@ -21,6 +21,8 @@
 
 namespace nlobs {
 
+struct PreparedScenario;
+
 struct RunSettings {
   // Recorded measurements instead of a simulation (no truth: no errors), and what they came
   // from (summary.json's "source"); empty: the scenario is simulated.
@@ -34,6 +36,14 @@ struct RunSettings {
   // observers' own before the run (as they come, a repeated one repeated), then those the run
   // finds (not one given before); they are also kept in the result, in that order.
   std::function<void(const std::string&)> warning{};
+  // Called by prepare_request and run_request once the scenario is parsed and its overrides
+  // checked, before any data is read or simulated (`nlobs run` takes its --out lock here: a bad
+  // scenario leaves no directory behind); empty: none.
+  std::function<void(const Scenario&)> parsed{};
+  // Called by run_request once the data is ready (simulated or read), before the observers run:
+  // a simulation that stopped early says why in data.stop_message, even when the run then fails
+  // (too few samples for a window); empty: none.
+  std::function<void(const PreparedScenario&)> prepared{};
 };
 
 // The scenario with its model and data: what every run of it (and every sweep value that keeps
@@ -52,6 +62,26 @@ struct PreparedScenario {
 // model's domain ends early with data.stop_message set (no sample at all: run_prepared
 // refuses it).
 PreparedScenario prepare_scenario(Scenario scenario, RunSettings settings = {});
+
+// A scenario as a program asks for it: by built-in name or JSON file, with the overrides of
+// `nlobs run` (--steps, --noise, --seed, --data, --allow-late) or a binding's keywords, each
+// checked by prepare_request and a refusal naming the field ('steps' = 0 is out of range: ...).
+struct ScenarioRequest {
+  std::string scenario;
+  std::optional<long> steps{};          // 1..kMaxScenarioSteps
+  std::optional<double> noise{};        // σ of the measurement noise: finite, ≥ 0
+  std::optional<std::uint64_t> seed{};  // of the noise
+  // Recorded measurements (nlobs/runs/measurements_file.hpp) read with the model's sizes,
+  // instead of a simulation; empty: simulated (or RunSettings::data, when given).
+  std::string data_file{};
+  bool allow_late = false;  // data_file's rows may come at or before an earlier row's time
+};
+
+// load_scenario, the request's overrides, settings.parsed, its data file read for the model
+// parse_scenario built (not built again), then prepare_scenario with `settings` (a data file and
+// settings.data together are refused). A simulation that leaves the model's domain ends early,
+// as prepare_scenario's.
+PreparedScenario prepare_request(const ScenarioRequest& request, RunSettings settings = {});
 
 struct ScenarioRun {
   PreparedScenario prepared;
@@ -72,6 +102,9 @@ struct ScenarioRun {
 ScenarioRun run_prepared(PreparedScenario prepared, const RunSettings& settings = {});
 // prepare_scenario, then run_prepared.
 ScenarioRun run_scenario(Scenario scenario, RunSettings settings = {});
+// prepare_request, settings.prepared, then run_prepared: the one call `nlobs run` makes into
+// this layer.
+ScenarioRun run_request(const ScenarioRequest& request, RunSettings settings = {});
 
 // The run as summary.json holds it: per observer its metrics (MSE per state, iterations,
 // failures, the papers' figures where they apply), the scenario's settings and the warnings.

@@ -1,5 +1,6 @@
 #pragma once
-// Recorded measurements for `nlobs run --data FILE.csv`: columns t, y1..yp[, u1..um].
+// Recorded measurements (`nlobs run --data FILE.csv`, ScenarioRequest::data_file): columns t,
+// y1..yp[, u1..um].
 //
 // The format, checked line by line (every error names FILE:LINE):
 // * a line is at most kMaxDataLineBytes long;
@@ -12,6 +13,7 @@
 // * t and u cells: finite numbers; times strictly increase, unless `late_rows` (--allow-late):
 //   then a row may come at or before an earlier time, and goes to the observers in file order
 //   (the MHE takes a late measurement into its horizon; the others refuse it, by name).
+// The run layer's, so that every program reads a data file as `nlobs run` does.
 #include <Eigen/Core>
 #include <cstddef>
 #include <iosfwd>
@@ -19,7 +21,7 @@
 
 #include "nlobs/observers/core/simulation.hpp"
 
-namespace nlobs::cli {
+namespace nlobs {
 
 // The longest line a data file may have (bytes, without the line break): 1 MiB, room for rows
 // of some 40 000 numbers; a longer line is an error naming it.
@@ -34,4 +36,4 @@ Measurements parse_measurements_csv(std::istream& in, const std::string& name, E
 Measurements read_measurements_csv(const std::string& file, Eigen::Index outputs,
                                    Eigen::Index inputs, bool late_rows = false);
 
-}  // namespace nlobs::cli
+}  // namespace nlobs

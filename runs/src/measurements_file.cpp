@@ -1,4 +1,4 @@
-#include "data_file.hpp"
+#include "nlobs/runs/measurements_file.hpp"
 
 #include <cerrno>
 #include <cmath>
@@ -13,7 +13,7 @@
 #include "nlobs/runs/input_file.hpp"
 #include "nlobs/solvers/status.hpp"
 
-namespace nlobs::cli {
+namespace nlobs {
 namespace {
 
 enum class CellKind { kNumber, kMissing, kText, kOutOfRange };
@@ -212,4 +212,4 @@ Measurements read_measurements_csv(const std::string& file, Eigen::Index outputs
   return parse_measurements_csv(in, file, outputs, inputs, late_rows);
 }
 
-}  // namespace nlobs::cli
+}  // namespace nlobs
