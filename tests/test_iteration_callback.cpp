@@ -1,7 +1,7 @@
 // SolverOptions::iteration_callback: every built-in engine calls it after each iteration with
 // what its trace records, kStop ends the solve with Status::kStoppedByCallback at the current
 // iterate (judged as any run cut short), an exception it throws leaves solve() unchanged, and
-// `auto` stops with the stage that was stopped.
+// `auto` stops with the stage that was stopped. Engine::set_record_trace reaches inner engines.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -24,6 +24,17 @@ FixedPointProblem<> coupled_cosine() {
         using std::cos, std::sin;
         g[0] = 0.5 * cos(x[1]);
         g[1] = 0.5 * sin(x[0]) + 0.25;
+      },
+      2);
+}
+
+// The same at the fixed size 2.
+FixedPointProblem<2> coupled_cosine_fixed() {
+  return FixedPointProblem<2>::with_autodiff(
+      [](const auto& v, auto& g) {
+        using std::cos, std::sin;
+        g[0] = 0.5 * cos(v[1]);
+        g[1] = 0.5 * sin(v[0]) + 0.25;
       },
       2);
 }
@@ -77,6 +88,42 @@ TEST(IterationCallback, EveryEngineReportsEachIterationAsItsTraceRecordsIt) {
     // The last residual the engine evaluated (for anderson, at the point extrapolated from).
     EXPECT_LE(seen.back().residual_norm, 1e-9) << spec;
   }
+}
+
+// Engine::set_record_trace turns the trace on and off between solves, through the engines that
+// hold others: auto's stages, Newton's trust region, a Dynamic engine served at a fixed size.
+TEST(RecordTrace, SetRecordTraceReachesEveryInnerEngine) {
+  auto& registry = EngineRegistry<Dynamic>::global();
+  for (const std::string spec : {"newton", "newton:trust_region=1", "auto", "dogleg", "broyden",
+                                 "levenberg-marquardt", "anderson"}) {
+    auto engine = registry.create(spec, tight());
+    const auto solve = [&] {
+      Vector<> x = start();
+      const Summary s = engine->solve(coupled_cosine(), x);
+      EXPECT_EQ(s.status, Status::kConverged) << spec << '\n' << s.full_report();
+      return s;
+    };
+    EXPECT_TRUE(solve().trace.empty()) << spec;
+    engine->set_record_trace(true);
+    EXPECT_TRUE(engine->options().record_trace) << spec;
+    if (const auto* poly = dynamic_cast<const PolyalgorithmEngine<Dynamic>*>(engine.get())) {
+      for (const auto& stage : poly->stages()) EXPECT_TRUE(stage->options().record_trace);
+    }
+    const Summary traced = solve();
+    EXPECT_FALSE(traced.trace.empty()) << spec;
+    engine->set_record_trace(false);
+    EXPECT_TRUE(solve().trace.empty()) << spec;
+  }
+  DynamicSizeEngine<2> fixed(std::make_unique<NewtonEngine<>>(NewtonOptions{}, tight()));
+  const FixedPointProblem<2> problem = coupled_cosine_fixed();
+  fixed.set_record_trace(true);
+  Vector<2> x(1.0, -1.0);
+  const Summary s = fixed.solve(problem, x);
+  EXPECT_EQ(s.status, Status::kConverged) << s.full_report();
+  EXPECT_FALSE(s.trace.empty());
+  fixed.set_record_trace(false);
+  x = Vector<2>(1.0, -1.0);
+  EXPECT_TRUE(fixed.solve(problem, x).trace.empty());
 }
 
 TEST(IterationCallback, StopEndsTheSolveAtTheCurrentIterate) {
@@ -250,13 +297,7 @@ TEST(IterationCallback, CeresTakesTheSolverBackEndForACallback) {
   EXPECT_FALSE(engine.uses_tiny_solver());
   EXPECT_TRUE(CeresEngine<2>(CeresOptions{}, tight()).uses_tiny_solver());
   Vector<2> x(1.0, -1.0);
-  const auto problem = FixedPointProblem<2>::with_autodiff(
-      [](const auto& v, auto& g) {
-        using std::cos, std::sin;
-        g[0] = 0.5 * cos(v[1]);
-        g[1] = 0.5 * sin(v[0]) + 0.25;
-      },
-      2);
+  const FixedPointProblem<2> problem = coupled_cosine_fixed();
   const Summary s = engine.solve(problem, x);
   EXPECT_TRUE(s.usable()) << s.full_report();
   EXPECT_GE(calls, 2);  // Ceres' iteration 0 and at least one step

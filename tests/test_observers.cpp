@@ -3,7 +3,10 @@
 
 #include <cmath>
 #include <functional>
+#include <stdexcept>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "nlobs/models/modified_chua.hpp"
 #include "nlobs/models/systems.hpp"
@@ -216,6 +219,76 @@ TEST(WindowEstimator, OneSampleWindowWhenTheOutputIsTheState) {
   EXPECT_EQ(observers[0]->info().window, 1);
   const auto r = run_observers(data, observers);
   EXPECT_LT((r.estimates[0] - data.x).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+// FullOutput with a sensor that fails while `broken`: h throws.
+struct FailingSensor : FullOutput {
+  static inline bool broken = false;
+  template <typename T>
+  Output<T> h(const State<T>& x) const {
+    if (broken) throw std::runtime_error("sensor failed");
+    return FullOutput::h(x);
+  }
+};
+
+// Newton that notes, at every solve, whether it was asked to record its trace.
+class TraceSpy : public Engine<2> {
+ public:
+  TraceSpy() : Engine<2>(SolverOptions{}) {}
+  std::string_view name() const override { return "trace-spy"; }
+  Summary solve(const FixedPointProblem<2>& problem, Vector<2>& x) override {
+    asked.push_back(options().record_trace);
+    return newton_.solve(problem, x);
+  }
+  std::vector<bool> asked;
+
+ private:
+  void on_set_record_trace(bool on) override { newton_.set_record_trace(on); }
+  NewtonEngine<2> newton_;
+};
+
+// trace_first_window: the engine of every step records its trace on the first window after each
+// reset only, and keeps its own setting otherwise — after a solve that threw too.
+TEST(WindowEstimator, TracesTheFirstWindowAfterEachResetOnly) {
+  SimulationOptions o;
+  o.steps = 6;
+  o.noise_std = 1e-3;  // every window a solve of its own (no guess already exact)
+  const Measurements data = simulate(FullOutput{}, Eigen::Vector2d(0.5, 0.2), o);
+  WindowEstimatorOptions options;
+  options.initial_estimate = Eigen::Vector2d(0.0, 0.0);
+  options.trace_first_window = true;
+  auto owned = std::make_unique<TraceSpy>();
+  TraceSpy* spy = owned.get();
+  WindowEstimator<FailingSensor> estimator(FailingSensor{}, options, std::move(owned));
+  const auto run = [&] {
+    std::vector<std::size_t> sizes;
+    for (long k = 0; k < data.steps(); ++k) {
+      const ObserverStep& step = estimator.step(k, data.t[k], data.y.col(k), data.u.col(k));
+      EXPECT_TRUE(step.summary.has_value()) << k;  // a one-sample window: solved every step
+      if (step.summary) sizes.push_back(step.summary->trace.size());
+    }
+    return sizes;
+  };
+  for (int pass = 0; pass < 2; ++pass) {  // the second after a reset
+    spy->asked.clear();
+    const std::vector<std::size_t> sizes = run();
+    EXPECT_EQ(spy->asked, std::vector<bool>({true, false, false, false, false, false})) << pass;
+    ASSERT_EQ(sizes.size(), 6u);
+    EXPECT_GT(sizes[0], 0u) << pass;
+    for (std::size_t k = 1; k < sizes.size(); ++k) EXPECT_EQ(sizes[k], 0u) << pass << ' ' << k;
+    EXPECT_FALSE(spy->options().record_trace);
+    estimator.reset();
+  }
+  FailingSensor::broken = true;
+  EXPECT_THROW(estimator.step(0, data.t[0], data.y.col(0), data.u.col(0)), std::runtime_error);
+  FailingSensor::broken = false;
+  EXPECT_FALSE(spy->options().record_trace) << "the failed first window left tracing on";
+  // An engine that records every solve's trace keeps doing so.
+  spy->set_record_trace(true);
+  estimator.reset();
+  spy->asked.clear();
+  run();
+  EXPECT_EQ(spy->asked, std::vector<bool>(6, true));
 }
 
 TEST(Baselines, LuenbergerErrorFollowsALC) {

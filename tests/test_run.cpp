@@ -119,6 +119,16 @@ TEST(Run, ChuaFpReproducesThePapersClaims) {
   for (const char* f : {"trajectories.csv", "scenario.json", "first_window.dat"}) {
     EXPECT_TRUE(fs::exists(dir / f)) << f;
   }
+  // The convergence plot's data: each window observer's first-window trace, one line per
+  // iteration (ceres records none: docs/solvers.md).
+  std::map<std::string, int> traced;
+  std::ifstream first_window(dir / "first_window.dat");
+  for (std::string line; std::getline(first_window, line);) {
+    if (!line.empty() && line[0] != '#') ++traced[line.substr(0, line.find(' '))];
+  }
+  for (const char* n : {"window:picard", "window:aitken", "window:newton"}) {
+    EXPECT_EQ(traced[n], first(n)) << n;
+  }
   for (const auto& entry : fs::directory_iterator(dir)) {
     // Nothing half-written (temporaries: `.NAME.tmp-XXXXXX`).
     EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();

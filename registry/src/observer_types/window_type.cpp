@@ -5,7 +5,6 @@
 
 #include "builtin_observer_types.hpp"
 #include "nlobs/observers/window/window_estimator.hpp"
-#include "nlobs/solvers/engine_registry.hpp"
 
 namespace nlobs::detail {
 namespace {
@@ -82,12 +81,8 @@ std::unique_ptr<Observer> build(const WindowSpec& s, const ObserverBuild& b) {
   window_options.warm_start = s.warm_start;
   window_options.gain = s.gain;
   window_options.gain_scale = s.gain_scale;
-  auto estimator = make_window_estimator(b.model.discrete, s.engine, window_options, options);
-  if (b.trace_first_window) {
-    options.record_trace = true;
-    estimator->set_first_window_engine(EngineRegistry<Dynamic>::global().create(s.engine, options));
-  }
-  return estimator;
+  window_options.trace_first_window = b.trace_first_window;
+  return make_window_estimator(b.model.discrete, s.engine, window_options, options);
 }
 
 }  // namespace

@@ -70,7 +70,10 @@ inline constexpr std::uint32_t kPluginMagic = 0x6e6c6f62;  // "nlob"
 // 4: ModelInstance gained the continuous model and its scheme (model-typed observer types), and
 // the registries a plugin's entries enter became one NamedRegistry with its own lock.
 // 5: Summary gained library_status and an engine entry without_common.
-inline constexpr std::uint32_t kPluginLayout = 5;
+// 6: Engine gained set_record_trace (a virtual hook: the vtable moved), SquareSystem and
+// LevenbergMarquardtEngine keep their accounts in a SolveLedger (their layouts changed), and
+// WindowEstimatorOptions gained trace_first_window.
+inline constexpr std::uint32_t kPluginLayout = 6;
 inline constexpr const char* kPluginSymbol = "nlobs_plugin_info";
 
 #define NLOBS_PLUGIN_STRINGIFY_(x) #x

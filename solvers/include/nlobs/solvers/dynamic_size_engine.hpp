@@ -39,6 +39,7 @@ class DynamicSizeEngine final : public Engine<N> {
   void on_limit_evaluations(int max_evaluations) override {
     engine_->limit_evaluations(max_evaluations);
   }
+  void on_set_record_trace(bool on) override { engine_->set_record_trace(on); }
   void on_set_bounds() override { engine_->set_bounds(this->bounds_); }
   void on_set_scaling() override { engine_->set_scaling(this->scaling_); }
   std::unique_ptr<Engine<Dynamic>> engine_;

@@ -82,6 +82,14 @@ class Engine {
   virtual bool needs_contraction() const { return false; }
 
   const SolverOptions& options() const { return options_; }
+  // SolverOptions::record_trace for the solves that follow: how an observer records one solve's
+  // trace (a window estimator's first window, for its convergence plot) on the engine it runs
+  // every step, without a second engine. Engines holding inner engines (auto's stages, Newton's
+  // trust region, DynamicSizeEngine) pass it on.
+  void set_record_trace(bool on) {
+    options_.record_trace = on;
+    on_set_record_trace(on);
+  }
   // Sets StopCriteria::max_evaluations (≥ 1) for the solves that follow: how a polyalgorithm
   // hands each stage what the earlier ones left. An engine that runs other engines passes it on
   // (on_limit_evaluations).
@@ -178,6 +186,8 @@ class Engine {
   }
   // Engines holding inner engines (DynamicSizeEngine, Newton's trust region) forward the limit.
   virtual void on_limit_evaluations(int /*max_evaluations*/) {}
+  // ... and set_record_trace (auto's stages too).
+  virtual void on_set_record_trace(bool /*on*/) {}
   // Engines holding inner engines or a library's own copy of the box (Ceres, NLopt) take it here.
   virtual void on_set_bounds() {}
   // Engines holding inner engines (auto's stages, Newton's trust region, DynamicSizeEngine) pass

@@ -121,6 +121,9 @@ class NewtonEngine : public Engine<N> {
   void on_limit_evaluations(int max_evaluations) override {
     if (trust_region_) trust_region_->limit_evaluations(max_evaluations);
   }
+  void on_set_record_trace(bool on) override {
+    if (trust_region_) trust_region_->set_record_trace(on);
+  }
   void on_set_bounds() override {
     if (trust_region_) trust_region_->set_bounds(this->bounds_);
   }

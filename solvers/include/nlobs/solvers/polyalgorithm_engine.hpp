@@ -315,6 +315,9 @@ class PolyalgorithmEngine : public Engine<N> {
   void on_set_scaling() override {
     set_on_every_stage(this->scaling_, &Engine<N>::scaling, &Engine<N>::set_scaling);
   }
+  void on_set_record_trace(bool on) override {
+    for (const auto& s : stages_) s->set_record_trace(on);  // (it cannot fail)
+  }
   std::vector<std::unique_ptr<Engine<N>>> stages_;
   std::vector<int> caps_;
   PolyalgorithmOptions poly_;

@@ -65,6 +65,10 @@ struct WindowEstimatorOptions {
   WarmStart warm_start = WarmStart::kPropagated;
   WindowGain gain = WindowGain::kAuto;  // Ψ (square windows only)
   double gain_scale = 1.0;              // Ψ = gain_scale · I for WindowGain::kScalar
+  // The engine records its trace (Summary::trace, the convergence plot's data) on the first
+  // window after each reset only: Engine::set_record_trace around that one solve, so that every
+  // other step stays lean.
+  bool trace_first_window = false;
   // Throws InvalidInput naming the field for a negative window, a gain_scale that is 0 or not
   // finite, or an initial estimate that is empty or not finite. The constructor calls it and
   // checks the sizes against the model.
@@ -83,8 +87,8 @@ class WindowEstimator final : public Observer {
   // window. The engine's label() (its spec when it came from the registry) names it in reports.
   WindowEstimator(Model model, WindowEstimatorOptions options, std::unique_ptr<Engine<N>> engine);
 
-  // An engine for the first window after each reset only (e.g. one that records its trace for
-  // a convergence plot), so that the engine of every other step stays lean.
+  // An engine of its own for the first window after each reset only (a first window solved
+  // differently; for its trace alone, WindowEstimatorOptions::trace_first_window needs none).
   void set_first_window_engine(std::unique_ptr<Engine<N>> engine) {
     first_engine_ = std::move(engine);
   }
@@ -280,6 +284,21 @@ const ObserverStep& WindowEstimator<Model>::step(long k, double t, const Eigen::
     State w = have_solution_ ? next_guess_ : coasted_guess(index, moves > 0);
     have_solution_ = false;
     Engine<N>& engine = (first_engine_ && !solved_once_) ? *first_engine_ : *engine_;
+    // The first window's trace: recording on for this solve; the engine's own setting back
+    // afterwards, even when the solve throws.
+    struct RestoreTrace {
+      RestoreTrace(Engine<N>* restored, bool setting) : engine(restored), before(setting) {}
+      Engine<N>* engine;  // null: nothing to restore
+      bool before;
+      ~RestoreTrace() {
+        if (engine) engine->set_record_trace(before);
+      }
+      RestoreTrace(const RestoreTrace&) = delete;
+      RestoreTrace& operator=(const RestoreTrace&) = delete;
+    };
+    const bool trace = options_.trace_first_window && !solved_once_;
+    const RestoreTrace restore{trace ? &engine : nullptr, engine.options().record_trace};
+    if (trace) engine.set_record_trace(true);
     solved_once_ = true;
     step_.summary = solve_window(engine, w, k);
     if (step_.summary->usable()) {
