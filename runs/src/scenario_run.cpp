@@ -225,20 +225,21 @@ PreparedScenario prepare_request(const ScenarioRequest& request, RunSettings set
     s.noise = *request.noise;
   }
   if (request.seed) s.seed = *request.seed;
+  if (!request.data_file.empty() && settings.data) {
+    throw std::invalid_argument("'data_file' = " + request.data_file +
+                                ": measurements were given as well (RunSettings::data); give "
+                                "one of them");
+  }
+  if (request.data_file.empty() && request.allow_late) {
+    throw std::invalid_argument(
+        "'allow_late' applies to a data file ('data_file'): a simulation's times always increase");
+  }
   if (settings.parsed) settings.parsed(s);
   if (!request.data_file.empty()) {
-    if (settings.data) {
-      throw std::invalid_argument("'data_file' = " + request.data_file +
-                                  ": measurements were given as well (RunSettings::data); give "
-                                  "one of them");
-    }
     const AnyModel model = scenario_model(s).discrete;  // the scenario's own, not built again
     settings.data = read_measurements_csv(request.data_file, model.outputs(), model.inputs(),
                                           request.allow_late);
     settings.data_source = request.data_file;
-  } else if (request.allow_late) {
-    throw std::invalid_argument(
-        "'allow_late' applies to a data file ('data_file'): a simulation's times always increase");
   }
   return prepare_scenario(std::move(s), std::move(settings));
 }
