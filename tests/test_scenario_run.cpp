@@ -24,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "cli_test_files.hpp"
 #include "nlobs/registry/register_model.hpp"
 #include "nlobs/runs/scenario_run.hpp"
 #include "nlobs/runs/sweep.hpp"
@@ -416,9 +417,9 @@ std::filesystem::path write_decay_file(const std::filesystem::path& dir) {
   return file;
 }
 
+// temp/nlobs_test_scenario_run_PID/NAME (created by write_decay_file).
 std::filesystem::path scratch_dir(const std::string& name) {
-  return std::filesystem::temp_directory_path() /
-         ("nlobs_test_scenario_run_" + std::to_string(::getpid())) / name;
+  return test::scratch_path("nlobs_test_scenario_run", name);
 }
 
 // Equal sizes and entries (Eigen's == asserts equal sizes).
