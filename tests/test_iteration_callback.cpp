@@ -277,10 +277,14 @@ TEST(IterationCallback, ALargeSparseSolveReportsAndStops) {
     return IterationDecision::kContinue;
   };
   auto on = EngineRegistry<Dynamic>::global().create("newton:line_search=1", quiet);
+  on->set_record_trace(true);  // switched on after construction, at n = 10^5
   x.setZero();
   const Summary done = on->solve(problem, x);
   EXPECT_EQ(done.status, Status::kConverged) << done.full_report();
   EXPECT_EQ(calls, done.iterations);
+  ASSERT_EQ(static_cast<int>(done.trace.size()), done.iterations);
+  for (const TraceEntry& t : done.trace) EXPECT_EQ(t.x.size(), n);
+  EXPECT_EQ(done.trace.back().x, x);
 }
 
 // Ceres: TinySolver has no callback; auto takes the Solver back end when one is set.
