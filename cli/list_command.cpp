@@ -35,12 +35,16 @@ void print_list(const std::string& what, std::ostream& out) {
                                 "'; valid: models, engines, observers, scenarios, problems");
   }
   if (all || what == "models") {
-    out << "models (JSON: {\"name\", \"parameters\", \"scheme\": euler|rk4, \"step\"}):\n";
+    out << "models (JSON: {\"name\", \"parameters\", \"scheme\": euler|rk4, \"step\", "
+           "\"substeps\": 1.."
+        << DiscretizationOptions::kMostSubsteps << "}):\n";
     for (const ModelEntry* m : model_registry().entries()) {
       out << "  " << m->name << " — " << m->description << '\n';
       out << "      " << m->states << " states, " << m->inputs << " inputs, " << m->outputs
           << " outputs; T = " << m->default_step << ", "
-          << (m->default_scheme == Scheme::kEuler ? "euler" : "rk4") << "; observers:";
+          << (m->default_scheme == Scheme::kEuler ? "euler" : "rk4");
+      if (m->default_substeps != 1) out << ", " << m->default_substeps << " substeps";
+      out << "; observers:";
       for (const auto& f : m->families) out << ' ' << f;
       const std::string source = model_registry().source(m->name);
       if (source != "built-in") out << "; from " << source;

@@ -53,9 +53,10 @@ void register_counted_decay() {
         .name = "counted-decay",
         .description = "x' = -a x, y = x; counts its builds (test_scenario_run)",
         .parameters = {{"a", "decay rate", [](Decay& m) -> double& { return m.a; }}}});
-    entry.make = [inner = entry.make](JsonReader& parameters, double step, Scheme scheme) {
+    entry.make = [inner = entry.make](JsonReader& parameters, double step,
+                                      const DiscretizationOptions& discretization) {
       ++decay_builds;
-      return inner(parameters, step, scheme);
+      return inner(parameters, step, discretization);
     };
     model_registry().add(entry, "test_scenario_run");
     return true;
@@ -96,6 +97,34 @@ TEST(ScenarioRun, TheModelIsBuiltOnceFromParseToResult) {
   // x(t) = 2 e^{-a t}: the truth at the last sample says which a was simulated.
   const double t = faster.prepared.data.t[299];
   EXPECT_NEAR(faster.prepared.data.x(0, 299), 2.0 * std::exp(-2.0 * t), 1e-6);
+}
+
+// The model spec's "substeps" reaches the simulated plant and the observers: forward Euler on
+// x' = −a x with s sub-steps per sample of h gives x_k = x0 (1 − a h / s)^{s k} exactly, and a
+// bad value is refused at parse time naming the key.
+TEST(ScenarioRun, TheModelsSubstepsReachThePlantAndTheObservers) {
+  register_counted_decay();
+  for (const int substeps : {1, 7}) {
+    nlohmann::json spec = decay_scenario();
+    spec["model"]["scheme"] = "euler";
+    spec["model"]["parameters"]["a"] = 20.0;  // a h = 0.2
+    spec["model"]["substeps"] = substeps;
+    const ScenarioRun run = run_scenario(parse_scenario(spec, "decay-test"));
+    const double per_sample = std::pow(1.0 - 0.2 / substeps, substeps);
+    EXPECT_NEAR(run.prepared.data.x(0, 10), 2.0 * std::pow(per_sample, 10), 1e-12) << substeps;
+    // The EKF on the same sub-steps: ~1e-8; one that dropped them would be ~7e-5 off.
+    EXPECT_LT(run.result.metrics[0].mse_after_window[0], 1e-6) << substeps;
+  }
+  nlohmann::json bad = decay_scenario();
+  bad["model"]["substeps"] = 0;
+  try {
+    parse_scenario(bad, "decay-test");
+    ADD_FAILURE() << "substeps 0 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'substeps' = 0 is out of range: must be in 1..1000"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(ScenarioRun, RecordedDataOfTheWrongShapeIsRefusedNamingIt) {

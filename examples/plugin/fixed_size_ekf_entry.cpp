@@ -76,7 +76,7 @@ void add_fixed_size_ekf(nlobs::PluginRegistrar& registrar) {
                   using Model = std::decay_t<decltype(model)>;
                   using Sampled = nlobs::Discretized<Model>;
                   return std::make_unique<nlobs::ExtendedKalmanFilter<Sampled>>(
-                      Sampled(model, b.model.discrete.sample_time(), b.model.scheme), s);
+                      Sampled(model, b.model.discrete.sample_time(), b.model.discretization), s);
                 });
           }}));
 }

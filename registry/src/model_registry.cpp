@@ -26,24 +26,28 @@ ModelInstance make_model_instance(JsonReader& spec, const ModelRegistry& registr
   if (!entry) {
     spec.fail("unknown model '" + name + "'; valid models: " + registry.valid_list());
   }
-  Scheme scheme = entry->default_scheme;
+  DiscretizationOptions discretization{.scheme = entry->default_scheme,
+                                       .substeps = entry->default_substeps};
   if (auto s = spec.text("scheme")) {
     if (*s == "euler") {
-      scheme = Scheme::kEuler;
+      discretization.scheme = Scheme::kEuler;
     } else if (*s == "rk4") {
-      scheme = Scheme::kRk4;
+      discretization.scheme = Scheme::kRk4;
     } else {
       spec.fail("scheme '" + *s + "' is not euler or rk4");
     }
+  }
+  if (auto n = spec.integer("substeps", 1, DiscretizationOptions::kMostSubsteps)) {
+    discretization.substeps = static_cast<int>(*n);
   }
   const double step = spec.number("step").value_or(entry->default_step);
   if (!(step > 0.0) || !std::isfinite(step)) spec.fail("'step' must be finite and > 0");
   static const nlohmann::json empty = nlohmann::json::object();
   std::optional<JsonReader> parameters = spec.object("parameters");
   JsonReader p = parameters ? *parameters : JsonReader(empty, spec.where() + ".parameters");
-  spec.finish({"name", "parameters", "scheme", "step"});
+  spec.finish({"name", "parameters", "scheme", "step", "substeps"});
   try {
-    return entry->make(p, step, scheme);
+    return entry->make(p, step, discretization);
   } catch (const InvalidInput& e) {  // the discretisation's refusal of the step
     spec.fail(e.what());
   } catch (const std::invalid_argument& e) {

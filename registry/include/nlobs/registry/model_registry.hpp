@@ -1,6 +1,6 @@
 #pragma once
 // Models by name for scenario files and the CLI. A model spec
-//   {"name": "lorenz", "parameters": {"sigma": 10}, "scheme": "rk4", "step": 0.01}
+//   {"name": "lorenz", "parameters": {"sigma": 10}, "scheme": "rk4", "step": 0.01, "substeps": 1}
 // becomes a ModelInstance: the discretised model every observer can run on (AnyModel, with AD
 // Jacobians), and the hooks of the observer families that need the continuous model's own C++
 // type (MVT, high-gain, modulating), each empty with the reason when the model does not meet
@@ -56,14 +56,14 @@ struct ModelInstance {
   AnyModel discrete;
   // The continuous model, as the C++ type it was registered with (a copy of the one `discrete`
   // integrates), and how `discrete` integrates it over discrete.sample_time(): enough to build
-  // Discretized<Model>(*model_as<Model>(), discrete.sample_time(), scheme) again.
+  // Discretized<Model>(*model_as<Model>(), discrete.sample_time(), discretization) again.
   std::any continuous{};
-  Scheme scheme = Scheme::kRk4;
+  DiscretizationOptions discretization{.scheme = Scheme::kRk4};
   // MvtOptions::sample_time is the discrete model's.
-  ModelHook<const MvtOptions&> mvt;
+  ModelHook<const MvtOptions&> mvt{};
   // (spec, initial estimate, sample time)
-  ModelHook<const HighGainSpec&, const Eigen::VectorXd&, double> high_gain;
-  ModelHook<const ModulatingSpec&, const Eigen::VectorXd&, double> modulating;
+  ModelHook<const HighGainSpec&, const Eigen::VectorXd&, double> high_gain{};
+  ModelHook<const ModulatingSpec&, const Eigen::VectorXd&, double> modulating{};
 
   // The continuous model if it is a `Model` (the exact type model_entry<Model>() registered),
   // else null.
@@ -100,18 +100,27 @@ struct ModelEntry {
   std::vector<KeyInfo> parameters;
   double default_step = 0.01;
   Scheme default_scheme = Scheme::kRk4;
+  int default_substeps = 1;
   Eigen::Index states = 0, inputs = 0, outputs = 0;
   // Which hooks can exist for this model at all (the rest of the conditions are checked when
   // the observer is built): for `nlobs list models`.
   std::vector<std::string> families;
   // Reads the "parameters" object strictly (an unknown key is an error naming it; a value the
-  // model refuses fails naming the parameters object) and discretises with (step, scheme).
-  std::function<ModelInstance(JsonReader& parameters, double step, Scheme scheme)> make;
+  // model refuses fails naming the parameters object) and discretises with (step, options).
+  std::function<ModelInstance(JsonReader& parameters, double step,
+                              const DiscretizationOptions& discretization)>
+      make;
 };
 
-// NamedRegistry refuses a model without make.
+// NamedRegistry refuses a model without make, or with a default_substeps out of range (a
+// hand-built entry: model_entry checks its definition's).
 inline std::string missing_part(const ModelEntry& e) {
-  return e.make ? std::string() : std::string("has no make");
+  if (!e.make) return "has no make";
+  if (e.default_substeps < 1 || e.default_substeps > DiscretizationOptions::kMostSubsteps) {
+    return "has default_substeps = " + std::to_string(e.default_substeps) + ", out of range [1, " +
+           std::to_string(DiscretizationOptions::kMostSubsteps) + "]";
+  }
+  return {};
 }
 
 using ModelRegistry = NamedRegistry<ModelEntry>;
@@ -119,7 +128,8 @@ using ModelRegistry = NamedRegistry<ModelEntry>;
 // The process-wide registry: every built-in model, then what plugins and user code add.
 ModelRegistry& model_registry();
 
-// The instance a model spec {"name", "parameters", "scheme", "step"} describes. Throws
+// The instance a model spec {"name", "parameters", "scheme", "step", "substeps"} describes
+// (substeps: DiscretizationOptions::substeps, 1..1000, the entry's default when absent). Throws
 // std::invalid_argument naming the key path on any problem (an unknown name lists the valid
 // ones).
 ModelInstance make_model_instance(JsonReader& spec,

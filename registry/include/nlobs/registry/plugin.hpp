@@ -73,7 +73,9 @@ inline constexpr std::uint32_t kPluginMagic = 0x6e6c6f62;  // "nlob"
 // 6: Engine gained set_record_trace (a virtual hook: the vtable moved), SquareSystem and
 // LevenbergMarquardtEngine keep their accounts in a SolveLedger (their layouts changed), and
 // WindowEstimatorOptions gained trace_first_window.
-inline constexpr std::uint32_t kPluginLayout = 6;
+// 7: ModelInstance's scheme became DiscretizationOptions discretization (scheme and substeps),
+// ModelEntry gained default_substeps and its make takes the DiscretizationOptions.
+inline constexpr std::uint32_t kPluginLayout = 7;
 inline constexpr const char* kPluginSymbol = "nlobs_plugin_info";
 
 #define NLOBS_PLUGIN_STRINGIFY_(x) #x

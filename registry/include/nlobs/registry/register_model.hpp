@@ -62,6 +62,7 @@ struct ModelDefinition {
   std::vector<ModelParameter<Parameters>> parameters{};
   double default_step = 0.01;
   Scheme default_scheme = Scheme::kRk4;
+  int default_substeps = 1;  // a stiff or fast plant's own (DiscretizationOptions::substeps)
   Parameters defaults{};
   std::function<Model(const Parameters&)> build{};  // empty: the parameters are the model
 };
@@ -84,10 +85,13 @@ template <typename Model>
 constexpr bool kHighGainFits = kFixedSizes<Model>&& Model::kOutputs == 1 && Model::kInputs == 0;
 
 template <typename Model>
-ModelInstance model_instance(const std::string& name, Model model, double step, Scheme scheme) {
+ModelInstance model_instance(const std::string& name, Model model, double step,
+                             const DiscretizationOptions& discretization) {
   ModelInstance out{
-      name, AnyModel(name, Discretized<Model>(model, step, scheme), step), model, scheme, {}, {},
-      {}};
+      .name = name,
+      .discrete = AnyModel(name, Discretized<Model>(model, step, discretization), step),
+      .continuous = model,
+      .discretization = discretization};
   if constexpr (kMvtFits<Model>) {
     out.mvt.make = [model](const MvtOptions& options) -> std::unique_ptr<Observer> {
       return std::make_unique<MvtObserver<Model>>(model, options);
@@ -140,6 +144,12 @@ ModelEntry model_entry(ModelDefinition<Model, Parameters> definition) {
   entry.description = definition.description;
   entry.default_step = definition.default_step;
   entry.default_scheme = definition.default_scheme;
+  entry.default_substeps = definition.default_substeps;
+  try {
+    DiscretizationOptions{.substeps = definition.default_substeps}.validate();
+  } catch (const InvalidInput& e) {
+    throw InvalidInput("model '" + definition.name + "': default_substeps: " + e.what());
+  }
   for (auto& p : definition.parameters) {
     const bool taken = std::any_of(entry.parameters.begin(), entry.parameters.end(),
                                    [&](const KeyInfo& k) { return k.key == p.key; });
@@ -179,7 +189,8 @@ ModelEntry model_entry(ModelDefinition<Model, Parameters> definition) {
   if constexpr (detail::kHighGainFits<Model>) entry.families.push_back("high_gain");
   if constexpr (detail::HasModulatingForm<Model>) entry.families.push_back("modulating");
   if (probe->outputs() == 1) entry.families.push_back("finite_difference");
-  entry.make = [definition, build](JsonReader& reader, double step, Scheme scheme) {
+  entry.make = [definition, build](JsonReader& reader, double step,
+                                   const DiscretizationOptions& discretization) {
     Parameters p = definition.defaults;
     std::vector<std::string> keys;
     for (const auto& parameter : definition.parameters) {
@@ -202,7 +213,7 @@ ModelEntry model_entry(ModelDefinition<Model, Parameters> definition) {
     } catch (...) {  // `throw 42`: nothing to quote, so name whose code it was
       reader.fail("model '" + definition.name + "': its build threw " + current_exception_text());
     }
-    return detail::model_instance(definition.name, std::move(*model), step, scheme);
+    return detail::model_instance(definition.name, std::move(*model), step, discretization);
   };
   return entry;
 }

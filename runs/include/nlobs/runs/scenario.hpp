@@ -39,7 +39,7 @@ using ReportedFigures = std::map<std::string, std::map<std::string, double>>;
 struct Scenario {
   std::string name;
   std::string description;  // where the scenario comes from (a paper's example), optional
-  nlohmann::json model;     // {"name": ..., "parameters": {...}, "scheme": ..., "step": ...}
+  nlohmann::json model;     // {"name", "parameters": {...}, "scheme", "step", "substeps"}
   Eigen::VectorXd x0, initial_guess;
   long steps = 400;
   double noise = 0.0;
