@@ -407,6 +407,35 @@ TEST(Sweep, AModelParameterIsSimulatedAgainPerValue) {
   EXPECT_TRUE(settles);  // a figure that tells the two simulations apart
 }
 
+// A key read as an integer (the MHE's horizon) takes whole values, as the scenario file's
+// `"horizon": 8` is taken; 4.5 is refused naming the key.
+TEST(Sweep, AnIntegerKeyTakesWholeValues) {
+  register_counted_decay();
+  nlohmann::json spec = decay_scenario();
+  spec["observers"] = {{{"type", "mhe"},
+                        {"horizon", 5},
+                        {"process_covariance", {{1e-8}}},
+                        {"measurement_covariance", {{1e-6}}},
+                        {"initial_covariance", {{1.0}}}}};
+  const PreparedScenario prepared = prepare_scenario(parse_scenario(spec, "decay-test"));
+  const SweepRun sweep = run_sweep(prepared, "horizon", {4.0, 8.0});
+  ASSERT_EQ(sweep.values.size(), 2u);
+  // "After" is after the longest horizon has filled: sample 7, not 8 / T = 800 samples (the
+  // modulating observers' horizon is a time).
+  EXPECT_EQ(sweep.settle_index, 7);
+  for (const SweepValue& v : sweep.values) {
+    EXPECT_LT(v.result.metrics[0].mse_after_window[0], 1e-4) << v.value;
+  }
+  try {
+    run_sweep(prepared, "horizon", {4.5});
+    ADD_FAILURE() << "horizon 4.5 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'horizon' must be an integer, got 4.5"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Sweep, HostileSweepsAreRefusedNamingKeyAndValue) {
   register_counted_decay();
   const PreparedScenario prepared =

@@ -19,6 +19,15 @@ std::string value_text(double v) {
   return os.str();
 }
 
+// A swept value as the JSON a scenario file would hold: a whole number as an integer, so that
+// keys read as integers (an MHE's horizon, an observer's substeps) take it as they take
+// `"horizon": 8`; any other number as itself (a key read as a number takes both).
+nlohmann::json value_json(double v) {
+  constexpr double kExactIntegers = 9007199254740992.0;  // 2^53: every whole double below is exact
+  if (v == std::floor(v) && std::abs(v) <= kExactIntegers) return static_cast<long>(v);
+  return v;
+}
+
 }  // namespace
 
 SweepRun run_sweep(const PreparedScenario& prepared, const std::string& key,
@@ -52,12 +61,19 @@ SweepRun run_sweep(const PreparedScenario& prepared, const std::string& key,
   }
   sweep.settle_index = std::max(prepared.settle_index, 0L);
   if (key == "horizon" && data.steps() > 1) {
-    // Every value counts the same samples: those after the longest horizon has filled.
+    // Every value counts the same samples: those after the longest horizon has filled. A
+    // modulating-function observer's horizon is a time T; the MHE's is N samples (full from
+    // sample N − 1 on).
     const double delta = data.t[1] - data.t[0];
     const double longest = *std::max_element(values.begin(), values.end());
+    double filled = 0.0;
+    for (const std::size_t i : sweep.swept) {
+      const std::string& type = s.observers[i].type;
+      if (type == "mhe") filled = std::max(filled, longest - 1.0);
+      if (type != "mhe") filled = std::max(filled, std::ceil(longest / delta - 1e-9));
+    }
     // (At most the data's length: a horizon of 1e300 s is no index.)
-    const double filled =
-        std::min(std::ceil(longest / delta - 1e-9), static_cast<double>(data.steps()));
+    filled = std::min(filled, static_cast<double>(data.steps()));
     sweep.settle_index = std::max(sweep.settle_index, static_cast<long>(filled));
   }
 
@@ -78,7 +94,7 @@ SweepRun run_sweep(const PreparedScenario& prepared, const std::string& key,
     const ModelInstance* model = &prepared.model;
     std::optional<ModelInstance> edited;
     if (sweep.model_parameter) {
-      run.model["parameters"][key] = value;
+      run.model["parameters"][key] = value_json(value);
       edited = named([&] {
         try {
           return scenario_model(run);
@@ -100,7 +116,7 @@ SweepRun run_sweep(const PreparedScenario& prepared, const std::string& key,
         const std::size_t i = sweep.run[j];
         if (std::find(sweep.swept.begin(), sweep.swept.end(), i) == sweep.swept.end()) continue;
         run.observers[j] = named([&] {
-          return with_key(run.observers[j], key, value, *model,
+          return with_key(run.observers[j], key, value_json(value), *model,
                           s.name + ".observers[" + std::to_string(i) + "]");
         });
       }
