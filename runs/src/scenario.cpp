@@ -9,15 +9,113 @@
 #include <string>
 
 #include "builtin_scenario_texts.hpp"
+#include "nlobs/common/invalid_input.hpp"
 #include "nlobs/common/printable.hpp"
 #include "nlobs/registry/json_reader.hpp"
 #include "nlobs/runs/input_file.hpp"
+#include "nlobs/runs/measurements_file.hpp"
 
 namespace nlobs {
 namespace {
 
 nlohmann::json vector_json(const Eigen::VectorXd& v) {
   return std::vector<double>(v.data(), v.data() + v.size());
+}
+
+// A schedule's knots from the file: "times" (t_0 < t_1 < …) and "values", one per time, each one
+// number (every input alike) or m numbers (the model's inputs, in order).
+void read_knots(JsonReader& in, Eigen::Index inputs, InputSchedule& schedule) {
+  if (!in.has("times") || !in.has("values")) in.fail("a schedule needs 'times' and 'values'");
+  const Eigen::VectorXd times = *in.vector("times");
+  const Eigen::MatrixXd values = *in.matrix("values");  // K × 1 or K × m
+  if (values.rows() != times.size()) {
+    in.fail("'values' has " + std::to_string(values.rows()) + " entries for " +
+            std::to_string(times.size()) + " 'times': one per time");
+  }
+  if (values.cols() != 1 && values.cols() != inputs) {
+    in.fail("each entry of 'values' must be one number (every input) or " + std::to_string(inputs) +
+            " numbers (the model's inputs), not " + std::to_string(values.cols()));
+  }
+  schedule.times.assign(times.data(), times.data() + times.size());
+  schedule.values = values.transpose().replicate(values.cols() == 1 ? inputs : 1, 1);
+}
+
+InputSpec parse_input(JsonReader& in, const AnyModel& model, const std::string& base_directory) {
+  InputSpec spec;
+  spec.kind = in.text("kind").value_or("zero");
+  if (spec.kind == "zero" || spec.kind == "constant" || spec.kind == "sin") {
+    spec.value = in.number("value").value_or(0.0);
+    spec.amplitude = in.number("amplitude").value_or(1.0);
+    spec.frequency = in.number("frequency").value_or(1.0);
+    in.finish({"kind", "value", "amplitude", "frequency"});
+    return spec;
+  }
+  const bool knots = spec.kind == "piecewise_constant" || spec.kind == "piecewise_linear";
+  if (!knots && spec.kind != "file") {
+    in.fail("'kind' must be zero, constant, sin, piecewise_constant, piecewise_linear or file");
+  }
+  const Eigen::Index inputs = model.inputs();
+  if (inputs == 0) {
+    in.fail("'kind' " + spec.kind + ": model '" + printable(model.name()) +
+            "' has no input for the schedule to drive");
+  }
+  if (knots) {
+    read_knots(in, inputs, spec.schedule);
+    spec.schedule.interpolation = spec.kind == "piecewise_linear"
+                                      ? InputSchedule::Interpolation::kLinear
+                                      : InputSchedule::Interpolation::kPrevious;
+    in.finish({"kind", "times", "values"});
+  } else {
+    const std::string interpolation = in.text("interpolation").value_or("previous");
+    if (interpolation != "previous" && interpolation != "linear") {
+      in.fail("'interpolation' must be previous or linear");
+    }
+    std::filesystem::path path(in.required_text("file"));
+    if (path.is_relative() && !base_directory.empty()) path = base_directory / path;
+    // Absolute, so that the scenario.json a run writes reads the same file from anywhere.
+    std::error_code ec;
+    const std::filesystem::path absolute = std::filesystem::absolute(path, ec);
+    spec.file = (ec ? path : absolute).lexically_normal().string();
+    in.finish({"kind", "file", "interpolation"});
+    Measurements read;
+    try {  // t, u1..um: the data file's reader with no output columns
+      read = read_measurements_csv(spec.file, 0, inputs);
+    } catch (const std::invalid_argument& e) {
+      in.fail(std::string("input file: ") + e.what());
+    }
+    spec.schedule.times.assign(read.t.data(), read.t.data() + read.t.size());
+    spec.schedule.values = read.u;
+    spec.schedule.interpolation = interpolation == "linear"
+                                      ? InputSchedule::Interpolation::kLinear
+                                      : InputSchedule::Interpolation::kPrevious;
+  }
+  try {
+    spec.schedule.validate(inputs);
+  } catch (const InvalidInput& e) {
+    in.fail(e.what());
+  }
+  return spec;
+}
+
+nlohmann::json input_json(const InputSpec& in) {
+  if (in.kind == "file") {
+    return {{"kind", in.kind},
+            {"file", in.file},
+            {"interpolation", in.schedule.interpolation == InputSchedule::Interpolation::kLinear
+                                  ? "linear"
+                                  : "previous"}};
+  }
+  if (in.kind == "piecewise_constant" || in.kind == "piecewise_linear") {
+    nlohmann::json values = nlohmann::json::array();
+    for (Eigen::Index i = 0; i < in.schedule.values.cols(); ++i) {
+      values.push_back(vector_json(in.schedule.values.col(i)));
+    }
+    return {{"kind", in.kind}, {"times", in.schedule.times}, {"values", values}};
+  }
+  return {{"kind", in.kind},
+          {"value", in.value},
+          {"amplitude", in.amplitude},
+          {"frequency", in.frequency}};
 }
 
 }  // namespace
@@ -44,10 +142,12 @@ Scenario load_scenario(const std::string& name_or_file) {
                                 ") nor a JSON file");
   }
   std::ifstream in = open_input_file(name_or_file, "scenario file");
-  return parse_scenario(parse_json(in, name_or_file), name_or_file);
+  return parse_scenario(parse_json(in, name_or_file), name_or_file,
+                        std::filesystem::path(name_or_file).parent_path().string());
 }
 
-Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
+Scenario parse_scenario(const nlohmann::json& json, const std::string& where,
+                        const std::string& base_directory) {
   JsonReader r(json, where);
   Scenario s;
   s.name = r.required_text("name");
@@ -84,16 +184,7 @@ Scenario parse_scenario(const nlohmann::json& json, const std::string& where) {
     if (!(*v >= 0.0) || !std::isfinite(*v)) r.fail("'settle_time' must be finite and >= 0 (s)");
     s.settle_time = *v;
   }
-  if (auto in = r.object("input")) {
-    s.input.kind = in->text("kind").value_or("zero");
-    if (s.input.kind != "zero" && s.input.kind != "constant" && s.input.kind != "sin") {
-      in->fail("'kind' must be zero, constant or sin");
-    }
-    s.input.value = in->number("value").value_or(0.0);
-    s.input.amplitude = in->number("amplitude").value_or(1.0);
-    s.input.frequency = in->number("frequency").value_or(1.0);
-    in->finish({"kind", "value", "amplitude", "frequency"});
-  }
+  if (auto in = r.object("input")) s.input = parse_input(*in, model, base_directory);
   for (JsonReader& o : r.objects("observers")) {
     s.observers.push_back(parse_observer_spec(o, instance));
   }
@@ -125,10 +216,7 @@ nlohmann::json to_json(const Scenario& s) {
   j["noise"] = s.noise;
   if (s.process_noise > 0.0) j["process_noise"] = s.process_noise;
   j["seed"] = s.seed;
-  j["input"] = {{"kind", s.input.kind},
-                {"value", s.input.value},
-                {"amplitude", s.input.amplitude},
-                {"frequency", s.input.frequency}};
+  j["input"] = input_json(s.input);
   nlohmann::json observers = nlohmann::json::array();
   for (const ObserverSpec& o : s.observers) observers.push_back(observer_spec_json(o));
   j["observers"] = observers;
@@ -161,6 +249,14 @@ Eigen::VectorXd scenario_input(const Scenario& s, const AnyModel& model, long k)
   if (u.size() == 0 || s.input.kind == "zero") return u;
   // Inputs are held over a sample.
   const double t = static_cast<double>(k) * model.sample_time();
+  if (!s.input.schedule.times.empty()) {
+    if (s.input.schedule.values.rows() != u.size()) {  // a scenario edited after its parse
+      throw InvalidInput("scenario '" + s.name + "': the input schedule has " +
+                         std::to_string(s.input.schedule.values.rows()) +
+                         " inputs where the model has " + std::to_string(u.size()));
+    }
+    return s.input.schedule.at(t);
+  }
   u.setConstant(s.input.kind == "constant" ? s.input.value
                                            : s.input.amplitude * std::sin(s.input.frequency * t));
   return u;

@@ -19,6 +19,7 @@
 #include "nlobs/observers/core/simulation.hpp"
 #include "nlobs/registry/model_registry.hpp"
 #include "nlobs/registry/observer_types.hpp"
+#include "nlobs/runs/input_schedule.hpp"
 
 namespace nlobs {
 
@@ -26,10 +27,16 @@ namespace nlobs {
 // kept).
 inline constexpr long kMaxScenarioSteps = 10'000'000;
 
+// u(t) of the simulated plant, sampled at t_k and held over the sample. zero, constant and sin
+// set every input alike; a schedule (piecewise_constant: steps, piecewise_linear: ramps) gives
+// each input its own values at knots, from the scenario file or from a CSV file of t, u1..um.
 struct InputSpec {
-  std::string kind = "zero";                // zero | constant | sin
-  double value = 0.0;                       // constant
+  std::string kind =
+      "zero";          // zero | constant | sin | piecewise_constant | piecewise_linear | file
+  double value = 0.0;  // constant
   double amplitude = 1.0, frequency = 1.0;  // sin: amplitude · sin(frequency · t)
+  InputSchedule schedule{};                 // piecewise_constant, piecewise_linear, file
+  std::string file{};                       // file: the path it was read from, resolved
 };
 
 // Figures a paper reported, printed beside ours: observer name → {"mse": x,
@@ -65,7 +72,10 @@ struct Scenario {
 std::vector<std::string> builtin_scenarios();
 // A built-in name, or a path to a JSON file. Throws std::invalid_argument otherwise.
 Scenario load_scenario(const std::string& name_or_file);
-Scenario parse_scenario(const nlohmann::json& json, const std::string& where);
+// `base_directory`: where a relative path in the scenario (an input file) is resolved; empty:
+// the working directory. load_scenario passes the scenario file's own directory.
+Scenario parse_scenario(const nlohmann::json& json, const std::string& where,
+                        const std::string& base_directory = "");
 nlohmann::json to_json(const Scenario& scenario);
 
 // The scenario's model: the one parse_scenario built (shared by every copy of the Scenario and
