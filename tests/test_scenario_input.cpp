@@ -92,6 +92,55 @@ TEST(ScenarioInput, StepsAndRampsDriveThePlant) {
     EXPECT_EQ(ramp.u(1, k), ramp.u(0, k)) << k;
   }
   EXPECT_EQ(ramp.x(0, 11), 0.0);  // u1 − u2 = 0 throughout
+
+  // Written back (scenario.json), each knot's values per input: the same schedule again.
+  register_integrator();
+  const Scenario s = parse_scenario(
+      scenario_with({{"kind", "piecewise_linear"}, {"times", {0.5, 2.5}}, {"values", {0.0, 4.0}}}),
+      "schedule-test");
+  const Scenario again = parse_scenario(to_json(s), "written back");
+  EXPECT_EQ(again.input.kind, "piecewise_linear");
+  EXPECT_EQ(again.input.schedule.times, s.input.schedule.times);
+  EXPECT_EQ(again.input.schedule.values, s.input.schedule.values);
+}
+
+// t_k = k T in floating point: 3 · 0.3 = 0.8999999999999999 < 0.9, yet the step at 0.9 is
+// applied at k = 3, as u_i on [t_i, t_{i+1}) says (a knot within rounding counts as reached).
+TEST(ScenarioInput, AKnotOnASampleIsReachedDespiteRounding) {
+  register_integrator();
+  nlohmann::json spec = scenario_with(
+      {{"kind", "piecewise_constant"}, {"times", {0.0, 0.9}}, {"values", {0.0, 1.0}}});
+  spec["model"]["step"] = 0.3;
+  const Measurements data = prepare_scenario(parse_scenario(spec, "schedule-test")).data;
+  ASSERT_LT(3 * 0.3, 0.9);
+  EXPECT_EQ(data.u(0, 2), 0.0);
+  EXPECT_EQ(data.u(0, 3), 1.0);
+  // A ramp between knots at ∓1e308 (t1 − t0 overflows) still moves: u(t) ≈ 1/2 near t = 0.
+  const Measurements far =
+      simulated({{"kind", "piecewise_linear"}, {"times", {-1e308, 1e308}}, {"values", {0.0, 1.0}}});
+  EXPECT_NEAR(far.u(0, 0), 0.5, 1e-12);
+}
+
+// A scenario built or edited in C++ after its parse is checked before it is simulated.
+TEST(ScenarioInput, AScheduleEditedInCppIsCheckedBeforeTheSimulation) {
+  register_integrator();
+  Scenario s = parse_scenario(
+      scenario_with(
+          {{"kind", "piecewise_constant"}, {"times", {0.0, 1.0}}, {"values", {1.0, 2.0}}}),
+      "schedule-test");
+  const ModelInstance model = scenario_model(s);
+  Scenario short_values = s;
+  short_values.input.schedule.values.conservativeResize(2, 1);
+  EXPECT_THROW(simulate_scenario(short_values, model.discrete), InvalidInput);
+  Scenario backwards = s;
+  backwards.input.schedule.times = {1.0, 0.0};
+  EXPECT_THROW(simulate_scenario(backwards, model.discrete), InvalidInput);
+  Scenario unknown = s;
+  unknown.input.kind = "cubic";
+  EXPECT_THROW(simulate_scenario(unknown, model.discrete), InvalidInput);
+  Scenario emptied = s;
+  emptied.input.schedule = {};
+  EXPECT_THROW(simulate_scenario(emptied, model.discrete), InvalidInput);
 }
 
 TEST(ScenarioInput, BadSchedulesAreRefusedNamingTheKnot) {
@@ -170,6 +219,17 @@ TEST(ScenarioInput, AFileScheduleIsReadBesideTheScenarioAndWrittenBackAbsolute) 
     EXPECT_EQ(again.input.schedule.times, s.input.schedule.times);
     EXPECT_EQ(again.input.schedule.values, s.input.schedule.values);
   }
+  // A relative path through a directory link is the operating system's: link/../u.csv is the
+  // link target's parent's u.csv, not the scenario directory's (a decoy there).
+  std::filesystem::create_directories(dir / "a" / "b");
+  test::write_file(dir / "a" / "u.csv", "t,u1,u2\n0,1,0\n");
+  test::write_file(dir / "u.csv", "t,u1,u2\n0,5,0\n");
+  std::filesystem::remove(dir / "lnk");
+  std::filesystem::create_directory_symlink(dir / "a" / "b", dir / "lnk");
+  test::write_file(dir / "scenario.json",
+                   scenario_with({{"kind", "file"}, {"file", "lnk/../u.csv"}}).dump());
+  EXPECT_EQ(prepare_scenario(load_scenario((dir / "scenario.json").string())).data.u(0, 0), 1.0);
+
   // Linear between the file's rows: u1 = 1 + 2 t on [0, 1].
   test::write_file(
       dir / "scenario.json",
@@ -188,11 +248,15 @@ TEST(ScenarioInput, AFileScheduleIsReadBesideTheScenarioAndWrittenBackAbsolute) 
     }
     return std::string("<no error>");
   };
-  EXPECT_NE(file_error({{"kind", "file"}, {"file", "missing.csv"}}).find("input file: "),
+  EXPECT_NE(file_error({{"kind", "file"}, {"file", "missing.csv"}}).find("does not exist"),
+            std::string::npos)
+      << file_error({{"kind", "file"}, {"file", "missing.csv"}});
+  EXPECT_NE(file_error({{"kind", "file"}, {"file", "missing.csv"}}).find("input file"),
             std::string::npos);
   std::filesystem::create_directories(dir / "a-directory");
-  EXPECT_NE(file_error({{"kind", "file"}, {"file", "a-directory"}}).find("input file: "),
-            std::string::npos);
+  EXPECT_NE(file_error({{"kind", "file"}, {"file", "a-directory"}}).find("is a directory"),
+            std::string::npos)
+      << file_error({{"kind", "file"}, {"file", "a-directory"}});
   test::write_file(dir / "backwards.csv", "t,u1,u2\n0,1,0\n2,3,1\n1,3,1\n");
   EXPECT_NE(file_error({{"kind", "file"}, {"file", "backwards.csv"}}).find("backwards.csv:4"),
             std::string::npos)

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 #include <string>
 
@@ -21,7 +22,7 @@ void InputSchedule::validate(Eigen::Index inputs) const {
   }
   for (std::size_t i = 0; i < times.size(); ++i) {
     std::ostringstream os;
-    os << "knot " << i << ": ";
+    os << std::setprecision(17) << "knot " << i << ": ";
     if (!std::isfinite(times[i])) {
       os << "time " << times[i] << " is not a finite number";
       fail(os.str());
@@ -38,15 +39,16 @@ void InputSchedule::validate(Eigen::Index inputs) const {
   }
 }
 
-Eigen::VectorXd InputSchedule::at(double t) const {
+Eigen::VectorXd InputSchedule::at(double t, double tolerance) const {
   // The first knot after t: u holds the one before it, or moves toward it.
-  const auto after = std::upper_bound(times.begin(), times.end(), t);
+  const auto after = std::upper_bound(times.begin(), times.end(), t + tolerance);
   if (after == times.begin()) return values.col(0);
   if (after == times.end()) return values.col(values.cols() - 1);
   const auto i = static_cast<Eigen::Index>(after - times.begin()) - 1;
   if (interpolation == Interpolation::kPrevious) return values.col(i);
   const double t0 = times[static_cast<std::size_t>(i)], t1 = *after;
-  const double w = (t - t0) / (t1 - t0);
+  // Halves: t1 − t0 of knots at ∓1e308 would overflow to inf (and the line stay flat).
+  const double w = std::clamp((t / 2 - t0 / 2) / (t1 / 2 - t0 / 2), 0.0, 1.0);
   return (1.0 - w) * values.col(i) + w * values.col(i + 1);
 }
 

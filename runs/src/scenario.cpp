@@ -30,7 +30,8 @@ void read_knots(JsonReader& in, Eigen::Index inputs, InputSchedule& schedule) {
   const Eigen::MatrixXd values = *in.matrix("values");  // K × 1 or K × m
   if (values.rows() != times.size()) {
     in.fail("'values' has " + std::to_string(values.rows()) + " entries for " +
-            std::to_string(times.size()) + " 'times': one per time");
+            std::to_string(times.size()) +
+            " 'times': one per time (one number, or an array of the model's inputs)");
   }
   if (values.cols() != 1 && values.cols() != inputs) {
     in.fail("each entry of 'values' must be one number (every input) or " + std::to_string(inputs) +
@@ -38,6 +39,10 @@ void read_knots(JsonReader& in, Eigen::Index inputs, InputSchedule& schedule) {
   }
   schedule.times.assign(times.data(), times.data() + times.size());
   schedule.values = values.transpose().replicate(values.cols() == 1 ? inputs : 1, 1);
+}
+
+bool input_is_schedule(const std::string& kind) {
+  return kind == "piecewise_constant" || kind == "piecewise_linear" || kind == "file";
 }
 
 InputSpec parse_input(JsonReader& in, const AnyModel& model, const std::string& base_directory) {
@@ -70,18 +75,28 @@ InputSpec parse_input(JsonReader& in, const AnyModel& model, const std::string& 
     if (interpolation != "previous" && interpolation != "linear") {
       in.fail("'interpolation' must be previous or linear");
     }
-    std::filesystem::path path(in.required_text("file"));
+    const std::string given = in.required_text("file");
+    std::filesystem::path path(given);
     if (path.is_relative() && !base_directory.empty()) path = base_directory / path;
-    // Absolute, so that the scenario.json a run writes reads the same file from anywhere.
+    // Written back absolute, so that the scenario.json a run writes reads the same file from
+    // anywhere; not normalised ("link/../u.csv" is not "u.csv" when link is a symbolic link);
+    // as given when the absolute path is no UTF-8 (JSON holds only UTF-8).
     std::error_code ec;
     const std::filesystem::path absolute = std::filesystem::absolute(path, ec);
-    spec.file = (ec ? path : absolute).lexically_normal().string();
+    if (!ec) path = absolute;
+    spec.file = path.string();
+    try {
+      (void)nlohmann::json(spec.file).dump();
+    } catch (const nlohmann::json::type_error&) {
+      spec.file = given;
+    }
     in.finish({"kind", "file", "interpolation"});
     Measurements read;
     try {  // t, u1..um: the data file's reader with no output columns
-      read = read_measurements_csv(spec.file, 0, inputs);
+      std::ifstream stream = open_input_file(path.string(), "input file");
+      read = parse_measurements_csv(stream, path.string(), 0, inputs);
     } catch (const std::invalid_argument& e) {
-      in.fail(std::string("input file: ") + e.what());
+      in.fail(e.what());
     }
     spec.schedule.times.assign(read.t.data(), read.t.data() + read.t.size());
     spec.schedule.values = read.u;
@@ -240,6 +255,17 @@ Measurements simulate_scenario(const Scenario& s, const AnyModel& model) {
   sim.process_noise_std = s.process_noise;
   sim.seed = s.seed;
   sim.sample_time = model.sample_time() > 0 ? model.sample_time() : 1.0;
+  if (input_is_schedule(s.input.kind)) {  // a scenario built or edited in C++: checked once here
+    try {
+      s.input.schedule.validate(model.inputs());
+    } catch (const InvalidInput& e) {
+      throw InvalidInput("scenario '" + s.name + "': " + e.what());
+    }
+  } else if (s.input.kind != "zero" && s.input.kind != "constant" && s.input.kind != "sin") {
+    throw InvalidInput("scenario '" + s.name + "': input kind '" + printable(s.input.kind) +
+                       "' is none of zero, constant, sin, piecewise_constant, piecewise_linear, "
+                       "file");
+  }
   sim.input = [&s, &model](long k) { return scenario_input(s, model, k); };
   return simulate(model, s.x0, sim);
 }
@@ -249,13 +275,15 @@ Eigen::VectorXd scenario_input(const Scenario& s, const AnyModel& model, long k)
   if (u.size() == 0 || s.input.kind == "zero") return u;
   // Inputs are held over a sample.
   const double t = static_cast<double>(k) * model.sample_time();
-  if (!s.input.schedule.times.empty()) {
-    if (s.input.schedule.values.rows() != u.size()) {  // a scenario edited after its parse
-      throw InvalidInput("scenario '" + s.name + "': the input schedule has " +
-                         std::to_string(s.input.schedule.values.rows()) +
-                         " inputs where the model has " + std::to_string(u.size()));
+  if (input_is_schedule(s.input.kind)) {
+    const InputSchedule& schedule = s.input.schedule;
+    if (schedule.times.empty() || schedule.values.rows() != u.size() ||
+        schedule.values.cols() != static_cast<Eigen::Index>(schedule.times.size())) {
+      throw InvalidInput("scenario '" + s.name + "': its input schedule is not " +
+                         std::to_string(u.size()) + " inputs at one or more knots");
     }
-    return s.input.schedule.at(t);
+    // A knot within rounding of t_k (k T in floating point) is reached at k.
+    return schedule.at(t, 1e-9 * model.sample_time());
   }
   u.setConstant(s.input.kind == "constant" ? s.input.value
                                            : s.input.amplitude * std::sin(s.input.frequency * t));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -24,7 +25,7 @@ std::string value_text(double v) {
 // `"horizon": 8`; any other number as itself (a key read as a number takes both).
 nlohmann::json value_json(double v) {
   constexpr double kExactIntegers = 9007199254740992.0;  // 2^53: every whole double below is exact
-  if (v == std::floor(v) && std::abs(v) <= kExactIntegers) return static_cast<long>(v);
+  if (v == std::floor(v) && std::abs(v) <= kExactIntegers) return static_cast<std::int64_t>(v);
   return v;
 }
 

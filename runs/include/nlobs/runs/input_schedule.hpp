@@ -19,8 +19,10 @@ struct InputSchedule {
   // Throws InvalidInput naming the knot (from 0): no knot, a time that is not finite or not
   // after the one before, a value that is not finite, `values` not `inputs` × K.
   void validate(Eigen::Index inputs) const;
-  // u(t); t must not be NaN.
-  Eigen::VectorXd at(double t) const;
+  // u(t); t must not be NaN. A knot within `tolerance` after t counts as reached (t = k T
+  // computed in floating point lands just before the knot at 0.9 when T = 0.3: 3 · 0.3 <
+  // 0.9), and the line between knots is clamped to them.
+  Eigen::VectorXd at(double t, double tolerance = 0.0) const;
 };
 
 }  // namespace nlobs

@@ -31,12 +31,12 @@ inline constexpr long kMaxScenarioSteps = 10'000'000;
 // set every input alike; a schedule (piecewise_constant: steps, piecewise_linear: ramps) gives
 // each input its own values at knots, from the scenario file or from a CSV file of t, u1..um.
 struct InputSpec {
-  std::string kind =
-      "zero";          // zero | constant | sin | piecewise_constant | piecewise_linear | file
-  double value = 0.0;  // constant
+  // zero | constant | sin | piecewise_constant | piecewise_linear | file
+  std::string kind = "zero";
+  double value = 0.0;                       // constant
   double amplitude = 1.0, frequency = 1.0;  // sin: amplitude · sin(frequency · t)
   InputSchedule schedule{};                 // piecewise_constant, piecewise_linear, file
-  std::string file{};                       // file: the path it was read from, resolved
+  std::string file{};  // file: the path it was read from, absolute (as given if that is no UTF-8)
 };
 
 // Figures a paper reported, printed beside ours: observer name → {"mse": x,
