@@ -70,8 +70,7 @@ SweepRun run_sweep(const PreparedScenario& prepared, const std::string& key,
     double filled = 0.0;
     for (const std::size_t i : sweep.swept) {
       const std::string& type = s.observers[i].type;
-      if (type == "mhe") filled = std::max(filled, longest - 1.0);
-      if (type != "mhe") filled = std::max(filled, std::ceil(longest / delta - 1e-9));
+      filled = std::max(filled, type == "mhe" ? longest - 1.0 : std::ceil(longest / delta - 1e-9));
     }
     // (At most the data's length: a horizon of 1e300 s is no index.)
     filled = std::min(filled, static_cast<double>(data.steps()));
