@@ -407,6 +407,17 @@ TEST(Sweep, AModelParameterIsSimulatedAgainPerValue) {
   EXPECT_TRUE(settles);  // a figure that tells the two simulations apart
 }
 
+// What a sweep refuses, as its message; "<no error>" when it runs.
+std::string sweep_error(const PreparedScenario& prepared, const std::string& key,
+                        const std::vector<double>& values) {
+  try {
+    run_sweep(prepared, key, values);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "<no error>";
+}
+
 // A key read as an integer (the MHE's horizon) takes whole values, as the scenario file's
 // `"horizon": 8` is taken; 4.5 is refused naming the key.
 TEST(Sweep, AnIntegerKeyTakesWholeValues) {
@@ -426,14 +437,27 @@ TEST(Sweep, AnIntegerKeyTakesWholeValues) {
   for (const SweepValue& v : sweep.values) {
     EXPECT_LT(v.result.metrics[0].mse_after_window[0], 1e-4) << v.value;
   }
-  try {
-    run_sweep(prepared, "horizon", {4.5});
-    ADD_FAILURE() << "horizon 4.5 accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("'horizon' must be an integer, got 4.5"),
-              std::string::npos)
-        << e.what();
-  }
+  EXPECT_NE(sweep_error(prepared, "horizon", {4.5}).find("'horizon' must be an integer, got 4.5"),
+            std::string::npos)
+      << sweep_error(prepared, "horizon", {4.5});
+}
+
+// "substeps", where no observer of the scenario takes it, is the model spec's: each value is
+// simulated again and run on that discretisation (the runs differ); 0 is refused naming it.
+TEST(Sweep, SubstepsSweepTheModelsDiscretisation) {
+  register_counted_decay();
+  nlohmann::json spec = decay_scenario();
+  spec["model"]["scheme"] = "euler";
+  spec["model"]["parameters"]["a"] = 20.0;
+  const PreparedScenario prepared = prepare_scenario(parse_scenario(spec, "decay-test"));
+  const SweepRun sweep = run_sweep(prepared, "substeps", {1.0, 7.0});
+  EXPECT_TRUE(sweep.model_parameter);
+  ASSERT_EQ(sweep.values.size(), 2u);
+  EXPECT_NE(sweep.values[0].result.metrics[1].mse[0], sweep.values[1].result.metrics[1].mse[0]);
+  EXPECT_NE(sweep_error(prepared, "substeps", {0.0})
+                .find("'substeps' = 0 is out of range: must be in 1..1000"),
+            std::string::npos)
+      << sweep_error(prepared, "substeps", {0.0});
 }
 
 TEST(Sweep, HostileSweepsAreRefusedNamingKeyAndValue) {

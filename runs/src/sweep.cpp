@@ -94,7 +94,12 @@ SweepRun run_sweep(const PreparedScenario& prepared, const std::string& key,
     const ModelInstance* model = &prepared.model;
     std::optional<ModelInstance> edited;
     if (sweep.model_parameter) {
-      run.model["parameters"][key] = value_json(value);
+      // The model spec's own key (its integration sub-steps) where no observer takes the key.
+      if (key == "substeps") {
+        run.model["substeps"] = value_json(value);
+      } else {
+        run.model["parameters"][key] = value_json(value);
+      }
       edited = named([&] {
         try {
           return scenario_model(run);

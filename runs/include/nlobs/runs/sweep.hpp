@@ -38,7 +38,9 @@ struct SweepValue {
 
 struct SweepRun {
   std::string key;
-  bool model_parameter = false;    // the key is the model's; else the observers'
+  // The key is the model's — a parameter, or `substeps` of its discretisation — and every value
+  // simulated again; else the observers'.
+  bool model_parameter = false;
   std::vector<std::size_t> swept;  // scenario indices of the observers given the value
   std::vector<std::size_t> run;    // scenario indices of the observers run, in result order
   long settle_index = 0;           // the first sample every value's "after" metrics count
