@@ -118,8 +118,8 @@ TEST(RealPlant, TheEkfTracksTheIgnitionWithSubsteps) {
   EXPECT_FALSE(std::sqrt(f.mse_after_window[1]) < 10.0) << f.mse_after_window.transpose();
 }
 
-// The order of each scheme, measured on this plant before ignition is not clean (u steps), so on
-// the known solution of x' = −x + sin t: halving the sub-step divides the error by 2^p.
+// The order of each scheme through sub-steps, measured where the solution is known in closed
+// form (the reactor's is not): x' = −x + sin t, whose error halving the sub-step divides by 2^p.
 struct ForcedDecay : ModelSizes<1, 0, 1> {
   template <typename T>
   State<T> vector_field(const State<T>& x, const Input&, double t) const {
