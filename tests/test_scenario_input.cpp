@@ -261,6 +261,9 @@ TEST(ScenarioInput, AFileScheduleIsReadBesideTheScenarioAndWrittenBackAbsolute) 
   EXPECT_NE(file_error({{"kind", "file"}, {"file", "backwards.csv"}}).find("backwards.csv:4"),
             std::string::npos)
       << file_error({{"kind", "file"}, {"file", "backwards.csv"}});
+  // --allow-late is for measurements: not offered for an input file.
+  EXPECT_EQ(file_error({{"kind", "file"}, {"file", "backwards.csv"}}).find("--allow-late"),
+            std::string::npos);
   test::write_file(dir / "nan.csv", "t,u1,u2\n0,nan,0\n");
   EXPECT_NE(file_error({{"kind", "file"}, {"file", "nan.csv"}}).find("nan.csv:2"),
             std::string::npos)

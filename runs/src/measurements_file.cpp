@@ -156,7 +156,10 @@ class Reader {
       std::ostringstream os;
       os.precision(17);
       os << "time " << values_[0] << " does not come after the previous row's " << times_.back()
-         << ": times must increase (--allow-late passes late rows to the observers)";
+         << ": times must increase";
+      // Late rows are measurements; a file without output columns (a scenario's input
+      // schedule) has none, and --allow-late does not apply to it.
+      if (p_ > 0) os << " (--allow-late passes late rows to the observers)";
       fail(os.str());
     }
   }
