@@ -20,21 +20,25 @@ void InputSchedule::validate(Eigen::Index inputs) const {
        << inputs << " input(s) at " << knots << " knot(s) need " << inputs << " x " << knots;
     fail(os.str());
   }
-  for (std::size_t i = 0; i < times.size(); ++i) {
+  // The message is built only for the knot that fails (a file may hold a million).
+  const auto fail_at = [&](std::size_t i, const auto& say) {
     std::ostringstream os;
     os << std::setprecision(17) << "knot " << i << ": ";
+    say(os);
+    fail(os.str());
+  };
+  for (std::size_t i = 0; i < times.size(); ++i) {
     if (!std::isfinite(times[i])) {
-      os << "time " << times[i] << " is not a finite number";
-      fail(os.str());
+      fail_at(i, [&](std::ostream& os) { os << "time " << times[i] << " is not a finite number"; });
     }
     if (i > 0 && !(times[i] > times[i - 1])) {
-      os << "time " << times[i] << " does not come after the knot before (" << times[i - 1]
-         << "): times must strictly increase";
-      fail(os.str());
+      fail_at(i, [&](std::ostream& os) {
+        os << "time " << times[i] << " does not come after the knot before (" << times[i - 1]
+           << "): times must strictly increase";
+      });
     }
     if (!values.col(static_cast<Eigen::Index>(i)).allFinite()) {
-      os << "a value is not a finite number";
-      fail(os.str());
+      fail_at(i, [](std::ostream& os) { os << "a value is not a finite number"; });
     }
   }
 }

@@ -41,22 +41,29 @@ void read_knots(JsonReader& in, Eigen::Index inputs, InputSchedule& schedule) {
   schedule.values = values.transpose().replicate(values.cols() == 1 ? inputs : 1, 1);
 }
 
+// The input kinds by family, named once: a signal on every input alike, knots in the file,
+// and a schedule (knots in the file or from a CSV file).
+bool input_is_signal(const std::string& kind) {
+  return kind == "zero" || kind == "constant" || kind == "sin";
+}
+bool input_has_knots(const std::string& kind) {
+  return kind == "piecewise_constant" || kind == "piecewise_linear";
+}
 bool input_is_schedule(const std::string& kind) {
-  return kind == "piecewise_constant" || kind == "piecewise_linear" || kind == "file";
+  return input_has_knots(kind) || kind == "file";
 }
 
 InputSpec parse_input(JsonReader& in, const AnyModel& model, const std::string& base_directory) {
   InputSpec spec;
   spec.kind = in.text("kind").value_or("zero");
-  if (spec.kind == "zero" || spec.kind == "constant" || spec.kind == "sin") {
+  if (input_is_signal(spec.kind)) {
     spec.value = in.number("value").value_or(0.0);
     spec.amplitude = in.number("amplitude").value_or(1.0);
     spec.frequency = in.number("frequency").value_or(1.0);
     in.finish({"kind", "value", "amplitude", "frequency"});
     return spec;
   }
-  const bool knots = spec.kind == "piecewise_constant" || spec.kind == "piecewise_linear";
-  if (!knots && spec.kind != "file") {
+  if (!input_is_schedule(spec.kind)) {
     in.fail("'kind' must be zero, constant, sin, piecewise_constant, piecewise_linear or file");
   }
   const Eigen::Index inputs = model.inputs();
@@ -64,7 +71,7 @@ InputSpec parse_input(JsonReader& in, const AnyModel& model, const std::string& 
     in.fail("'kind' " + spec.kind + ": model '" + printable(model.name()) +
             "' has no input for the schedule to drive");
   }
-  if (knots) {
+  if (input_has_knots(spec.kind)) {
     read_knots(in, inputs, spec.schedule);
     spec.schedule.interpolation = spec.kind == "piecewise_linear"
                                       ? InputSchedule::Interpolation::kLinear
@@ -120,7 +127,7 @@ nlohmann::json input_json(const InputSpec& in) {
                                   ? "linear"
                                   : "previous"}};
   }
-  if (in.kind == "piecewise_constant" || in.kind == "piecewise_linear") {
+  if (input_has_knots(in.kind)) {
     nlohmann::json values = nlohmann::json::array();
     for (Eigen::Index i = 0; i < in.schedule.values.cols(); ++i) {
       values.push_back(vector_json(in.schedule.values.col(i)));
@@ -261,7 +268,7 @@ Measurements simulate_scenario(const Scenario& s, const AnyModel& model) {
     } catch (const InvalidInput& e) {
       throw InvalidInput("scenario '" + s.name + "': " + e.what());
     }
-  } else if (s.input.kind != "zero" && s.input.kind != "constant" && s.input.kind != "sin") {
+  } else if (!input_is_signal(s.input.kind)) {
     throw InvalidInput("scenario '" + s.name + "': input kind '" + printable(s.input.kind) +
                        "' is none of zero, constant, sin, piecewise_constant, piecewise_linear, "
                        "file");
