@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "nlobs/models/discretization.hpp"
+#include "nlobs/models/reaction_diffusion_chain.hpp"
 #include "nlobs/observers/baselines/baselines.hpp"
 #include "nlobs/observers/core/simulation.hpp"
 #include "nlobs/registry/json_reader.hpp"
@@ -206,6 +207,25 @@ TEST(RealPlant, TheFlowOffTheGridStepsByTheSubstep) {
   const Eigen::Matrix<double, 1, 1> u(308.0);
   EXPECT_EQ(four.flow(x, u, 3.0, 2.5 * kSampleTime), quarter.flow(x, u, 3.0, 2.5 * kSampleTime));
   EXPECT_EQ(four.f(x, u, 30), quarter.flow(x, u, 3.0, kSampleTime));
+}
+
+// At n = 10^5 (the reaction–diffusion chain, run-time size): 4 sub-steps of a sample are the
+// flow over it on a grid of h / 4, bit for bit, and the fronts stay finite and in [−0.5, 1.5].
+TEST(RealPlant, SubstepsAtAHundredThousandStates) {
+  const long n = 100000;
+  const ReactionDiffusionChain chain({.cells = n, .sensors = 8});
+  const Discretized<ReactionDiffusionChain> four(chain, 0.25,
+                                                 {.scheme = Scheme::kRk4, .substeps = 4});
+  const Discretized<ReactionDiffusionChain> quarter(chain, 0.0625, Scheme::kRk4);
+  Eigen::VectorXd x(n);
+  for (long i = 0; i < n; ++i) x[i] = i < n / 4 ? 1.0 : 0.0;  // a front at n / 4
+  const ModelVector<double, 0> u;
+  const Eigen::VectorXd stepped = four.f(x, u, 3);
+  EXPECT_EQ(stepped, quarter.flow(x, u, 0.75, 0.25));
+  EXPECT_TRUE(stepped.allFinite());
+  EXPECT_GT(stepped.minCoeff(), -0.5);
+  EXPECT_LT(stepped.maxCoeff(), 1.5);
+  EXPECT_NE(stepped, x);
 }
 
 // From a scenario file: the model spec's "substeps" (the entry's default when absent) reaches

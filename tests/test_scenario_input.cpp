@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 
 #include "cli_test_files.hpp"
@@ -229,6 +230,20 @@ TEST(ScenarioInput, AFileScheduleIsReadBesideTheScenarioAndWrittenBackAbsolute) 
   test::write_file(dir / "scenario.json",
                    scenario_with({{"kind", "file"}, {"file", "lnk/../u.csv"}}).dump());
   EXPECT_EQ(prepare_scenario(load_scenario((dir / "scenario.json").string())).data.u(0, 0), 1.0);
+
+  // A file of 10^5 rows (knots every 0.001 s): read whole, each sample at its knot.
+  {
+    std::ostringstream rows;
+    rows << "t,u1,u2\n";
+    for (long i = 0; i < 100000; ++i) rows << 0.001 * static_cast<double>(i) << ',' << i << ",0\n";
+    test::write_file(dir / "long.csv", rows.str());
+    test::write_file(dir / "scenario.json",
+                     scenario_with({{"kind", "file"}, {"file", "long.csv"}}).dump());
+    const Scenario s = load_scenario((dir / "scenario.json").string());
+    ASSERT_EQ(s.input.schedule.times.size(), 100000u);
+    const Measurements data = prepare_scenario(s).data;
+    EXPECT_EQ(data.u(0, 11), 2750.0);  // t = 2.75 is the knot of row 2750
+  }
 
   // Linear between the file's rows: u1 = 1 + 2 t on [0, 1].
   test::write_file(
