@@ -35,14 +35,14 @@ void print_list(const std::string& what, std::ostream& out) {
                                 "'; valid: models, engines, observers, scenarios, problems");
   }
   if (all || what == "models") {
-    out << "models (JSON: {\"name\", \"parameters\", \"scheme\": euler|rk4, \"step\", "
-           "\"substeps\": 1.."
-        << DiscretizationOptions::kMostSubsteps << "}):\n";
+    out << "models (JSON: {\"name\", \"parameters\", \"scheme\": euler|rk4|dopri5|sdirk3, "
+           "\"step\", \"substeps\": 1.."
+        << DiscretizationOptions::kMostSubsteps
+        << ", \"absolute_tolerance\", \"relative_tolerance\"}):\n";
     for (const ModelEntry* m : model_registry().entries()) {
       out << "  " << m->name << " — " << m->description << '\n';
       out << "      " << m->states << " states, " << m->inputs << " inputs, " << m->outputs
-          << " outputs; T = " << m->default_step << ", "
-          << (m->default_scheme == Scheme::kEuler ? "euler" : "rk4");
+          << " outputs; T = " << m->default_step << ", " << scheme_name(m->default_scheme);
       if (m->default_substeps != 1) out << ", " << m->default_substeps << " substeps";
       out << "; observers:";
       for (const auto& f : m->families) out << ' ' << f;

@@ -1,6 +1,7 @@
 #include "nlobs/registry/model_registry.hpp"
 
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -29,23 +30,29 @@ ModelInstance make_model_instance(JsonReader& spec, const ModelRegistry& registr
   DiscretizationOptions discretization{.scheme = entry->default_scheme,
                                        .substeps = entry->default_substeps};
   if (auto s = spec.text("scheme")) {
-    if (*s == "euler") {
-      discretization.scheme = Scheme::kEuler;
-    } else if (*s == "rk4") {
-      discretization.scheme = Scheme::kRk4;
-    } else {
-      spec.fail("scheme '" + *s + "' is not euler or rk4");
+    const std::optional<Scheme> scheme = scheme_from_name(*s);
+    if (!scheme) {
+      spec.fail("scheme '" + printable(*s) + "' is not one of " + std::string(kSchemeNames));
     }
+    discretization.scheme = *scheme;
   }
   if (auto n = spec.integer("substeps", 1, DiscretizationOptions::kMostSubsteps)) {
     discretization.substeps = static_cast<int>(*n);
+  }
+  if (auto a = spec.number("absolute_tolerance")) discretization.absolute_tolerance = *a;
+  if (auto r = spec.number("relative_tolerance")) discretization.relative_tolerance = *r;
+  try {
+    discretization.validate();
+  } catch (const InvalidInput& e) {
+    spec.fail(e.what());
   }
   const double step = spec.number("step").value_or(entry->default_step);
   if (!(step > 0.0) || !std::isfinite(step)) spec.fail("'step' must be finite and > 0");
   static const nlohmann::json empty = nlohmann::json::object();
   std::optional<JsonReader> parameters = spec.object("parameters");
   JsonReader p = parameters ? *parameters : JsonReader(empty, spec.where() + ".parameters");
-  spec.finish({"name", "parameters", "scheme", "step", "substeps"});
+  spec.finish({"absolute_tolerance", "name", "parameters", "relative_tolerance", "scheme", "step",
+               "substeps"});
   try {
     return entry->make(p, step, discretization);
   } catch (const InvalidInput& e) {  // the discretisation's refusal of the step

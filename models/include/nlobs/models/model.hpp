@@ -89,6 +89,20 @@ constexpr bool traces_sparsity() {
   }
 }
 
+// Whether this model, as configured, may be traced: it opts in (traces_sparsity) and, when it
+// says so at run time with `bool traceable() const`, its moves take the same steps at every x
+// (Discretized: not dopri5, whose steps follow the values, nor sdirk3, whose move is dense).
+template <typename M>
+bool traces_sparsity_now(const M& model) {
+  if constexpr (!traces_sparsity<M>()) {
+    return false;
+  } else if constexpr (requires { model.traceable(); }) {
+    return model.traceable();
+  } else {
+    return true;
+  }
+}
+
 // A discrete model that integrates over any interval: flow(x, u, t, dt).
 template <typename M>
 concept IntervalModel = DiscreteModel<M> &&

@@ -1,6 +1,7 @@
 #pragma once
 // Models by name for scenario files and the CLI. A model spec
-//   {"name": "lorenz", "parameters": {"sigma": 10}, "scheme": "rk4", "step": 0.01, "substeps": 1}
+//   {"name": "lorenz", "parameters": {"sigma": 10}, "scheme": "rk4", "step": 0.01, "substeps": 1,
+//    "absolute_tolerance": 1e-8, "relative_tolerance": 1e-6}
 // becomes a ModelInstance: the discretised model every observer can run on (AnyModel, with AD
 // Jacobians), and the hooks of the observer families that need the continuous model's own C++
 // type (MVT, high-gain, modulating), each empty with the reason when the model does not meet
@@ -128,8 +129,9 @@ using ModelRegistry = NamedRegistry<ModelEntry>;
 // The process-wide registry: every built-in model, then what plugins and user code add.
 ModelRegistry& model_registry();
 
-// The instance a model spec {"name", "parameters", "scheme", "step", "substeps"} describes
-// (substeps: DiscretizationOptions::substeps, 1..1000, the entry's default when absent). Throws
+// The instance a model spec {"name", "parameters", "scheme", "step", "substeps",
+// "absolute_tolerance", "relative_tolerance"} describes (scheme: euler, rk4, dopri5 or sdirk3;
+// the rest DiscretizationOptions' fields; the entry's defaults when absent). Throws
 // std::invalid_argument naming the key path on any problem (an unknown name lists the valid
 // ones).
 ModelInstance make_model_instance(JsonReader& spec,

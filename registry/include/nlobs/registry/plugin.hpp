@@ -75,7 +75,9 @@ inline constexpr std::uint32_t kPluginMagic = 0x6e6c6f62;  // "nlob"
 // WindowEstimatorOptions gained trace_first_window.
 // 7: ModelInstance's scheme became DiscretizationOptions discretization (scheme and substeps),
 // ModelEntry gained default_substeps and its make takes the DiscretizationOptions.
-inline constexpr std::uint32_t kPluginLayout = 7;
+// 8: DiscretizationOptions gained absolute_tolerance and relative_tolerance (schemes dopri5 and
+// sdirk3), and Scheme two values.
+inline constexpr std::uint32_t kPluginLayout = 8;
 inline constexpr const char* kPluginSymbol = "nlobs_plugin_info";
 
 #define NLOBS_PLUGIN_STRINGIFY_(x) #x

@@ -81,6 +81,12 @@ class MoveCovariance {
       traced_note_ = "not traced: the model does not opt in (kTracesSparsity)";
       return false;
     } else {
+      if (!traces_sparsity_now(model)) {
+        traced_note_ =
+            "not traced: the model's scheme takes steps that depend on the state, or "
+            "its move is dense (traceable() is false)";
+        return false;
+      }
       auto move = [&model, &u, &s](const auto& v) {
         using T = typename std::decay_t<decltype(v)>::Scalar;
         return ModelVector<T, Eigen::Dynamic>(

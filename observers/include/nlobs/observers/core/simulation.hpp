@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "nlobs/common/printable.hpp"
+#include "nlobs/models/integration_failure.hpp"
 #include "nlobs/models/model.hpp"
 #include "nlobs/observers/core/observer.hpp"
 #include "nlobs/solvers/status.hpp"
@@ -32,7 +33,9 @@ struct Measurements {
   Eigen::VectorXd t;  // t_k of every sample (run_observers needs one per sample)
   bool has_truth() const { return x.size() > 0; }
   Eigen::Index steps() const { return y.cols(); }
-  std::string stop_message;  // why the simulation ended early (domain), empty otherwise
+  // Why the simulation ended early (the domain, a non-finite state or output, a move the
+  // discretisation could not integrate), empty otherwise.
+  std::string stop_message;
 };
 
 struct SimulationOptions {
@@ -62,7 +65,8 @@ double simulation_sample_time(const Model& model, const SimulationOptions& o) {
 
 // Throws InvalidInput for steps < 1, σ < 0 or non-finite, a sample time that is not finite and
 // > 0, or an x0 of the wrong size; std::runtime_error naming the model (its name() when it has
-// one), the sample and its time when the model or the input signal throws.
+// one), the sample and its time when the model or the input signal throws — except an
+// IntegrationFailure, which stops the simulation as a non-finite state does (stop_message).
 template <DiscreteModel Model>
 Measurements simulate(const Model& model, const Eigen::VectorXd& x0, const SimulationOptions& o) {
   const Eigen::Index n = model.states(), p = model.outputs(), m = model.inputs();
@@ -96,11 +100,16 @@ Measurements simulate(const Model& model, const Eigen::VectorXd& x0, const Simul
   // The true system is the user's model too: whatever it (or the input signal) throws ends the
   // simulation with an error naming the model, the sample and its time. An exception is not a
   // domain exit (the model did not say where its domain ends); InvalidInput is ours, unchanged.
+  // IntegrationFailure is the discretisation's (an adaptive or implicit scheme that could not
+  // follow the plant): the simulation stops there as at a non-finite state, keeping the samples
+  // before it.
+  std::string failed_move;
   try {
     for (; k < o.steps; ++k) {
       // Stop where the state leaves its domain or the state or its output is no longer finite:
       // a NaN measurement must never reach the observers.
-      std::string violation = domain_violation_of(model, x);
+      std::string violation = failed_move;
+      if (violation.empty()) violation = domain_violation_of(model, x);
       Eigen::VectorXd y;
       if (violation.empty() && !x.allFinite()) {
         std::ostringstream os;
@@ -132,7 +141,13 @@ Measurements simulate(const Model& model, const Eigen::VectorXd& x0, const Simul
         for (Eigen::Index i = 0; i < p; ++i) y[i] += o.noise_std * noise(rng);
       }
       data.y.col(k) = y;
-      x = model.f(x, ModelVector<double, Model::kInputs>(u), k);
+      try {
+        x = model.f(x, ModelVector<double, Model::kInputs>(u), k);
+      } catch (const IntegrationFailure& e) {
+        failed_move = "the move from sample " + std::to_string(k) +
+                      " could not be integrated: " + printable(e.what());
+        continue;
+      }
       if (o.process_noise_std > 0.0) {
         for (Eigen::Index i = 0; i < n; ++i) x[i] += o.process_noise_std * noise(rng);
       }

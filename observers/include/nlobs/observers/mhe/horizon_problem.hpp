@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "nlobs/models/integration_failure.hpp"
 #include "nlobs/models/model.hpp"
 #include "nlobs/observers/core/discrete_jacobians.hpp"
 #include "nlobs/observers/core/model_step.hpp"
@@ -129,9 +130,17 @@ class MheHorizonProblem {
  private:
   bool inside_domain(const State& x) const { return domain_violation_of(*model_, x).empty(); }
 
-  // V at the states xs[0..M−1] (+inf when a term is not finite or a state leaves the model's
-  // domain).
+  // V at the states xs[0..M−1] (+inf when a term is not finite, a state leaves the model's
+  // domain, or a move cannot be integrated: IntegrationFailure, an adaptive or implicit scheme
+  // at a trial state far outside its range — the line search backtracks from it).
   double cost(const std::vector<State>& xs) const {
+    try {
+      return cost_or_throw(xs);
+    } catch (const IntegrationFailure&) {
+      return std::numeric_limits<double>::infinity();
+    }
+  }
+  double cost_or_throw(const std::vector<State>& xs) const {
     const std::size_t m = active_;
     double v = arrival_->cost(xs[0]);
     for (std::size_t i = 0; i < m; ++i) {

@@ -5,9 +5,11 @@
 // with the residual Y − H(w). N = n/p is the paper's square window; N > n/p overdetermines it.
 // Samples are pushed in time order; a non-finite sample is refused (the caller decides what a
 // missing measurement means).
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
+#include "nlobs/models/integration_failure.hpp"
 #include "nlobs/models/model.hpp"
 #include "nlobs/solvers/status.hpp"
 
@@ -92,14 +94,23 @@ class OutputWindow {
   auto input(Eigen::Index j) const { return u_.col((head_ + j) % length_); }
 
   // out = H(w), for any scalar T; `out` has rows() entries (a fixed-size vector for a square
-  // window keeps the evaluation allocation-free).
+  // window keeps the evaluation allocation-free). Where the model's discretisation cannot
+  // integrate on from w (IntegrationFailure: an adaptive or implicit scheme at a state far
+  // outside its range) the rest of H is NaN: to an engine, a trial point that is not finite,
+  // rejected as one where an explicit step overflowed.
   template <typename T, typename Out>
   void map_into(const State<T>& w, Out& out) const {
     State<T> x = w;
     const long k0 = first_index();
     for (Eigen::Index j = 0; j < length_; ++j) {
       out.segment(j * p_, p_) = model_.h(x);
-      if (j + 1 < length_) x = model_.f(x, Input(input(j)), k0 + static_cast<long>(j));
+      if (j + 1 == length_) break;
+      try {
+        x = model_.f(x, Input(input(j)), k0 + static_cast<long>(j));
+      } catch (const IntegrationFailure&) {
+        out.tail((length_ - j - 1) * p_).setConstant(T(std::numeric_limits<double>::quiet_NaN()));
+        return;
+      }
     }
   }
 
