@@ -172,6 +172,22 @@ std::string error_of(const nlohmann::json& json) {
   return "<no error>";
 }
 
+// sliding_mode's gamma has the default docs/observers.md gives (SlidingModeOptions::gamma, 1):
+// an entry without it runs, and `nlobs list observers` says so.
+TEST(ModelRegistry, SlidingModeTakesItsDocumentedDefaultGamma) {
+  register_once();
+  const RunResult r = run(rossler_scenario(nlohmann::json::parse(
+      R"([{"type": "sliding_mode", "Q": [0.05, 0.05, 0.0], "R": [1.0, 0.5, 0.0]}])")));
+  ASSERT_EQ(r.metrics.size(), 1u);
+  EXPECT_TRUE(r.metrics[0].mse_after_window.allFinite());
+  const ObserverTypeEntry& entry = observer_type_registry().get("sliding_mode");
+  bool listed = false;
+  for (const KeyInfo& k : entry.keys) {
+    if (k.key == "gamma") listed = k.default_value == "1";
+  }
+  EXPECT_TRUE(listed);
+}
+
 TEST(ModelRegistry, UserModelRunsWithEveryObserverTypeItsConditionsAllow) {
   register_once();
   const nlohmann::json observers = nlohmann::json::parse(R"([

@@ -102,7 +102,7 @@ bool has_key(const ObserverSpec& spec, const std::string& key, const ObserverTyp
 
 std::unique_ptr<Observer> build_observer(const ObserverSpec& spec, const ModelInstance& model,
                                          const Eigen::VectorXd& start, const std::string& where,
-                                         bool trace_first_window,
+                                         bool trace_first_window, double output_noise,
                                          const ObserverTypeRegistry& types) {
   const ObserverTypeEntry& entry = types.get(spec.type);
   std::optional<ModelInstance> design;
@@ -110,8 +110,9 @@ std::unique_ptr<Observer> build_observer(const ObserverSpec& spec, const ModelIn
     JsonReader reader(*spec.model, where + ".model");
     design = make_model_instance(reader);
   }
-  const ObserverBuild build{model, design ? design->discrete : model.discrete, start, where,
-                            trace_first_window};
+  const ObserverBuild build{
+      model,       design ? design->discrete : model.discrete, start, where, trace_first_window,
+      output_noise};
   std::unique_ptr<Observer> observer;
   try {
     observer = entry.build(spec.spec, build);

@@ -299,13 +299,14 @@ Eigen::VectorXd scenario_input(const Scenario& s, const AnyModel& model, long k)
 
 std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& s,
                                                       const ModelInstance& instance,
-                                                      bool trace_first_window) {
+                                                      bool trace_first_window,
+                                                      double output_noise) {
   std::vector<std::unique_ptr<Observer>> out;
   for (size_t i = 0; i < s.observers.size(); ++i) {
     const ObserverSpec& o = s.observers[i];
     out.push_back(build_observer(o, instance, o.initial.value_or(s.initial_guess),
                                  s.name + ".observers[" + std::to_string(i) + "]",
-                                 trace_first_window));
+                                 trace_first_window, output_noise));
   }
   return out;
 }

@@ -142,8 +142,9 @@ PreparedScenario prepare_scenario(Scenario scenario, RunSettings settings) {
     data = simulate_scenario(scenario, model);  // no sample at all: run_prepared refuses it
   }
   const long settle_index = settle_index_of(scenario, model, data.steps());
+  const bool simulated = !settings.data;
   return PreparedScenario{std::move(scenario), std::move(instance), std::move(data),
-                          std::move(source), settle_index};
+                          std::move(source),   settle_index,        simulated};
 }
 
 ScenarioRun run_prepared(PreparedScenario prepared, const RunSettings& settings) {
@@ -156,7 +157,8 @@ ScenarioRun run_prepared(PreparedScenario prepared, const RunSettings& settings)
   ScenarioRun run{std::move(prepared), {}, nlohmann::json::array(), {}, {}, {}};
   const Scenario& s = run.prepared.scenario;
   const Measurements& data = run.prepared.data;
-  auto observers = make_observers(s, run.prepared.model, settings.trace_first_window);
+  auto observers = make_observers(s, run.prepared.model, settings.trace_first_window,
+                                  run.prepared.simulated && s.process_noise == 0.0 ? s.noise : 0.0);
   Eigen::Index longest = 1;
   for (const auto& o : observers) longest = std::max(longest, o->info().window);
   if (longest > data.steps()) {

@@ -126,7 +126,10 @@ SweepRun run_sweep(const PreparedScenario& prepared, const std::string& key,
         });
       }
     }
-    auto observers = named([&] { return make_observers(run, *model, false); });
+    // The noise the data were simulated with (a model sweep simulates them again), if any.
+    const bool simulated_data = d == &simulated || prepared.simulated;
+    const double declared_noise = simulated_data && run.process_noise == 0.0 ? run.noise : 0.0;
+    auto observers = named([&] { return make_observers(run, *model, false, declared_noise); });
     SweepValue v;
     v.value = value;
     v.result = measure_observers(*d, observers, sweep.settle_index, v.horizon_indices);

@@ -27,6 +27,14 @@ void WindowEstimatorOptions::validate() const {
        << " must be finite and nonzero (Psi = gain_scale I must be invertible)";
     throw InvalidInput(os.str());
   }
+  if (measurement_covariance.size()) {
+    detail::require_covariance("WindowEstimatorOptions", "measurement_covariance",
+                               measurement_covariance, detail::Definiteness::kDefinite);
+  }
+  if (!(consistency_quantile > 0.0 && consistency_quantile < 1.0)) {
+    detail::invalid_option("WindowEstimatorOptions", "consistency_quantile", "be in (0, 1)",
+                           detail::option_value(consistency_quantile));
+  }
   if (initial_estimate.size() == 0 || !initial_estimate.allFinite()) {
     std::ostringstream os;
     os << "WindowEstimatorOptions::initial_estimate = [" << initial_estimate.transpose()

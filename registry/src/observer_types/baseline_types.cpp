@@ -47,7 +47,7 @@ void add_sliding_mode(ObserverTypeRegistry& registry) {
       .condition = "",
       .keys = {{"Q", "linear gain (n x p)", ""},
                {"R", "switching gain (n x p)", ""},
-               {"gamma", "boundary layer of sat(e / gamma), > 0", ""},
+               {"gamma", "boundary layer of sat(e / gamma), > 0", "1"},
                initial_key(),
                design_model_key()},
       .parse =
@@ -56,7 +56,7 @@ void add_sliding_mode(ObserverTypeRegistry& registry) {
             s.q = o.matrix("Q").value_or(Eigen::MatrixXd());
             s.r = o.matrix("R").value_or(Eigen::MatrixXd());
             if (s.q.size() == 0 || s.r.size() == 0) o.fail("missing field 'Q' or 'R'");
-            s.gamma = o.required_number("gamma");
+            s.gamma = o.number("gamma").value_or(s.gamma);  // SlidingModeOptions' default
             return s;
           },
       .write =

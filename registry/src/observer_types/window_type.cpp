@@ -4,6 +4,7 @@
 #include <string>
 
 #include "builtin_observer_types.hpp"
+#include "covariance_keys.hpp"
 #include "nlobs/observers/window/window_estimator.hpp"
 
 namespace nlobs::detail {
@@ -19,10 +20,15 @@ struct WindowSpec {
   WarmStart warm_start = WarmStart::kPropagated;
   WindowGain gain = WindowGain::kAuto;
   double gain_scale = 1.0;
+  Eigen::MatrixXd measurement_covariance{};  // R; empty: σ² I of a simulated run's noise
+  double consistency_quantile = WindowEstimatorOptions{}.consistency_quantile;
 };
 
-WindowSpec parse(JsonReader& o, const ModelInstance&) {
+WindowSpec parse(JsonReader& o, const ModelInstance& model) {
   WindowSpec s;
+  s.measurement_covariance = covariance_key(o, "measurement_covariance", model.discrete.outputs());
+  s.consistency_quantile =
+      o.number("consistency_quantile").value_or(WindowEstimatorOptions{}.consistency_quantile);
   s.engine = o.text("engine").value_or("newton");
   s.tol = o.number("tol");
   s.window = o.integer("window", 0, kMaxWindow).value_or(0);
@@ -54,6 +60,12 @@ void write(const WindowSpec& s, nlohmann::json& out) {
   if (s.tol) out["tol"] = *s.tol;
   out["window"] = s.window;
   out["warm_start"] = s.warm_start == WarmStart::kPrevious ? "previous" : "propagated";
+  if (s.measurement_covariance.size()) {
+    out["measurement_covariance"] = matrix_json(s.measurement_covariance);
+  }
+  if (s.consistency_quantile != WindowEstimatorOptions{}.consistency_quantile) {
+    out["consistency_quantile"] = s.consistency_quantile;
+  }
   switch (s.gain) {
     case WindowGain::kScalar:
       out["psi"] = s.gain_scale;
@@ -82,6 +94,13 @@ std::unique_ptr<Observer> build(const WindowSpec& s, const ObserverBuild& b) {
   window_options.gain = s.gain;
   window_options.gain_scale = s.gain_scale;
   window_options.trace_first_window = b.trace_first_window;
+  window_options.consistency_quantile = s.consistency_quantile;
+  window_options.measurement_covariance = s.measurement_covariance;
+  const double variance = b.output_noise * b.output_noise;
+  if (!s.measurement_covariance.size() && variance > 0.0 && std::isfinite(variance)) {
+    const Eigen::Index p = b.design.outputs();  // (a square window ignores it)
+    window_options.measurement_covariance = variance * Eigen::MatrixXd::Identity(p, p);
+  }
   return make_window_estimator(b.model.discrete, s.engine, window_options, options);
 }
 
@@ -97,6 +116,13 @@ void add_window_type(ObserverTypeRegistry& registry) {
                {"window", "samples N of the window; 0: square (N = n)", "0"},
                {"warm_start", "propagated | previous: the next window's first guess", "propagated"},
                {"psi", "auto | identity | newton | a number: the square window's gain", "auto"},
+               {"measurement_covariance",
+                "R (p x p, or v for v I): the noise a least-squares window's cost is checked "
+                "against",
+                "noise^2 I of a simulated run without process noise; else none"},
+               {"consistency_quantile",
+                "in (0, 1): answers with 2V above this quantile of chi2(N p - n) are refused",
+                "0.9999"},
                initial_key()},
       .parse = parse,
       .write = write,

@@ -32,6 +32,12 @@ struct ObserverBuild {
   const Eigen::VectorXd& start;     // "initial", or the scenario's initial guess
   const std::string& where;         // "scenario.observers[2]", for messages
   bool trace_first_window = false;  // window estimators: record the first window's iterations
+  // σ of the output noise the run declares: its scenario's "noise" when it simulates the data
+  // without process noise; 0 for recorded data (--data), whose noise the scenario does not
+  // know, and with process noise, which a window (the model exact over N samples) does not
+  // account for. A least-squares window checks its answers against σ² I unless its own
+  // measurement_covariance is given.
+  double output_noise = 0.0;
 };
 
 struct ObserverTypeEntry {
@@ -126,11 +132,11 @@ ObserverSpec with_key(const ObserverSpec& spec, const std::string& key, const nl
 // Whether the spec's type lists `key`.
 bool has_key(const ObserverSpec& spec, const std::string& key,
              const ObserverTypeRegistry& types = observer_type_registry());
-// Builds it; `start` and `design` as in ObserverBuild. InvalidInput from the type is prefixed
-// with `where`.
+// Builds it; `start`, `design` and `output_noise` as in ObserverBuild. InvalidInput from the
+// type is prefixed with `where`.
 std::unique_ptr<Observer> build_observer(
     const ObserverSpec& spec, const ModelInstance& model, const Eigen::VectorXd& start,
-    const std::string& where, bool trace_first_window,
+    const std::string& where, bool trace_first_window, double output_noise = 0.0,
     const ObserverTypeRegistry& types = observer_type_registry());
 
 }  // namespace nlobs

@@ -77,7 +77,9 @@ inline constexpr std::uint32_t kPluginMagic = 0x6e6c6f62;  // "nlob"
 // ModelEntry gained default_substeps and its make takes the DiscretizationOptions.
 // 8: DiscretizationOptions gained absolute_tolerance and relative_tolerance (schemes dopri5 and
 // sdirk3), and Scheme two values.
-inline constexpr std::uint32_t kPluginLayout = 8;
+// 9: ObserverBuild gained output_noise (the noise a simulated run declares) and build_observer
+// a parameter for it.
+inline constexpr std::uint32_t kPluginLayout = 9;
 inline constexpr const char* kPluginSymbol = "nlobs_plugin_info";
 
 #define NLOBS_PLUGIN_STRINGIFY_(x) #x

@@ -86,10 +86,13 @@ ModelInstance scenario_model(const Scenario& scenario);
 // Measurements::stop_message set.
 Measurements simulate_scenario(const Scenario& scenario, const AnyModel& model);
 // The observers a scenario describes, on its model. `trace_first_window`: window estimators
-// record the engine's trace of their first window (for the convergence plot).
+// record the engine's trace of their first window (for the convergence plot). `output_noise`:
+// ObserverBuild's: the scenario's noise when the run simulates its data without process noise,
+// else 0.
 std::vector<std::unique_ptr<Observer>> make_observers(const Scenario& scenario,
                                                       const ModelInstance& model,
-                                                      bool trace_first_window);
+                                                      bool trace_first_window,
+                                                      double output_noise = 0.0);
 Eigen::VectorXd scenario_input(const Scenario& scenario, const AnyModel& model, long k);
 
 // What the scenario's observer types report before a run (their entries' `report`: per PI

@@ -54,6 +54,9 @@ struct PreparedScenario {
   Measurements data;
   std::string source;      // "simulation" or RunSettings::data_source
   long settle_index = -1;  // the first sample of "after" (settle_time); −1: none set
+  // The data were simulated (with the scenario's noise, which observers may then take as
+  // declared), not recorded.
+  bool simulated = false;
 };
 
 // Builds the model (the one parse_scenario built, unless the scenario's model was edited) and

@@ -21,14 +21,18 @@
 //
 //   auto estimator = make_window_estimator(model, "newton:tol=1e-10", options);  // by spec, or
 //   WindowEstimator<Model> estimator(model, options, std::make_unique<CeresEngine<3>>(...));
+#include <Eigen/Cholesky>
 #include <Eigen/LU>
+#include <Eigen/QR>
 #include <cmath>
 #include <memory>
 #include <sstream>
 #include <string>
 #include <string_view>
 
+#include "nlobs/observers/core/chi_squared.hpp"
 #include "nlobs/observers/core/observer.hpp"
+#include "nlobs/observers/core/option_checks.hpp"
 #include "nlobs/observers/core/sample_clock.hpp"
 #include "nlobs/observers/window/output_window.hpp"
 #include "nlobs/observers/window/window_problems.hpp"
@@ -65,13 +69,35 @@ struct WindowEstimatorOptions {
   WarmStart warm_start = WarmStart::kPropagated;
   WindowGain gain = WindowGain::kAuto;  // Ψ (square windows only)
   double gain_scale = 1.0;              // Ψ = gain_scale · I for WindowGain::kScalar
+  // The noise the outputs are declared to carry, R (p × p; symmetric positive definite), for the
+  // consistency check of a least-squares window (N·p > n). With the model right over the window
+  // (no process noise) and the noise Gaussian, the R-weighted cost at its minimiser,
+  //   2V = ‖(I − P) z‖²,  z = L⁻¹ (Y − H(w*)) sample by sample (R = L Lᵀ),
+  //   P the projector on the range of L⁻¹ ∂H/∂w(w*),
+  // follows χ² with N·p − n degrees of freedom (exactly for a linear model, to first order
+  // otherwise) [BSLK01]. The projection removes what one more Gauss–Newton step in the R
+  // metric would still fit, so the statistic is the weighted minimiser's even when the engine
+  // minimised the unweighted cost or stopped at its tolerance short of the minimum — when that
+  // step is small (‖δ‖∞ ≤ 1e-2 (1 + ‖w*‖∞)); a larger one is no refinement of the answer (a
+  // flat local minimum, where ∂H/∂w nearly vanishes), and 2V is then ‖z‖². An answer
+  // with 2V above that χ²'s `consistency_quantile` is refused — failure
+  // "inconsistent_with_noise", the estimate coasts as after an unusable solve — rather than
+  // published: a local minimum, or a model that does not fit the data. Empty: not checked. A
+  // square window (N·p = n) fits any data exactly and is never checked.
+  Eigen::MatrixXd measurement_covariance;
+  // In (0, 1): the share of consistent answers the check lets through; 1 − it is the rate of
+  // false refusals when everything is right (one window in 10 000 by default: a refusal coasts
+  // the estimate, which costs on a chaotic plant, and the local minima the check is for sit
+  // orders of magnitude above any quantile — 2V ≈ 4.5e4 against 23.5 in the tests).
+  double consistency_quantile = 0.9999;
   // The engine records its trace (Summary::trace, the convergence plot's data) on the first
   // window after each reset only: Engine::set_record_trace around that one solve, so that every
   // other step stays lean.
   bool trace_first_window = false;
   // Throws InvalidInput naming the field for a negative window, a gain_scale that is 0 or not
-  // finite, or an initial estimate that is empty or not finite. The constructor calls it and
-  // checks the sizes against the model.
+  // finite, an initial estimate that is empty or not finite, a measurement_covariance given but
+  // not symmetric positive definite, or a consistency_quantile outside (0, 1). The constructor
+  // calls it and checks the sizes against the model.
   void validate() const;
 };
 
@@ -127,6 +153,9 @@ class WindowEstimator final : public Observer {
   Summary solve_window(Engine<N>& engine, State& w, long k);
   Summary solve_once(Engine<N>& engine, State& w);
   void choose_gain(const Engine<N>& engine, const State& w, long k);
+  // False, with the step's failure set, when a least-squares window's answer w is inconsistent
+  // with the declared noise (WindowEstimatorOptions::measurement_covariance); true otherwise.
+  bool consistent_with_noise(const State& w, long k);
   // Ψ = (∂H/∂w)⁻¹ at w; false (Ψ unchanged) where ∂H/∂w is singular or not finite.
   bool refresh_newton_gain(const State& w);
   bool window_jacobian(const State& w, Gain& dh) const;  // dh = ∂H/∂w
@@ -155,10 +184,22 @@ class WindowEstimator final : public Observer {
   bool gain_chosen_ = false;        // the first window decided Ψ (kAuto) and checked it
   std::size_t setup_warnings_ = 0;  // info_.warnings from the constructor
   bool warned_singular_ = false;
+  // The consistency check: R = L Lᵀ, the χ² quantile 2V is held to, and its buffers (sized once,
+  // the QR's at its first use; a model of run-time size also allocates the step δ's n entries
+  // per check).
+  bool check_consistency_ = false;
+  Eigen::LLT<Eigen::MatrixXd> noise_factor_;
+  double consistency_bound_ = 0.0;
+  Eigen::VectorXd predicted_, whitened_, householder_workspace_;
+  typename RootProblem<N, Dynamic>::JacobianType window_jacobian_;  // ∂F/∂w, F = Y − H
+  Eigen::HouseholderQR<typename RootProblem<N, Dynamic>::JacobianType> projection_;
   // Relative offset of a guess at a singular point of the window map; an LU pivot below this
   // fraction of the largest |∂H/∂w| entry counts as zero (as in NewtonEngine).
   static constexpr double kPerturbation = 1e-3;
   static constexpr double kSingularPivot = 1e-13;
+  // The largest Gauss–Newton step, relative to 1 + ‖w*‖∞, whose fit the consistency check
+  // credits to the answer (consistent_with_noise).
+  static constexpr double kLargestRefinement = 1e-2;
 };
 
 // The one-line form: the engine named by a spec of EngineRegistry<N> ("newton:tol=1e-10"),
@@ -192,6 +233,11 @@ WindowEstimator<Model>::WindowEstimator(Model model, WindowEstimatorOptions opti
     throw InvalidInput(os.str());
   }
   initial_guess_ = options_.initial_estimate;
+  if (options_.measurement_covariance.size()) {
+    const Eigen::Index p = state_->window.model().outputs();
+    detail::require_shape("WindowEstimatorOptions", "measurement_covariance",
+                          options_.measurement_covariance, p, p);
+  }
   square_ = state_->window.rows() == n;
   // Built once; they read the window, which never moves (it lives behind a unique_ptr).
   if (square_) {
@@ -209,6 +255,17 @@ WindowEstimator<Model>::WindowEstimator(Model model, WindowEstimatorOptions opti
                          " is solved in the least-squares sense, without Psi");
     }
     root_ = std::make_unique<RootProblem<N, Dynamic>>(window_residual_problem(state_->window));
+    if (options_.measurement_covariance.size()) {
+      const Eigen::Index rows = state_->window.rows();
+      noise_factor_.compute(options_.measurement_covariance);
+      consistency_bound_ =
+          chi_squared_quantile(static_cast<double>(rows - n), options_.consistency_quantile);
+      predicted_.resize(rows);
+      whitened_.resize(rows);
+      householder_workspace_.resize(1);
+      window_jacobian_.resize(rows, n);
+      check_consistency_ = true;
+    }
   }
   info_.engine = spec_;
   info_.window = state_->window.length();
@@ -301,7 +358,7 @@ const ObserverStep& WindowEstimator<Model>::step(long k, double t, const Eigen::
     if (trace) engine.set_record_trace(true);
     solved_once_ = true;
     step_.summary = solve_window(engine, w, k);
-    if (step_.summary->usable()) {
+    if (step_.summary->usable() && consistent_with_noise(w, k)) {
       const State w1 = window.propagate(w, 1);  // x̂[k−N+2]
       // x̂[k] = f^{N−1}(w*): w* itself for a one-sample window.
       const State estimate = length == 1 ? w : window.propagate(w1, length - 2, 1);
@@ -328,6 +385,55 @@ const ObserverStep& WindowEstimator<Model>::step(long k, double t, const Eigen::
   history_[slot(index)] = coast_;
   step_.estimate = coast_;
   return step_;
+}
+
+template <DiscreteModel Model>
+bool WindowEstimator<Model>::consistent_with_noise(const State& w, long k) {
+  if (!check_consistency_) return true;
+  const OutputWindow<Model>& window = state_->window;
+  const Eigen::Index p = window.model().outputs(), n = window.states();
+  window.map_into(w, predicted_);
+  root_->jacobian(w, window_jacobian_);
+  // z = L⁻¹ (Y − H(w*)) and L⁻¹ ∂F/∂w, sample by sample.
+  whitened_ = window.outputs() - predicted_;
+  const auto factor = noise_factor_.matrixL();
+  for (Eigen::Index j = 0; j < window.length(); ++j) {
+    auto residual = whitened_.segment(j * p, p);
+    factor.solveInPlace(residual);
+    auto rows = window_jacobian_.middleRows(j * p, p);
+    factor.solveInPlace(rows);
+  }
+  // 2V = ‖(I − P) z‖²: the entries of Qᵀ z beyond the first n, Q R the QR of L⁻¹ ∂F/∂w —
+  // trusted only when the Gauss–Newton step it stands for, δ = R⁻¹ (Qᵀ z)_{1..n}, is small;
+  // otherwise (∂H/∂w nearly singular, as at a flat local minimum, or w* far from the weighted
+  // minimum) the plain ‖z‖².
+  const double plain = whitened_.squaredNorm();
+  projection_.compute(window_jacobian_);
+  projection_.householderQ().adjoint().applyThisOnTheLeft(whitened_, householder_workspace_);
+  const State step =
+      projection_.matrixQR().topRows(n).template triangularView<Eigen::Upper>().solve(
+          whitened_.head(n));
+  const double reach = kLargestRefinement * (1.0 + w.template lpNorm<Eigen::Infinity>());
+  const bool small_step = step.allFinite() && step.template lpNorm<Eigen::Infinity>() <= reach;
+  const double statistic = small_step ? whitened_.tail(whitened_.size() - n).squaredNorm() : plain;
+  if (statistic <= consistency_bound_) return true;
+  std::ostringstream os;
+  os << name() << ": the window's answer at sample k = " << k;
+  if (std::isfinite(statistic)) {
+    os << " is inconsistent with the declared noise R: 2V = " << statistic << " > "
+       << consistency_bound_ << ", the " << options_.consistency_quantile << " quantile of chi2("
+       << window.rows() - n
+       << ") (N p - n degrees of freedom); a local minimum, or a model that does not fit the "
+          "data: the estimate coasts";
+  } else {
+    os << " has a residual or window Jacobian that is not finite: it cannot be checked against "
+          "the declared noise R, and the estimate coasts";
+  }
+  if (step_.failure.empty()) {
+    step_.failure = "inconsistent_with_noise";
+    step_.failure_message = os.str();
+  }
+  return false;
 }
 
 template <DiscreteModel Model>
