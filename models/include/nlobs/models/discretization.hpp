@@ -63,8 +63,9 @@ struct DiscretizationOptions {
   static constexpr int kMostSubsteps = 1000;
   static constexpr long kMostImplicitStates = 200;  // sdirk3: dense, AD in O(n⁴ / 8) (sdirk.hpp)
   Scheme scheme = Scheme::kEuler;
-  int substeps =
-      1;  // 1 ≤ substeps ≤ kMostSubsteps; dopri5: its first and largest step h / substeps
+  // 1 ≤ substeps ≤ kMostSubsteps: steps of h / substeps per sample; dopri5: its first and
+  // largest step h / substeps.
+  int substeps = 1;
   // dopri5's local error control, err_i ≤ atol + rtol |x_i| (dormand_prince.hpp); sdirk3's
   // Newton increment ≤ 1 % of it (sdirk.hpp). Unused by euler and rk4.
   double absolute_tolerance = 1e-8;  // finite, > 0
